@@ -1,0 +1,86 @@
+"""The ``schuler`` command: ``schuler SYSTEM ACTION [options]``.
+
+Systems: ``errors`` (INS error propagation), ``vertical`` (gyro vertical),
+``calibrate`` (pulse drift calibration), ``align`` (gyrocompassing), ``north``
+(ground gyrocompass); each has ``run`` and ``reproduce``. Studies: ``run
+SCENARIO.toml``, ``sweep``, ``report``. Commands are loaded lazily so that
+``schuler --help`` is quick.
+
+Errors (a :class:`~schuler.exceptions.SchulerError` or a usage mistake) print one
+line on stderr and exit with code 2.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+import warnings
+
+import click
+
+from schuler import __version__
+from schuler.exceptions import SchulerError
+
+COMMANDS: dict[str, tuple[str, str]] = {
+    "errors": ("schuler.cli.errors:group", "Schuler-tuned INS error propagation (Bollay)."),
+    "vertical": ("schuler.cli.vertical:group", "Gyro vertical with integral correction (Drozdovich)."),
+    "calibrate": ("schuler.cli.calibrate:group", "Gyro drift calibration by alternating torque pulses."),
+    "align": ("schuler.cli.align:group", "Physical gyrocompassing of a platform INS."),
+    "north": ("schuler.cli.north:group", "Ground gyrocompass during rotor run-down."),
+    "run": ("schuler.cli.study:run_scenario", "Run a scenario file (TOML)."),
+    "sweep": ("schuler.cli.study:sweep", "Sweep parameters or Monte Carlo over a scenario."),
+    "report": ("schuler.cli.study:report", "Build the HTML report of all systems."),
+}
+
+
+class LazyGroup(click.Group):
+    """A group whose subcommands are imported only when used."""
+
+    def list_commands(self, ctx):
+        return list(COMMANDS)
+
+    def get_command(self, ctx, name):
+        if name not in COMMANDS:
+            return None
+        module_name, attribute = COMMANDS[name][0].split(":")
+        return getattr(importlib.import_module(module_name), attribute)
+
+    def format_commands(self, ctx, formatter):
+        rows = [(name, help_text) for name, (_, help_text) in COMMANDS.items()]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
+@click.version_option(__version__, prog_name="schuler")
+def cli():
+    """Model, simulate and analyse gyroscopic navigation instruments.
+
+    Bare numbers are in each option's display unit (shown in --help); values
+    with units ("0.01 deg/h", "6 h", "1e-4 g") are converted. A bare "g" in an
+    acceleration means standard gravity. Add --json for machine-readable output
+    and --out DIR to write figures and data.
+    """
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    print(f"schuler: warning: {message}", file=sys.stderr)
+
+
+def main(argv=None) -> None:
+    """Entry point: run the CLI, turning errors into one line and exit code 2."""
+    warnings.showwarning = _show_warning
+    try:
+        code = cli.main(args=argv, prog_name="schuler", standalone_mode=False)
+    except click.exceptions.Exit as exit_:
+        code = exit_.exit_code
+    except click.exceptions.Abort:
+        print("schuler: error: aborted", file=sys.stderr)
+        code = 130
+    except click.ClickException as error:
+        print(f"schuler: error: {error.format_message()}", file=sys.stderr)
+        code = 2
+    except SchulerError as error:
+        print(f"schuler: error: {error}", file=sys.stderr)
+        code = 2
+    sys.exit(code if isinstance(code, int) else 0)

@@ -1,0 +1,84 @@
+"""What every command shares: options built from Parameters, output, and errors.
+
+Commands stay thin: parse options with :func:`parse_options`, call one public
+API function, hand its result to :func:`emit`.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from schuler import __version__
+from schuler.params import Parameter, parse_parameters
+from schuler.results import json_safe
+
+
+def parameter_options(parameters):
+    """Decorator adding one click option per :class:`Parameter` (values stay strings).
+
+    Strings keep unit text ("0.01 deg/h") intact; :func:`parse_options` converts.
+    """
+
+    def decorate(function):
+        for spec in reversed(tuple(parameters)):
+            if spec.kind == "flag":
+                option = click.option(
+                    f"{spec.option}/--no-{spec.option[2:]}", spec.name, default=None, help=spec.help_text()
+                )
+            elif spec.kind == "choice":
+                option = click.option(
+                    spec.option, spec.name, default=None, metavar="|".join(spec.choices), help=spec.help_text()
+                )
+            else:
+                metavar = "INT" if spec.kind == "integer" else ("VALUE" if not spec.unit else "QTY")
+                option = click.option(spec.option, spec.name, default=None, metavar=metavar, help=spec.help_text())
+            function = option(function)
+        return function
+
+    return decorate
+
+
+def parse_options(parameters, values: dict) -> dict:
+    """Parse the raw option values of ``parameters`` into SI (errors name the option)."""
+    names = {p.name for p in parameters}
+    return parse_parameters(parameters, {k: v for k, v in values.items() if k in names}, labels="option")
+
+
+json_option = click.option("--json", "as_json", is_flag=True, help="Print a machine-readable JSON result on stdout.")
+out_option = click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Folder for figures and data files (created if missing).",
+)
+
+
+def emit(result, as_json: bool, inputs: dict | None = None, files=()) -> None:
+    """Print a result: rich text by default, JSON (with version, SI inputs, units) with --json."""
+    if as_json:
+        data = {"schuler_version": __version__, "inputs": json_safe(inputs or {})}
+        data.update(result.to_dict())
+        if files:
+            data["files"] = [str(f) for f in files]
+        click.echo(json.dumps(data, indent=2))
+        return
+    from rich.console import Console
+
+    console = Console()
+    console.print(result.render())
+    if files:
+        folders = sorted({str(Path(f).parent) for f in files})
+        console.print(f"wrote {len(files)} file(s) to {', '.join(folders)}")
+
+
+def warn(message: str) -> None:
+    """One line on stderr, for conditions that degrade but do not stop a run."""
+    print(f"schuler: warning: {message}", file=sys.stderr)
+
+
+__all__ = ["Parameter", "parameter_options", "parse_options", "json_option", "out_option", "emit", "warn"]

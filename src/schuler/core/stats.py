@@ -1,0 +1,117 @@
+"""Streaming statistics over Monte Carlo members, in bounded memory.
+
+A Monte Carlo of 100,000 members over 7,200 time points would need 100,000 full
+histories to compute statistics naively. :class:`StreamingStatistics` takes the
+members chunk by chunk and keeps, per time point and channel, the count, mean and
+sum of squared deviations (Chan et al.'s parallel merge of Welford's update), the
+minimum and maximum, and a fixed-size uniform random sample of members (a
+reservoir, chosen by the smallest of one seeded random key per member) from
+which percentiles are taken. Percentiles are exact while the number of members
+does not exceed the reservoir size, and estimates from a uniform sample beyond.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class StreamingStatistics:
+    """Mean, standard deviation, extremes and percentiles of streamed samples.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        Shape of one member's sample, e.g. ``(n_time, n_channels)``.
+    reservoir_size : int
+        Members kept for percentiles (memory: reservoir_size x prod(shape) floats).
+    seed : int
+        Seed of the reservoir's random keys.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(1)
+    >>> data = rng.normal(size=(1000, 3))
+    >>> stats = StreamingStatistics((3,), reservoir_size=1000)
+    >>> for chunk in np.array_split(data, 7):
+    ...     stats.update(chunk)
+    >>> bool(np.allclose(stats.mean, data.mean(axis=0)))
+    True
+    >>> bool(np.allclose(stats.std, data.std(axis=0, ddof=1)))
+    True
+    >>> bool(np.allclose(stats.percentile(50), np.percentile(data, 50, axis=0)))
+    True
+    """
+
+    def __init__(self, shape: tuple[int, ...], reservoir_size: int = 2048, seed: int = 0):
+        self.shape = tuple(shape)
+        self.count = 0
+        self._mean = np.zeros(self.shape)
+        self._m2 = np.zeros(self.shape)
+        self._min = np.full(self.shape, np.inf)
+        self._max = np.full(self.shape, -np.inf)
+        self._reservoir_size = int(reservoir_size)
+        self._rng = np.random.default_rng(seed)
+        self._keys = np.empty(0)
+        self._reservoir = np.empty((0, *self.shape))
+
+    def update(self, samples: np.ndarray) -> None:
+        """Add a chunk of members, shape ``(k, *shape)``."""
+        samples = np.asarray(samples, dtype=float)
+        if samples.shape[1:] != self.shape:
+            raise ValueError(f"samples of shape {samples.shape[1:]} do not match {self.shape}")
+        k = samples.shape[0]
+        if k == 0:
+            return
+        chunk_mean = samples.mean(axis=0)
+        chunk_m2 = ((samples - chunk_mean) ** 2).sum(axis=0)
+        total = self.count + k
+        delta = chunk_mean - self._mean
+        self._mean = self._mean + delta * (k / total)
+        self._m2 = self._m2 + chunk_m2 + delta**2 * (self.count * k / total)
+        self.count = total
+        np.minimum(self._min, samples.min(axis=0), out=self._min)
+        np.maximum(self._max, samples.max(axis=0), out=self._max)
+        keys = np.concatenate([self._keys, self._rng.random(k)])
+        pool = np.concatenate([self._reservoir, samples])
+        if keys.size > self._reservoir_size:
+            keep = np.argpartition(keys, self._reservoir_size - 1)[: self._reservoir_size]
+            keys, pool = keys[keep], pool[keep]
+        self._keys, self._reservoir = keys, pool
+
+    @property
+    def mean(self) -> np.ndarray:
+        """Mean over members."""
+        return self._mean.copy()
+
+    @property
+    def std(self) -> np.ndarray:
+        """Sample standard deviation over members (ddof = 1; 0 for one member)."""
+        if self.count < 2:
+            return np.zeros(self.shape)
+        return np.sqrt(self._m2 / (self.count - 1))
+
+    @property
+    def rms(self) -> np.ndarray:
+        """Root mean square over members."""
+        if self.count == 0:
+            return np.zeros(self.shape)
+        return np.sqrt(self._mean**2 + self._m2 / self.count)
+
+    @property
+    def min(self) -> np.ndarray:
+        return self._min.copy()
+
+    @property
+    def max(self) -> np.ndarray:
+        return self._max.copy()
+
+    @property
+    def exact_percentiles(self) -> bool:
+        """True while every member seen is in the reservoir."""
+        return self.count <= self._reservoir_size
+
+    def percentile(self, q) -> np.ndarray:
+        """Percentile(s) ``q`` (0..100) over members, from the reservoir."""
+        if self.count == 0:
+            raise ValueError("no samples yet")
+        return np.percentile(self._reservoir, q, axis=0)

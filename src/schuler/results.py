@@ -1,0 +1,86 @@
+"""Typed results: every study returns a dataclass deriving from :class:`Result`.
+
+A result knows how to turn itself into JSON-safe data (:meth:`Result.to_dict`)
+and into something people read (:meth:`Result.render`, a rich renderable; its
+``str`` is the plain-text form). Keys whose unit is not in their name are listed
+in the class's ``units`` map.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, ClassVar
+
+import numpy as np
+
+
+def json_safe(value: Any) -> Any:
+    """Convert numpy arrays and scalars, tuples and nested results to JSON-safe data.
+
+    Non-finite floats become None (JSON has no NaN).
+
+    >>> json_safe({"a": np.array([1.0, np.nan]), "b": (np.int64(2),)})
+    {'a': [1.0, None], 'b': [2]}
+    """
+    if isinstance(value, Result):
+        return value.to_dict()
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: json_safe(getattr(value, f.name)) for f in dataclasses.fields(value) if f.repr}
+    if isinstance(value, dict):
+        return {str(k): json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_safe(value.tolist())
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        return value if math.isfinite(value) else None
+    if hasattr(value, "__fspath__"):
+        return str(value)
+    return value
+
+
+@dataclasses.dataclass
+class Result:
+    """Base of every result dataclass.
+
+    Subclasses are dataclasses; fields declared with ``field(repr=False)`` are
+    left out of :meth:`to_dict` (use it for large internal arrays).
+    """
+
+    units: ClassVar[dict[str, str]] = {}
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe dict of the public fields, plus ``units`` when the class defines it."""
+        data = {f.name: json_safe(getattr(self, f.name)) for f in dataclasses.fields(self) if f.repr}
+        if self.units:
+            data["units"] = dict(self.units)
+        return data
+
+    def render(self):
+        """A rich renderable for people; the default is a two-column table of scalars."""
+        from rich.table import Table
+
+        table = Table(title=type(self).__name__, show_header=False)
+        table.add_column("quantity")
+        table.add_column("value", justify="right")
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if f.repr and isinstance(value, (int, float, str, bool, np.floating, np.integer)):
+                shown = f"{value:.6g}" if isinstance(value, (float, np.floating)) else str(value)
+                unit = self.units.get(f.name, "")
+                table.add_row(f.name, f"{shown} {unit}".strip())
+        return table
+
+    def __str__(self) -> str:
+        from rich.console import Console
+
+        console = Console(width=110)
+        with console.capture() as capture:
+            console.print(self.render())
+        return capture.get()

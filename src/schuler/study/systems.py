@@ -1,0 +1,31 @@
+"""Which systems this installation has.
+
+A system is *not available* only when its ``api`` module (or the subpackage
+holding it) does not exist. Any other failure while importing it, including a
+missing third-party module it needs, is a real error and propagates.
+"""
+
+from __future__ import annotations
+
+from schuler.registry import SYSTEM_MODULES, System, get_system
+
+
+def load_system(name: str) -> System | None:
+    """The system registered under ``name``, or None when its module does not exist.
+
+    >>> load_system("errors") is None or load_system("errors").name == "errors"
+    True
+    """
+    module = SYSTEM_MODULES[name]
+    try:
+        return get_system(name)
+    except ModuleNotFoundError as error:
+        if error.name in _module_and_parents(module):
+            return None
+        raise
+
+
+def _module_and_parents(module: str) -> set[str]:
+    """``a.b.c`` -> {"a.b.c", "a.b"}: the module and its parent packages below the top one."""
+    parts = module.split(".")
+    return {".".join(parts[:i]) for i in range(2, len(parts) + 1)}

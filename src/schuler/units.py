@@ -1,0 +1,190 @@
+"""Units at the boundary: parse what users type into SI, format SI for people.
+
+The package works in SI inside (rad, rad/s, m, m/s, m/s^2, s). Users write
+"0.01 deg/h", "6 h", "1e-4 g", "50 deg", "3960 mi": :func:`parse_quantity` turns
+such a string, or a bare number in the option's display unit, into an SI float,
+with a clear :class:`~schuler.exceptions.InvalidParameter` when it cannot.
+
+Two traps of the units library are closed here:
+
+* **"g" is gram in pint.** Where an acceleration is expected, a bare ``g`` (and
+  ``mg``, ``ug``/``µg``) means standard gravity g0 = 9.80665 m/s^2, as the field
+  writes it ("1e-4 g"). The explicit spellings ``g0`` and ``gee`` mean standard
+  gravity everywhere.
+* **Radians are dimensionless in pint**, so "0.01 Hz" would pass as an angular
+  rate and "95 percent" as an angle. Every option whose display unit carries an
+  angle (deg, deg/h, arcmin ...) requires the value to carry an angle unit too,
+  with the same power.
+
+Examples
+--------
+>>> parse_quantity("0.01 deg/h", "deg/h", name="drift")
+4.84813681109536e-08
+>>> parse_quantity(50, "deg", name="latitude")   # bare number: display unit
+0.8726646259971648
+>>> parse_quantity("1e-4 g", "g", name="bias")
+0.000980665
+>>> parse_quantity("0.01 Hz", "deg/h", name="drift")
+Traceback (most recent call last):
+...
+schuler.exceptions.InvalidParameter: drift: '0.01 Hz' is not an angular rate (expected a unit like deg/h)
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from functools import lru_cache
+
+import pint
+
+from schuler.exceptions import InvalidParameter
+
+ureg = pint.UnitRegistry()
+ureg.define("standard_gravity_unit = 9.80665 meter / second ** 2 = g0 = gee")
+ureg.define("statute_mile = 1609.344 meter = smi")
+
+_ANGLE_UNITS = frozenset(
+    {"radian", "degree", "arcminute", "arcsecond", "revolution", "turn", "gradian", "milliarcsecond"}
+)
+_ANGLE_RATE_UNITS = frozenset({"revolutions_per_minute", "revolutions_per_second", "degree_per_second"})
+
+# A bare g (optionally milli or micro) as a whole token: standard gravity where an
+# acceleration is expected.
+_G_TOKEN = re.compile(r"(?<![A-Za-z_])(m|u|µ|micro|milli)?g(?![A-Za-z_0-9])")
+_G_PREFIX = {None: "", "m": "milli", "milli": "milli", "u": "micro", "µ": "micro", "micro": "micro"}
+
+_KIND_NAMES = {
+    "[length]": "a length",
+    "[length] / [time]": "a speed",
+    "[length] / [time] ** 2": "an acceleration",
+    "[time]": "a time",
+    "1 / [time]": "a rate (1/s)",
+    "[mass] * [length] ** 2": "a moment of inertia",
+    "[mass] * [length] ** 2 / [time]": "an angular momentum",
+    "[mass] * [length] ** 2 / [time] ** 2": "a torque",
+}
+
+
+def _angle_power(unit: pint.Unit) -> int:
+    """The power of angle units in a unit (deg/h -> 1, Hz -> 0, rad^2 -> 2)."""
+    power = 0
+    for name, exponent in unit._units.items():
+        _, base, _ = ureg.parse_unit_name(name)[0] if ureg.parse_unit_name(name) else ("", name, "")
+        if base in _ANGLE_UNITS or base in _ANGLE_RATE_UNITS:
+            power += exponent
+    return int(round(power))
+
+
+@lru_cache(maxsize=256)
+def _display_unit(unit: str) -> pint.Unit:
+    return ureg.Unit(_standard_gravity_spelling(unit))
+
+
+def _standard_gravity_spelling(text: str) -> str:
+    return _G_TOKEN.sub(lambda m: f"{_G_PREFIX[m.group(1)]}g0", text)
+
+
+def _describe(unit: pint.Unit) -> str:
+    angle = _angle_power(unit)
+    dims = str(unit.dimensionality)
+    if angle == 1 and dims == "1 / [time]":
+        return "an angular rate"
+    if angle == 1 and dims == "dimensionless":
+        return "an angle"
+    if dims == "dimensionless":
+        return "a plain number"
+    return _KIND_NAMES.get(dims, f"a quantity in {unit:~P}")
+
+
+def _is_acceleration(unit: pint.Unit) -> bool:
+    return unit.dimensionality == ureg.Unit("m/s^2").dimensionality
+
+
+def parse_quantity(value, unit: str, *, name: str) -> float:
+    """Convert a user value to an SI float.
+
+    Parameters
+    ----------
+    value : str, int or float
+        A number (taken in ``unit``) or a string with a unit ("0.01 deg/h").
+        A string holding only a number is also taken in ``unit``.
+    unit : str
+        The display unit of the option, e.g. ``"deg"``, ``"deg/h"``, ``"s"``,
+        ``"ft"``, ``"g"`` (standard gravity), ``""`` for a plain number.
+    name : str
+        The option or key name, used in error messages.
+
+    Returns
+    -------
+    float
+        The value in SI (angles in rad).
+
+    Raises
+    ------
+    InvalidParameter
+        Unparseable text, an unknown unit, a unit of the wrong dimension or
+        without the angle the option needs, or a value that is not finite.
+    """
+    target = _display_unit(unit)
+    if isinstance(value, bool):
+        raise InvalidParameter(name, f"{value!r} is not a number")
+    if isinstance(value, (int, float)):
+        quantity = ureg.Quantity(float(value), target)
+        shown = repr(value)
+    else:
+        text = str(value).strip()
+        shown = repr(text)
+        if not text:
+            raise InvalidParameter(name, "empty value")
+        try:
+            quantity = ureg.Quantity(float(text), target)
+        except ValueError:
+            spelled = _standard_gravity_spelling(text) if _is_acceleration(target) else text
+            try:
+                quantity = ureg.Quantity(spelled)
+            except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError, KeyError):
+                raise InvalidParameter(name, f"cannot read {shown} as a quantity in {unit or 'plain numbers'}")
+            if not isinstance(quantity, ureg.Quantity):
+                quantity = ureg.Quantity(float(quantity), "")
+            if not str(quantity.units) and str(target):
+                # "50" with spaces or an expression: a bare number in the display unit
+                quantity = ureg.Quantity(float(quantity.magnitude), target)
+    if not quantity.is_compatible_with(target) or _angle_power(quantity.units) != _angle_power(target):
+        raise InvalidParameter(
+            name, f"{shown} is not {_describe(target)} (expected a unit like {unit or 'a plain number'})"
+        )
+    si = quantity.to_base_units()
+    try:
+        magnitude = float(si.magnitude)
+    except TypeError:
+        raise InvalidParameter(name, f"{shown} is not a single number")
+    if not math.isfinite(magnitude):
+        raise InvalidParameter(name, f"{shown} is not a finite number")
+    return magnitude
+
+
+def to_unit(value_si, unit: str):
+    """Express an SI value (float or array) in ``unit`` (e.g. rad -> "arcmin").
+
+    >>> round(to_unit(4.84813681109536e-08, "deg/h"), 12)
+    0.01
+    """
+    target = _display_unit(unit)
+    base = ureg.Quantity(1.0, target).to_base_units()
+    return value_si / base.magnitude
+
+
+def from_unit(value, unit: str):
+    """Express a value given in ``unit`` in SI (the inverse of :func:`to_unit`)."""
+    target = _display_unit(unit)
+    return value * ureg.Quantity(1.0, target).to_base_units().magnitude
+
+
+def format_quantity(value_si: float, unit: str, digits: int = 4) -> str:
+    """Format an SI value in ``unit`` for people: ``"3.556 arcmin"``.
+
+    >>> format_quantity(1e-3, "arcmin")
+    '3.438 arcmin'
+    """
+    return f"{to_unit(value_si, unit):.{digits}g} {unit}".rstrip()
