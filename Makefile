@@ -20,6 +20,7 @@ $(VENV)/.installed-test: $(BIN)/python pyproject.toml
 
 demo: $(VENV)/.installed
 	$(BIN)/schuler report --out $(OUT)
+	@echo "Open $(OUT)/index.html in a browser."
 
 test: $(VENV)/.installed-test
 	$(BIN)/python -m pytest -n 2 -q

@@ -1,0 +1,60 @@
+"""Meta-tests that keep the layering and the system contract honest."""
+
+from __future__ import annotations
+
+import ast
+import inspect
+from pathlib import Path
+
+import pytest
+
+import schuler
+from schuler.registry import SYSTEM_MODULES, get_system
+
+PACKAGE = Path(schuler.__file__).parent
+BOUNDARY_LIBRARIES = {"pint", "click", "rich", "matplotlib", "pydantic", "pandas"}
+
+
+def imported_modules(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module.split(".")[0])
+            if node.module.startswith("schuler."):
+                names.add(node.module)
+    return names
+
+
+@pytest.mark.parametrize("path", sorted((PACKAGE / "core").glob("*.py")), ids=lambda p: p.name)
+def test_core_is_pure_numerics(path):
+    """The core works on SI floats and arrays: no units library, CLI, printing or plotting."""
+    imports = imported_modules(path)
+    assert not imports & BOUNDARY_LIBRARIES, f"{path.name} imports {imports & BOUNDARY_LIBRARIES}"
+    assert not {m for m in imports if m.startswith("schuler.") and not m.startswith(("schuler.core", "schuler.exceptions"))}
+
+
+@pytest.mark.parametrize("name", list(SYSTEM_MODULES))
+def test_system_contract(name):
+    """run() takes exactly the documented parameters, each with help and a valid default."""
+    system = get_system(name)
+    assert system.name == name
+    names = [p.name for p in system.parameters]
+    assert len(names) == len(set(names))
+    signature = inspect.signature(system.run)
+    accepted = {p.name for p in signature.parameters.values() if p.kind is not p.VAR_KEYWORD}
+    assert accepted == set(names), f"run() takes {sorted(accepted)}, parameters are {sorted(names)}"
+    for parameter in system.parameters:
+        assert parameter.help.strip(), f"{parameter.name} has no help"
+        if parameter.default is not None:
+            parameter.parse(parameter.default)
+
+
+@pytest.mark.parametrize("name", list(SYSTEM_MODULES))
+def test_run_options_are_the_system_parameters(name, run_cli):
+    out = run_cli(name, "run", "--help")
+    assert out.code == 0
+    for parameter in get_system(name).parameters:
+        assert parameter.option in out.stdout
