@@ -98,7 +98,7 @@ def horizontal_earth_rate(latitude, earth_rate: float = EARTH_RATE):
         raise InvalidParameter("latitude", "must lie in [-90, 90] deg")
     omega_h = earth_rate * np.cos(latitude)
     if np.any(omega_h < 1e-9 * earth_rate):
-        raise NotObservable("latitude: 90 deg: no horizontal Earth rate, north is not observable")
+        raise NotObservable("latitude: ±90 deg: no horizontal Earth rate, north is not observable")
     return float(omega_h) if omega_h.ndim == 0 else omega_h
 
 
@@ -122,7 +122,8 @@ def directive_coefficient(hm, omega_h, inertia):
     check_positive(hm, "Hm", "N m s")
     check_positive(omega_h, "omega_h", "rad/s")
     check_positive(inertia, "inertia", "kg m^2")
-    return np.asarray(hm) * np.asarray(omega_h) / np.asarray(inertia) + 0.0
+    coefficient = np.asarray(hm, dtype=float) * np.asarray(omega_h) / np.asarray(inertia)
+    return float(coefficient) if coefficient.ndim == 0 else coefficient
 
 
 def bessel_argument(time, decay_rate, coefficient):
@@ -182,7 +183,7 @@ def basis(time, decay_rate, coefficient, torque: bool = True, derivatives: bool 
     Examples
     --------
     >>> b = basis(np.array([0.0, 10.0]), SOURCE_LAMBDA, 0.0135849)
-    >>> np.round(b.angle[:, 0], 12)   # u1(0) = 1, u2(0) = 0, u3(0) = 0
+    >>> np.round(b.angle[:, 0], 12) + 0.0   # u1(0) = 1, u2(0) = 0, u3(0) = 0
     array([1., 0., 0.])
     """
     check_decay_rate(decay_rate)

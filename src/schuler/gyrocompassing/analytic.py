@@ -71,7 +71,7 @@ def gains_from_design(time_constant, damping, latitude, earth_rate=EARTH_RATE):
     --------
     >>> c_gamma, c_a = gains_from_design(30.0, 0.8, np.radians(50))
     >>> round(float(c_gamma), 4), round(float(c_a), 2)
-    (0.0533, 23.71)
+    (0.0533, 23.7)
     """
     T = np.asarray(time_constant, dtype=float)
     zeta = np.asarray(damping, dtype=float)

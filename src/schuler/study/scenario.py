@@ -11,9 +11,9 @@ as the command-line options (underscores instead of dashes)::
     latitude = "50 deg"
     drift_east = "0.01 deg/h"
 
-    [simulation]        # optional: only for systems with these parameters
-    duration = "6 h"
-    step = "1 s"
+    [simulation]        # optional: the run's duration and step parameter (step may
+    duration = "6 h"    # stand for time_step); each may be set here or in
+    step = "1 s"        # [parameters], not both
 
     [outputs]           # optional
     directory = "out"   # like --out (relative to the current folder)
@@ -56,8 +56,24 @@ from schuler.params import Parameter
 from schuler.registry import SYSTEM_MODULES, System, get_system
 from schuler.study.systems import load_system
 
-SIMULATION_KEYS = ("duration", "step")
-"""Keys of the ``[simulation]`` table; each maps to the system parameter of that name."""
+SIMULATION_KEYS: dict[str, tuple[str, ...]] = {"duration": ("duration",), "step": ("step", "time_step")}
+"""Keys of the ``[simulation]`` table and the run parameter each may stand for."""
+
+
+def simulation_keys(parameters) -> dict[str, str]:
+    """``[simulation]`` key -> run parameter name, for the keys a system supports.
+
+    >>> from schuler.params import Parameter
+    >>> simulation_keys([Parameter("time_step", "s", 1.0, "Output step.")])
+    {'step': 'time_step'}
+    """
+    names = {spec.name for spec in parameters}
+    found = {}
+    for key, candidates in SIMULATION_KEYS.items():
+        match = next((name for name in candidates if name in names), None)
+        if match is not None:
+            found[key] = match
+    return found
 
 Value = Union[StrictBool, StrictInt, StrictFloat, StrictStr]
 """What a TOML scalar can be; the Parameter decides what it means."""
@@ -192,14 +208,17 @@ def scenario_model(system: System) -> type[BaseModel]:
     and range), so a scenario accepts exactly what the command line accepts.
     """
     parameters = {spec.name: spec for spec in system.parameters}
-    simulation_keys = [key for key in SIMULATION_KEYS if key in parameters]
-    fields = {name: (Value | None, None) for name in parameters if name not in simulation_keys}
+    fields = {name: (Value | None, None) for name in parameters}
     parameters_table = create_model(
         f"{system.name}_parameters", __config__=_STRICT, __validators__=_validators(parameters, fields), **fields
     )
-    sim_fields = {name: (Value | None, None) for name in simulation_keys}
+    stands_for = simulation_keys(system.parameters)
+    sim_fields = {key: (Value | None, None) for key in stands_for}
     simulation_table = create_model(
-        f"{system.name}_simulation", __config__=_STRICT, __validators__=_validators(parameters, sim_fields), **sim_fields
+        f"{system.name}_simulation",
+        __config__=_STRICT,
+        __validators__=_validators({key: parameters[name] for key, name in stands_for.items()}, sim_fields),
+        **sim_fields,
     )
     random_fields = {name: (Value | None, None) for name in parameters}
     normal_table = create_model(f"{system.name}_normal", __config__=_STRICT, **random_fields)
@@ -232,7 +251,8 @@ def _validators(parameters: dict[str, Parameter], fields: dict) -> dict:
 
     def check(cls, value, info):
         if value is not None:
-            parameters[info.field_name].parse(value, info.field_name)
+            spec = parameters[info.field_name]
+            spec.parse(value, spec.name)
         return value
 
     if not fields:
@@ -294,9 +314,17 @@ def _names(items) -> str:
 
 def _build(parsed: BaseModel, system: System, source: str) -> Scenario:
     written: dict[str, Any] = {}
-    for table in (parsed.parameters, parsed.simulation):
-        if table is not None:
-            written.update({k: v for k, v in table.model_dump().items() if v is not None})
+    if parsed.parameters is not None:
+        written.update({k: v for k, v in parsed.parameters.model_dump().items() if v is not None})
+    if parsed.simulation is not None:
+        stands_for = simulation_keys(system.parameters)
+        for key, value in parsed.simulation.model_dump().items():
+            if value is None:
+                continue
+            name = stands_for[key]
+            if name in written:
+                raise ScenarioError(f"{source}: [simulation] {key}: also set as [parameters] {name}; set it once")
+            written[name] = value
     specs = {p.name: p for p in system.parameters}
     values = {}
     for name, spec in specs.items():

@@ -1,0 +1,94 @@
+"""Figures of the ground gyrocompass: fit and residuals, misfit map, error against time.
+
+Each function draws one figure and writes it through :mod:`schuler.io` (PNG and
+SVG); it returns the written paths.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from schuler.ground_gyrocompass.grid import axis
+from schuler.io import save_figure_formats
+
+ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
+ARCMIN_PER_RAD = 180.0 * 60.0 / math.pi
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_fit(estimate, stem, formats=("png", "svg")):
+    """Observed coordinate with the fitted model (arcmin) and the residuals (arcsec)."""
+    plt = _pyplot()
+    time = estimate.time
+    fitted = estimate.observed - estimate.residuals
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 6), sharex=True, height_ratios=(2, 1))
+    top.plot(time, estimate.observed * ARCMIN_PER_RAD, ".", ms=3, label="observed")
+    top.plot(time, fitted * ARCMIN_PER_RAD, "-", lw=1.2, label=f"fit, {estimate.unknowns} unknowns ({estimate.method})")
+    top.set_ylabel("observed azimuth motion, arcmin")
+    top.set_title(f"Rotor run-down: north {estimate.north_dms} from the rotor axis at release")
+    top.legend(loc="best")
+    top.grid(alpha=0.3)
+    bottom.plot(time, estimate.residuals * ARCSEC_PER_RAD, ".", ms=3, color="C3")
+    bottom.axhline(0.0, color="k", lw=0.6)
+    bottom.set_xlabel("time since release, s")
+    bottom.set_ylabel("residual, arcsec")
+    bottom.grid(alpha=0.3)
+    fig.tight_layout()
+    return save_figure_formats(fig, stem, formats)
+
+
+def plot_misfit_map(stage, stem, formats=("png", "svg")):
+    """log10 of the misfit over (alpha0, alpha0_dot) of a grid stage, best cell marked."""
+    plt = _pyplot()
+    alpha0 = axis(*stage.box["alpha0"]) * ARCMIN_PER_RAD
+    rate = axis(*stage.box["alpha0_dot"]) * 1e4
+    fig, ax = plt.subplots(figsize=(7, 5.5))
+    levels = np.log10(np.maximum(stage.surface, 1e-30))
+    mesh = ax.pcolormesh(rate, alpha0, levels, shading="nearest", cmap="viridis")
+    fig.colorbar(mesh, ax=ax, label="log10 misfit F, rad^2")
+    ax.plot(stage.best["alpha0_dot"] * 1e4, stage.best["alpha0"] * ARCMIN_PER_RAD, "r+", ms=14, mew=2, label="best cell")
+    ax.set_xlabel("initial rate alpha0_dot, 1e-4 rad/s")
+    ax.set_ylabel("initial angle alpha0, arcmin")
+    ax.set_title(f"First grid stage ({stage.cells} cells), at the best lambda and B")
+    ax.legend(loc="upper right")
+    fig.tight_layout()
+    return save_figure_formats(fig, stem, formats)
+
+
+def plot_error_vs_time(durations, series, stem, title, formats=("png", "svg")):
+    """North standard error (arcsec) against the observation window.
+
+    ``series`` is a list of (label, values in arcsec, style) drawn on a log scale.
+    """
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for label, values, style in series:
+        ax.plot(durations, values, style, label=label)
+    ax.set_yscale("log")
+    ax.set_xlabel("observation window, s")
+    ax.set_ylabel("north standard error, arcsec")
+    ax.set_title(title)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(loc="best", fontsize="small")
+    fig.tight_layout()
+    return save_figure_formats(fig, stem, formats)
+
+
+def plot_study(study, stem, formats=("png", "svg")):
+    """Monte Carlo scatter and predicted standard error of north against the window."""
+    series = []
+    for j, noise in enumerate(study.noises_arcsec):
+        series.append((f'Monte Carlo, noise {noise:g}"', study.std_error_arcsec[:, j], f"C{j}o"))
+        series.append((f'predicted (Jacobian), noise {noise:g}"', study.predicted_std_arcsec[:, j], f"C{j}-"))
+    title = f"Accuracy against time: {study.unknowns} unknowns, {study.members} runs per point"
+    return plot_error_vs_time(study.durations_s, series, stem, title, formats)

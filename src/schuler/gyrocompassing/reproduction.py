@@ -1,0 +1,220 @@
+"""The source's design example and statements, reproduced with their errata (source 003).
+
+Constants: Earth rate U = 7.292115e-5 rad/s (the source does not state one),
+g = 9.80665 m/s^2, Kyiv (the source's university) at 50.45 deg for "the" latitude.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.lti import simulate
+from schuler.gyrocompassing import analytic, models, plots, study
+from schuler.registry import FigureRef, ReportSection, ReproductionRow
+from schuler.results import Result
+from schuler.units import from_unit, to_unit
+
+KYIV_LATITUDE = math.radians(50.45)
+"""Latitude of Kyiv, rad: the source's laboratory."""
+PRINTED_C_GAMMA = 0.08
+"""c_Gamma printed for T = 30 s, 1/s."""
+PRINTED_C_A = 22.0
+"""c_a printed for T = 30 s, 1/s."""
+DESIGN_TIME_CONSTANT = 30.0
+DESIGN_DAMPING = 0.8
+EXAMPLE_DRIFT = from_unit(0.01, "deg/h")
+"""0.01 deg/h, rad/s: the residual drift of the worked cases."""
+EXAMPLE_ACCEL_ERROR = 1e-4 * STANDARD_GRAVITY
+"""100 micro-g, m/s^2."""
+
+
+@dataclass
+class ReproductionResult(Result):
+    """The source's numbers beside the computed ones."""
+
+    source: str
+    constants: dict
+    rows: list
+    notes: list = field(default_factory=list)
+
+    def render(self):
+        from rich.table import Table
+
+        table = Table(title="Gyrocompassing: source 003 reproduced", show_lines=False)
+        for column in ("quantity", "printed", "computed", "unit", "agrees"):
+            table.add_column(column, justify="left" if column == "quantity" else "right")
+        for row in self.rows:
+            printed = f"{row.printed:.6g}" if isinstance(row.printed, float) else str(row.printed)
+            table.add_row(row.quantity, printed, f"{row.computed:.6g}", row.unit, "yes" if row.agrees else "NO")
+        return table
+
+
+def _printed_aperiodic_time(c_gamma: float, c_a: float, latitude: float) -> float:
+    """The aperiodic settling time as printed: 5 / (-h + sqrt(h^2 - omega0^2)) (negative)."""
+    h = c_gamma / 2
+    omega0_sq = c_a * EARTH_RATE * math.cos(latitude)
+    return 5.0 / (-h + math.sqrt(h**2 - omega0_sq))
+
+
+def reproduce() -> ReproductionResult:
+    """Reproduce the design example (T = 30 s) and check the source's statements and equations.
+
+    Examples
+    --------
+    >>> r = reproduce()
+    >>> [row.quantity for row in r.rows][:2]
+    ['c_Gamma for T = 30 s, zeta = 0.8', 'c_a for T = 30 s at Kyiv (50.45 deg)']
+    """
+    rows = []
+    c_gamma, c_a_kyiv = (float(x) for x in analytic.gains_from_design(DESIGN_TIME_CONSTANT, DESIGN_DAMPING, KYIV_LATITUDE))
+    rows.append(ReproductionRow(
+        "c_Gamma for T = 30 s, zeta = 0.8", PRINTED_C_GAMMA, c_gamma, "1/s", False,
+        f"c_Gamma = 2 zeta / T; the printed 0.08 needs zeta = {PRINTED_C_GAMMA * DESIGN_TIME_CONSTANT / 2:.2f}",
+    ))
+    latitude_for_22 = math.acos(1.0 / (DESIGN_TIME_CONSTANT**2 * EARTH_RATE * PRINTED_C_A))
+    rows.append(ReproductionRow(
+        "c_a for T = 30 s at Kyiv (50.45 deg)", PRINTED_C_A, c_a_kyiv, "1/s", False,
+        f"c_a = 1 / (T^2 U cos(latitude)); the printed 22 holds at {math.degrees(latitude_for_22):.2f} deg "
+        f"(U = {EARTH_RATE} rad/s)",
+    ))
+    _, zeta_printed = analytic.design_from_gains(PRINTED_C_GAMMA, PRINTED_C_A, latitude_for_22)
+    rows.append(ReproductionRow(
+        "damping of the printed pair (0.08, 22)", DESIGN_DAMPING, float(zeta_printed), "", False,
+        "the printed gains give an aperiodic loop (zeta > 1), not zeta = 0.8",
+    ))
+    rows.append(ReproductionRow(
+        "aperiodic settling time of the printed pair", _printed_aperiodic_time(PRINTED_C_GAMMA, PRINTED_C_A, latitude_for_22),
+        float(analytic.settling_time(PRINTED_C_GAMMA, PRINTED_C_A, latitude_for_22)), "s", False,
+        "the printed formula 5/(-h + sqrt(h^2 - omega0^2)) is negative; corrected 5/(h - sqrt(h^2 - omega0^2))",
+    ))
+    design = study.AlignmentCase(latitude=KYIV_LATITUDE, drift_east=EXAMPLE_DRIFT, drift_z=EXAMPLE_DRIFT,
+                                 latitude_error=from_unit(1.0, "arcmin"))
+    run = study.run_case(design, "simplified")
+    settling_simulated = float(run.simulated.settling_time[0])
+    rows.append(ReproductionRow(
+        "settling time 5/h, T = 30 s, zeta = 0.8 (simulated 1 % band)", run.analytic["settling_time_s"],
+        settling_simulated, "s", abs(settling_simulated / run.analytic["settling_time_s"] - 1) < 0.05,
+        "5/h against the last exit of the simulated azimuth error from a 1 % band",
+    ))
+    rows.append(ReproductionRow(
+        "delta_y (1.21) vs simulated (1.19): 0.01 deg/h east and up, 1 arcmin latitude error",
+        float(to_unit(run.analytic["azimuth_error_analytic_rad"], "arcmin")),
+        float(to_unit(run.simulated.azimuth_error[0], "arcmin")), "arcmin",
+        math.isclose(run.analytic["azimuth_error_analytic_rad"], run.simulated.azimuth_error[0], rel_tol=1e-9),
+        "closed form and exact simulation",
+    ))
+    east_only = analytic.steady_state(math.radians(50.0), c_gamma, c_a_kyiv, drift_east=EXAMPLE_DRIFT)[0]
+    rows.append(ReproductionRow(
+        "delta_y for 0.01 deg/h east drift at 50 deg", 3.556, float(to_unit(east_only, "arcmin")), "arcmin",
+        abs(float(to_unit(east_only, "arcmin")) - 3.556) < 5e-4, "dominant term dw_dxi / (U cos(latitude))",
+    ))
+    rate = {}
+    for label, builder in (("printed", models.printed_mu_nu_model), ("corrected", models.full_mu_nu_model)):
+        gains = analytic.gains_from_design(DESIGN_TIME_CONSTANT, DESIGN_DAMPING, KYIV_LATITUDE)
+        rate[label] = float(np.max(builder(KYIV_LATITUDE, 0.0, *gains).eigenvalues().real))
+    rows.append(ReproductionRow(
+        "largest real part of the (1.17) eigenvalues at A = 0, as printed", "< 0 (stable)", rate["printed"], "1/s",
+        False, f"as printed the azimuth loop diverges (e-folding {1 / rate['printed'] / 3600:.1f} h); "
+               f"corrected: {rate['corrected']:.4f} 1/s",
+    ))
+    accel = study.AlignmentCase(latitude=math.radians(50.0), accel_error_x=EXAMPLE_ACCEL_ERROR)
+    shift = {m: study.run_case(accel, m).simulated.azimuth_error[0] for m in ("simplified", "full")}
+    rows.append(ReproductionRow(
+        "azimuth shift from 100 micro-g on x at 50 deg, A = 0 (full model)", 0.0,
+        float(to_unit(shift["full"], "arcsec")), "arcsec", False,
+        f"'does not depend on accelerometer errors' holds for (1.19) ({float(to_unit(shift['simplified'], 'arcsec')):.2g} "
+        "arcsec); in (1.17)/(1.18) alpha U_z adds about eps_alpha tan(latitude)",
+    ))
+    tilt = study.AlignmentCase(latitude=math.radians(50.0), azimuth=math.pi / 2, accel_error_x=EXAMPLE_ACCEL_ERROR)
+    beta_full = study.run_case(tilt, "full").simulated.level_error_beta[0]
+    eps_beta_printed = EXAMPLE_ACCEL_ERROR * math.sin(math.pi / 2) / STANDARD_GRAVITY
+    rows.append(ReproductionRow(
+        "beta_y for 100 micro-g on x at A = 90 deg", float(to_unit(-eps_beta_printed, "arcsec")),
+        float(to_unit(beta_full, "arcsec")), "arcsec", False,
+        "printed eps_beta = (Delta a_x sin A + Delta a_y cos A)/g; (1.8) gives eps_beta = (Delta a_y cos A - Delta a_x sin A)/g",
+    ))
+    return ReproductionResult(
+        source="source 003 (KPI lab manual, Meleshko), Sec. 2",
+        constants={"earth_rate_rad_per_s": EARTH_RATE, "gravity_m_per_s2": STANDARD_GRAVITY,
+                   "latitude_deg": math.degrees(KYIV_LATITUDE)},
+        rows=rows,
+        notes=[
+            "The third line of (1.17) pairs cos A with mu and sin A with nu; (1.10), (1.11) and (1.18) require "
+            "(nu + eps_y) cos A + (mu - eps_x) sin A. The models use the corrected line.",
+            "In (1.24) C1 has 'delta_2' for delta_y; the critical C2 is delta'0 + h (delta0 - delta_y).",
+        ],
+    )
+
+
+def report(outdir: Path) -> ReportSection:
+    """Write this system's figures into ``outdir`` and describe them (a few seconds).
+
+    The Monte Carlo uses 400 members and the latitude sweep 9 simulated cases;
+    ``schuler align run --monte-carlo 10000`` and ``schuler align sweep`` scale them up.
+    """
+    outdir = Path(outdir)
+    reproduction = reproduce()
+    base = study.AlignmentCase(drift_east=EXAMPLE_DRIFT)
+    runs = {f"{name} model": study.run_case(base, name, duration=1200) for name in ("full", "simplified")}
+    slow = study.AlignmentCase(drift_east=EXAMPLE_DRIFT, damping=0.4)
+    phase_runs = {"zeta = 0.8": runs["full model"], "zeta = 0.4": study.run_case(slow, "full", duration=1200)}
+    latitudes = np.radians(np.arange(0.0, 81.0, 10.0))
+    sweep_case = study.AlignmentCase(latitude=latitudes, drift_east=EXAMPLE_DRIFT)
+    swept = study.evaluate_cases(sweep_case, "full", simulate_runs=True)
+    mc = study.monte_carlo(base, "full", 400, sigma_drift=EXAMPLE_DRIFT, sigma_drift_z=EXAMPLE_DRIFT,
+                           sigma_accel=EXAMPLE_ACCEL_ERROR, duration=1200)
+    corrected = study.AlignmentCase(latitude=KYIV_LATITUDE)
+    gains = corrected.gains()
+    time = np.arange(0.0, 48 * 3600.0 + 1, 600.0)
+    x0 = models.initial_state("full", corrected.initial_azimuth_error)
+    printed = simulate(models.printed_mu_nu_model(KYIV_LATITUDE, 0.0, *gains), time, x0)["delta"]
+    fixed = simulate(models.full_mu_nu_model(KYIV_LATITUDE, 0.0, *gains), time, x0)["delta"]
+    figures = {
+        "align_time_history": plots.time_history(runs),
+        "align_phase_trajectory": plots.phase_trajectory(phase_runs),
+        "align_latitude_sweep": plots.sweep_curves(
+            np.degrees(latitudes), "latitude [deg]",
+            {"azimuth_error_analytic_arcmin": to_unit(swept["azimuth_error_analytic_rad"], "arcmin"),
+             "azimuth_error_arcmin": to_unit(swept["azimuth_error_simulated_rad"], "arcmin"),
+             "settling_time_s": swept["settling_time_s"],
+             "settling_time_simulated_s": swept["settling_time_simulated_s"]}),
+        "align_monte_carlo": plots.monte_carlo_histogram(
+            to_unit(mc.azimuth_errors, "arcmin"), float(to_unit(mc.sigma_analytic, "arcmin")),
+            float(to_unit(mc.mean, "arcmin")), "full"),
+        "align_printed_1_17": plots.printed_versus_corrected(time, printed, fixed),
+    }
+    plots.write_figures(figures, outdir, formats=("png",))
+    captions = {
+        "align_time_history": "Azimuth error delta and level error beta against time, full and simplified "
+                              "models (0.01 deg/h east drift, 50 deg, T = 30 s, zeta = 0.8): the source's Fig. 1.4.",
+        "align_phase_trajectory": "Phase trajectory in the (delta, beta) plane (task 5) for zeta = 0.8 and 0.4.",
+        "align_latitude_sweep": "Accuracy and time against latitude: (1.21) and 5/h (lines), simulated full "
+                                "model (circles); the error grows as 1/cos(latitude).",
+        "align_monte_carlo": "Monte Carlo (400 members; 0.01 deg/h drifts, 100 micro-g accelerometers, "
+                             "1-sigma): simulated azimuth errors and the analytic 1-sigma.",
+        "align_printed_1_17": "The printed third line of (1.17) diverges at A = 0; the corrected one converges.",
+    }
+    return ReportSection(
+        system="align",
+        title="Physical gyrocompassing of a semi-analytic platform INS",
+        source=reproduction.source,
+        summary=(
+            "The platform is driven to north by its accelerometers: three linear models (full in (mu, nu), "
+            "full in (beta, alpha), simplified (1.19)) are simulated exactly and compared with the closed forms "
+            "(1.21), (1.22), (1.25). The source's design example and several printed equations are corrected."
+        ),
+        rows=reproduction.rows,
+        figures=[FigureRef(f"{stem}.png", captions[stem]) for stem in figures],
+        commands=[
+            "schuler align reproduce",
+            "schuler align run --latitude 50 --azimuth 30 --drift-east '0.01 deg/h' --out align",
+            "schuler align sweep latitude=0:80:10 --drift-east '0.01 deg/h' --out align",
+            "schuler align run --drift-east '0.01 deg/h' --monte-carlo 10000 --out align",
+        ],
+        notes=reproduction.notes,
+    )

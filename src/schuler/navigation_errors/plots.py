@@ -1,0 +1,154 @@
+"""Figures of the navigation-error system (matplotlib, Agg; SI in, display units on the axes).
+
+Every function returns a matplotlib Figure; writing it is the caller's job
+(:func:`schuler.io.save_figure_formats`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from schuler.units import to_unit
+
+SOURCE_TITLES = {
+    "tilt": "initial level misalignment",
+    "velocity": "initial velocity error",
+    "accelerometer": "accelerometer error",
+    "drift": "gyro drift",
+    "azimuth": "azimuth misalignment",
+}
+
+
+def _figure(*args, **kwargs):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(*args, **kwargs)
+
+
+def plot_flat_vs_spherical(time, flat, spherical, unit: str, title: str, simulated=None):
+    """One error source: flat vs spherical Earth (left), the spherical error alone (right).
+
+    Parameters
+    ----------
+    time : ndarray
+        t, s.
+    flat, spherical : ndarray
+        Position errors, m.
+    unit : str
+        Display unit of the errors ("ft", "m", "mi").
+    title : str
+        Figure title.
+    simulated : (ndarray, ndarray), optional
+        Times (s) and simulated spherical errors (m), drawn as markers (at most ~45).
+    """
+    fig, (both, alone) = _figure(1, 2, figsize=(11, 4.2))
+    for axis in (both, alone):
+        axis.plot(time, to_unit(spherical, unit), color="C0", lw=1.8, label="spherical Earth (Schuler)")
+        if simulated is not None:
+            simulated_time, simulated_error = simulated
+            every = max(1, len(simulated_time) // 45)
+            axis.plot(simulated_time[::every], to_unit(simulated_error[::every], unit), "o", ms=3.5, color="C2",
+                      label="spherical, simulated")
+        axis.set_xlabel("time since launch [s]")
+        axis.set_ylabel(f"position error [{unit}]")
+        axis.grid(True, alpha=0.3)
+    both.plot(time, to_unit(flat, unit), color="C3", lw=1.8, ls="--", label="flat Earth")
+    both.set_title("flat vs spherical Earth")
+    alone.set_title("spherical Earth, enlarged")
+    both.legend(loc="upper left")
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_overview(time, flat: dict, spherical: dict, unit: str, title: str):
+    """All sources on one log-scale axis: flat (dashed) and spherical (solid) |error|.
+
+    Parameters
+    ----------
+    time : ndarray
+        t, s.
+    flat, spherical : dict of str -> ndarray
+        Position errors per source, m.
+    unit : str
+        Display unit.
+    title : str
+    """
+    fig, axis = _figure(figsize=(12, 5.5))
+    floor = to_unit(1e-3, unit)
+    for index, source in enumerate(spherical):
+        color = f"C{index}"
+        label = SOURCE_TITLES.get(source, source)
+        axis.plot(time, np.maximum(np.abs(to_unit(spherical[source], unit)), floor), color=color, lw=1.6,
+                  label=f"{label}, spherical")
+        axis.plot(time, np.maximum(np.abs(to_unit(flat[source], unit)), floor), color=color, lw=1.2, ls="--",
+                  label=f"{label}, flat")
+    axis.set_yscale("log")
+    axis.set_ylim(bottom=to_unit(1.0, unit))
+    axis.set_xlabel("time since launch [s]")
+    axis.set_ylabel(f"|position error| [{unit}] (log scale)")
+    axis.set_title(title)
+    axis.grid(True, which="both", alpha=0.25)
+    axis.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    return fig
+
+
+def plot_vertical(time, unaided, aided: dict, unit: str, title: str):
+    """Pure-inertial (divergent) vs baro-aided altitude error.
+
+    Parameters
+    ----------
+    time : ndarray
+        t, s.
+    unaided : ndarray
+        Pure-inertial altitude error, m.
+    aided : dict of str -> ndarray
+        Label -> aided altitude error, m.
+    unit : str
+        Display unit.
+    title : str
+    """
+    fig, (left, right) = _figure(1, 2, figsize=(11, 4.2))
+    left.plot(time, to_unit(unaided, unit), color="C3", lw=1.8, label="pure inertial")
+    for index, (label, values) in enumerate(aided.items()):
+        left.plot(time, to_unit(values, unit), color=f"C{index}", lw=1.4, label=label)
+        right.plot(time, to_unit(values, unit), color=f"C{index}", lw=1.4, label=label)
+    left.set_title("pure inertial diverges")
+    right.set_title("baro-aided loops, enlarged")
+    for axis in (left, right):
+        axis.set_xlabel("time [s]")
+        axis.set_ylabel(f"altitude error [{unit}]")
+        axis.grid(True, alpha=0.3)
+        axis.legend()
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_foucault(time, north, east, unit: str, title: str):
+    """Ground track of the horizontal position error: the Schuler swing turning at the Foucault rate.
+
+    Parameters
+    ----------
+    time : ndarray
+        t, s (colour).
+    north, east : ndarray
+        Position errors, m.
+    unit : str
+    title : str
+    """
+    fig, axis = _figure(figsize=(6, 6))
+    points = axis.scatter(to_unit(east, unit), to_unit(north, unit), c=np.asarray(time) / 3600.0, s=2,
+                          cmap="viridis")
+    fig.colorbar(points, ax=axis, label="time [h]")
+    axis.set_xlabel(f"east error [{unit}]")
+    axis.set_ylabel(f"north error [{unit}]")
+    axis.set_aspect("equal")
+    axis.set_title(title)
+    axis.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,256 @@
+"""The HTML report: one self-contained page with a section per system.
+
+``build_report(out_dir)`` asks every system for its report section
+(:meth:`System.report`, which writes its figures into ``out_dir/figures``) and
+writes ``out_dir/index.html``: an introduction, then per system what it is,
+its source, the reproduction table (source value, computed value, agreement,
+errata explained), its key figures and the commands that reproduce them. The
+page needs no script and no network: it is plain HTML with inline CSS and
+images beside it.
+"""
+
+from __future__ import annotations
+
+import html
+import importlib
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from schuler import __version__
+from schuler.io import write_text
+from schuler.registry import SYSTEM_MODULES, ReportSection, System
+from schuler.study.systems import load_system
+
+FIGURES = "figures"
+"""Subfolder of the report folder that holds the figures."""
+
+
+@dataclass
+class SystemEntry:
+    """One system in the report: its section, or why it has none."""
+
+    name: str
+    system: System | None
+    section: ReportSection | None
+    seconds: float = 0.0
+
+
+def build_report(out_dir, systems=None, jobs: int = 1) -> Path:
+    """Build the report into ``out_dir``; returns the path of ``index.html``.
+
+    Parameters
+    ----------
+    out_dir : path
+        Report folder (created if missing); figures go into ``out_dir/figures``.
+    systems : iterable of str, optional
+        System names to include (default: all five, in the order of the toolkit).
+    jobs : int
+        Sections built at once, each in its own process (1: in this process).
+
+    A system whose module does not exist in this installation is listed as not
+    yet available; any error inside an existing system propagates.
+    """
+    out_dir = Path(out_dir)
+    figures = out_dir / FIGURES
+    figures.mkdir(parents=True, exist_ok=True)
+    began = time.perf_counter()
+    names = list(systems or SYSTEM_MODULES)
+    loaded = {name: load_system(name) for name in names}
+    present = [name for name in names if loaded[name] is not None]
+    if jobs > 1 and len(present) > 1:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        context = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(min(jobs, len(present)), mp_context=context) as pool:
+            futures = {name: pool.submit(build_section, SYSTEM_MODULES[name], figures) for name in present}
+            built = {name: future.result() for name, future in futures.items()}
+    else:
+        built = {name: build_section(SYSTEM_MODULES[name], figures) for name in present}
+    entries = [
+        SystemEntry(name, loaded[name], *built[name]) if name in built else SystemEntry(name, None, None)
+        for name in names
+    ]
+    return write_text(out_dir / "index.html", render_html(entries, time.perf_counter() - began))
+
+
+def build_section(module: str, figures: Path) -> tuple[ReportSection, float]:
+    """The report section of the system defined in ``module`` and the seconds it took."""
+    began = time.perf_counter()
+    section = importlib.import_module(module).SYSTEM.report(figures)
+    return section, time.perf_counter() - began
+
+
+def render_html(entries: list[SystemEntry], seconds: float) -> str:
+    """The report page for the given entries (figure paths relative to ``figures/``).
+
+    ``seconds`` is the time the whole report took, shown in the footer.
+    """
+    available = [e for e in entries if e.section is not None]
+    parts = [
+        "<!DOCTYPE html>",
+        '<html lang="en">',
+        "<head>",
+        '<meta charset="utf-8">',
+        '<meta name="viewport" content="width=device-width, initial-scale=1">',
+        "<title>schuler: report of the gyroscopic navigation instruments</title>",
+        f"<style>{_CSS}</style>",
+        "</head>",
+        "<body>",
+        "<main>",
+        _intro(entries),
+        _contents(entries),
+    ]
+    parts.extend(_section(entry) for entry in entries)
+    parts.append(
+        f"<footer><p>schuler {html.escape(__version__)}: {len(available)} of {len(entries)} systems, "
+        f"built in {seconds:.1f} s. Rebuild with <code>schuler report --out DIR</code>.</p></footer>"
+    )
+    parts.extend(["</main>", "</body>", "</html>", ""])
+    return "\n".join(parts)
+
+
+def _intro(entries: list[SystemEntry]) -> str:
+    return f"""<header>
+<h1>schuler: gyroscopic navigation instruments, reproduced</h1>
+<p>This report follows an inertial system through its life: calibrate the gyros,
+align the platform in azimuth (or let a ground gyrocompass find north), then
+navigate with errors bounded by Schuler tuning. Each section takes one classic
+source, reproduces its published numbers with the toolkit, and says where and why
+a printed number does not follow from the source's own formulas.</p>
+<p>Every quantity is computed in SI and shown in the source's units. Each section
+ends with the commands that reproduce it; <code>schuler SYSTEM run --help</code>
+lists every parameter, and <code>schuler run SCENARIO.toml</code> and
+<code>schuler sweep</code> turn a case into a study.</p>
+<p>{sum(e.section is not None for e in entries)} of {len(entries)} systems are in this report.</p>
+</header>"""
+
+
+def _contents(entries: list[SystemEntry]) -> str:
+    items = []
+    for entry in entries:
+        if entry.section is None:
+            items.append(f"<li>{html.escape(entry.name)}: not yet available</li>")
+        else:
+            items.append(
+                f'<li><a href="#{_anchor(entry.name)}">{html.escape(entry.section.title)}</a> '
+                f"(<code>schuler {html.escape(entry.name)}</code>)</li>"
+            )
+    return '<nav><h2>Contents</h2><ol>' + "".join(items) + "</ol></nav>"
+
+
+def _anchor(name: str) -> str:
+    return f"system-{name}"
+
+
+def _section(entry: SystemEntry) -> str:
+    name = html.escape(entry.name)
+    if entry.section is None:
+        return (
+            f'<section id="{_anchor(entry.name)}" class="missing"><h2>{name}</h2>'
+            f"<p>Not yet available in this installation (module "
+            f"<code>{html.escape(SYSTEM_MODULES[entry.name])}</code> is not installed).</p></section>"
+        )
+    section, system = entry.section, entry.system
+    parts = [
+        f'<section id="{_anchor(entry.name)}">',
+        f"<h2>{html.escape(section.title)} <small><code>schuler {name}</code></small></h2>",
+        f'<p class="source"><strong>Source:</strong> {html.escape(section.source)}</p>',
+        f"<p>{html.escape(section.summary)}</p>",
+    ]
+    if section.rows:
+        parts.append(_reproduction_table(section))
+    if section.notes:
+        parts.append("<h3>Notes and errata</h3><ul>")
+        parts.extend(f"<li>{html.escape(note)}</li>" for note in section.notes)
+        parts.append("</ul>")
+    if section.figures:
+        parts.append('<div class="figures">')
+        for figure in section.figures:
+            src = html.escape(f"{FIGURES}/{figure.path}", quote=True)
+            caption = html.escape(figure.caption)
+            parts.append(
+                f'<figure><a href="{src}"><img src="{src}" alt="{html.escape(figure.caption, quote=True)}" '
+                f'loading="lazy"></a><figcaption>{caption}</figcaption></figure>'
+            )
+        parts.append("</div>")
+    parts.append(_parameters_table(system))
+    if section.commands:
+        parts.append("<h3>Reproduce</h3>")
+        parts.append("<pre><code>" + "\n".join(html.escape(c) for c in section.commands) + "</code></pre>")
+    parts.append(f'<p class="timing">Section built in {entry.seconds:.1f} s.</p>')
+    parts.append("</section>")
+    return "\n".join(parts)
+
+
+def _number(value) -> str:
+    if value is None:
+        return "&mdash;"
+    if isinstance(value, bool):
+        return str(value)
+    if isinstance(value, (int, float)):
+        if isinstance(value, float) and not math.isfinite(value):
+            return html.escape(str(value))
+        return html.escape(f"{value:.6g}")
+    return html.escape(str(value))
+
+
+def _reproduction_table(section: ReportSection) -> str:
+    rows = []
+    for row in section.rows:
+        mark = '<td class="ok">agrees</td>' if row.agrees else '<td class="differs">differs</td>'
+        rows.append(
+            f"<tr><td>{html.escape(row.quantity)}</td><td>{_number(row.printed)}</td>"
+            f"<td>{_number(row.computed)}</td><td>{html.escape(row.unit)}</td>{mark}"
+            f"<td>{html.escape(row.note)}</td></tr>"
+        )
+    agreeing = sum(row.agrees for row in section.rows)
+    return (
+        f"<h3>Reproduction ({agreeing} of {len(section.rows)} agree)</h3>"
+        "<table class=\"reproduction\"><thead><tr><th>quantity</th><th>source</th><th>computed</th>"
+        "<th>unit</th><th>agreement</th><th>note</th></tr></thead><tbody>" + "".join(rows) + "</tbody></table>"
+    )
+
+
+def _parameters_table(system: System) -> str:
+    rows = []
+    for spec in system.parameters:
+        unit = spec.unit if spec.kind == "quantity" else spec.kind
+        allowed = spec.range_text() if spec.kind in ("quantity", "integer") else ", ".join(spec.choices or ())
+        default = "not set" if spec.default is None else str(spec.default)
+        rows.append(
+            f"<tr><td><code>{html.escape(spec.option)}</code></td><td>{html.escape(unit)}</td>"
+            f"<td>{html.escape(default)}</td><td>{html.escape(allowed)}</td><td>{html.escape(spec.help)}</td></tr>"
+        )
+    return (
+        f"<details><summary>Parameters of <code>schuler {html.escape(system.name)} run</code> "
+        f"(also the keys of a scenario file)</summary>"
+        "<table><thead><tr><th>option</th><th>unit</th><th>default</th><th>allowed</th><th>meaning</th></tr></thead>"
+        "<tbody>" + "".join(rows) + "</tbody></table></details>"
+    )
+
+
+_CSS = """
+body { font-family: system-ui, -apple-system, "Segoe UI", sans-serif; margin: 0; color: #1d2430;
+       background: #fafbfc; line-height: 1.5; }
+main { max-width: 1100px; margin: 0 auto; padding: 1.5rem 2rem 3rem; }
+h1 { font-size: 1.8rem; margin-bottom: 0.3rem; }
+h2 { border-bottom: 2px solid #d0d7de; padding-bottom: 0.2rem; margin-top: 2.5rem; }
+h2 small { font-weight: normal; font-size: 0.6em; color: #57606a; }
+section.missing h2 { color: #8c959f; }
+table { border-collapse: collapse; width: 100%; margin: 0.8rem 0; font-size: 0.9rem; }
+th, td { border: 1px solid #d0d7de; padding: 0.3rem 0.5rem; text-align: left; vertical-align: top; }
+thead th { background: #eef1f4; }
+td.ok { color: #116329; font-weight: 600; }
+td.differs { color: #9a3412; font-weight: 600; }
+.figures { display: flex; flex-wrap: wrap; gap: 1rem; }
+figure { margin: 0; flex: 1 1 480px; background: #fff; border: 1px solid #d0d7de; padding: 0.5rem; }
+figure img { width: 100%; height: auto; }
+figcaption { font-size: 0.85rem; color: #57606a; }
+pre { background: #f3f4f6; padding: 0.8rem; overflow-x: auto; }
+code { font-family: ui-monospace, "SFMono-Regular", Menlo, monospace; font-size: 0.9em; }
+details { margin: 0.8rem 0; }
+.timing, footer { color: #57606a; font-size: 0.85rem; }
+"""

@@ -1,0 +1,313 @@
+"""Single-channel, vertical-channel and effective-period models of source 002 (Bollay)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from schuler.core.earth import BOLLAY, FOOT, MEAN_RADIUS, STANDARD_GRAVITY, STATUTE_MILE
+from schuler.core.lti import simulate
+from schuler.exceptions import InvalidParameter
+from schuler.navigation_errors import api
+from schuler.navigation_errors.effective_period import (
+    effective_schuler_period,
+    flight_gravity,
+    orbital_speed,
+    thrust_gravity,
+)
+from schuler.navigation_errors.reproduction import FLIGHT_TIME, MAGNITUDES, SPEED, problem3_rows
+from schuler.navigation_errors.single_channel import (
+    SOURCES,
+    channel_model,
+    flat_error,
+    maximum_error,
+    simulate_error,
+    spherical_error,
+    x_minus_sin,
+)
+from schuler.navigation_errors.vertical_channel import (
+    BaroLoopGains,
+    aided_steady_state_error,
+    baro_aided_model,
+    check_stable,
+    critically_damped_gains,
+    hover_altitude_error,
+    printed_hover_expression,
+    unaided_model,
+)
+
+R_BOLLAY, G_BOLLAY = BOLLAY.radius, BOLLAY.effective_gravity
+EARTHS = {"bollay": (R_BOLLAY, G_BOLLAY), "default": (MEAN_RADIUS, STANDARD_GRAVITY)}
+
+
+# --- closed form vs simulation -------------------------------------------------------------------
+
+@pytest.mark.parametrize("earth", sorted(EARTHS))
+@pytest.mark.parametrize("source", SOURCES)
+def test_spherical_closed_form_matches_simulation(source, earth):
+    radius, gravity = EARTHS[earth]
+    t = np.linspace(0.0, 3 * FLIGHT_TIME, 301)
+    closed = spherical_error(source, MAGNITUDES[source], t, radius, gravity, SPEED)
+    simulated = simulate_error(source, MAGNITUDES[source], t, radius, gravity, SPEED)
+    # exact matrix exponential: agreement to rounding, relative to the error's size
+    np.testing.assert_allclose(simulated, closed, rtol=0, atol=1e-9 * np.max(np.abs(closed)))
+
+
+@pytest.mark.parametrize("source", SOURCES)
+def test_flat_closed_form_matches_simulation_with_infinite_radius(source):
+    t = np.linspace(0.0, FLIGHT_TIME, 101)
+    closed = flat_error(source, MAGNITUDES[source], t, G_BOLLAY, SPEED)
+    simulated = simulate_error(source, MAGNITUDES[source], t, np.inf, G_BOLLAY, SPEED)
+    np.testing.assert_allclose(simulated, closed, rtol=0, atol=1e-9 * np.max(np.abs(closed)))
+
+
+@pytest.mark.parametrize("source", SOURCES)
+def test_spherical_tends_to_flat_for_short_times(source):
+    # omega t << 1: the Schuler loop has not acted yet; the relative difference is O((omega t)^2)
+    t = np.array([1.0, 10.0])
+    flat = flat_error(source, MAGNITUDES[source], t, G_BOLLAY, SPEED)
+    spherical = spherical_error(source, MAGNITUDES[source], t, R_BOLLAY, G_BOLLAY, SPEED)
+    np.testing.assert_allclose(spherical, flat, rtol=2e-4)
+
+
+def test_platform_tilt_of_the_drift_case_is_bounded_by_epsilon_over_omega():
+    # spec: tilt from the local vertical is (eps/omega) sin(omega t), at most ~8 arcsec, zero at 10,120 s
+    t = np.linspace(0.0, FLIGHT_TIME, 1013)
+    tilt = simulate(channel_model(R_BOLLAY, G_BOLLAY), t, inputs=[0.0, MAGNITUDES["drift"]])["tilt"]
+    omega = BOLLAY.schuler_frequency
+    np.testing.assert_allclose(tilt, MAGNITUDES["drift"] / omega * np.sin(omega * t), atol=1e-15)
+    assert math.degrees(np.max(np.abs(tilt))) * 3600 == pytest.approx(8.05, abs=0.01)
+
+
+def test_x_minus_sin_series_matches_direct_formula_where_both_are_accurate():
+    x = np.array([0.05, 0.1, 0.2, 0.2499, 0.2501, 1.0])
+    np.testing.assert_allclose(x_minus_sin(x), x - np.sin(x), rtol=1e-10)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    source=st.sampled_from(SOURCES),
+    duration=st.floats(1.0, 40_000.0),
+    magnitude=st.floats(1e-6, 1.0),
+    speed=st.floats(0.0, 3000.0),
+)
+def test_maximum_error_is_the_largest_value_on_a_dense_grid(source, duration, magnitude, speed):
+    t = np.linspace(0.0, duration, 20_001)
+    dense = np.max(np.abs(spherical_error(source, magnitude, t, MEAN_RADIUS, STANDARD_GRAVITY, speed)))
+    peak = maximum_error(source, magnitude, duration, MEAN_RADIUS, STANDARD_GRAVITY, speed)
+    # the grid can only miss the peak by its curvature over half a step
+    assert dense <= peak * (1 + 1e-12) + 1e-12
+    assert dense == pytest.approx(float(peak), rel=1e-6, abs=1e-9)
+
+
+@settings(max_examples=20, deadline=None)
+@given(source=st.sampled_from(SOURCES[:4]), scale=st.floats(0.1, 10.0))
+def test_errors_are_linear_in_the_magnitude(source, scale):
+    t = np.linspace(0.0, FLIGHT_TIME, 7)
+    base = spherical_error(source, MAGNITUDES[source], t, R_BOLLAY, G_BOLLAY)
+    scaled = spherical_error(source, scale * MAGNITUDES[source], t, R_BOLLAY, G_BOLLAY)
+    np.testing.assert_allclose(scaled, scale * base, rtol=1e-12, atol=1e-18)
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda: spherical_error("gyro", 1.0, 1.0, 1.0, 1.0), "source"),
+        (lambda: spherical_error("tilt", np.nan, 1.0, 1.0, 1.0), "magnitude"),
+        (lambda: spherical_error("tilt", 1e-4, 1.0, 0.0, 9.8), "radius"),
+        (lambda: flat_error("drift", 1e-8, -1.0, 9.8), "time"),
+        (lambda: channel_model(-1.0, 9.8), "radius"),
+        (lambda: maximum_error("tilt", 1.0, 1.0, 1.0, 1.0, earth="round"), "earth"),
+    ],
+)
+def test_bad_input_raises_invalid_parameter_naming_it(call, name):
+    with pytest.raises(InvalidParameter) as error:
+        call()
+    assert error.value.name == name
+
+
+# --- source 002, Problem 3 table and Problem 4 --------------------------------------------------
+
+PUBLISHED = [
+    # (source, earth, quantity, printed ft, agrees): source 002, Problem 3 summary table / Problem 4
+    ("tilt", "flat", "at_10120s", 288_000, True),
+    ("tilt", "spherical", "at_10120s", 0, True),
+    ("tilt", "spherical", "max", 3_650, False),  # erratum: 2 R dtheta = 7,300 ft (solution text)
+    ("velocity", "flat", "at_10120s", 10_120, True),
+    ("velocity", "spherical", "at_10120s", 0, True),
+    ("velocity", "spherical", "max", 805, True),
+    ("accelerometer", "flat", "at_10120s", 341_000, False),  # erratum: k g t^2/2 = 165,089 ft
+    ("accelerometer", "spherical", "at_10120s", 0, True),
+    ("accelerometer", "spherical", "max", 4_170, True),
+    ("drift", "flat", "at_10120s", 1.62e6, False),  # erratum: the 1/6 dropped
+    ("drift", "spherical", "at_10120s", 10_250, True),
+    ("azimuth", "flat", "at_10120s", 4_660, True),
+    ("azimuth", "spherical", "at_10120s", 3_500, True),
+    ("hover", "vertical", "at_T", 724 * 5280, False),  # erratum: 715.4 mi
+]
+
+
+def test_problem3_rows_have_the_published_values_and_flags():
+    rows = problem3_rows()
+    assert [(r.source, r.earth, r.quantity, r.printed_ft, r.agrees) for r in rows] == PUBLISHED
+    assert all(r.note for r in rows)
+
+
+@pytest.mark.parametrize("row", [r for r in problem3_rows() if r.agrees], ids=lambda r: f"{r.source}-{r.earth}-{r.quantity}")
+def test_agreeing_rows_are_within_the_source_rounding(row):
+    # source 002 prints three significant figures: 0.5 % (or 0.5 ft of a printed zero)
+    if row.printed_ft == 0:
+        assert row.computed_ft < 0.5
+    else:
+        assert row.computed_ft == pytest.approx(row.printed_ft, rel=0.005)
+
+
+def test_errata_values_recomputed_from_the_formulas():
+    by_key = {(r.source, r.earth, r.quantity): r.computed_ft for r in problem3_rows()}
+    # spec errata, recomputed with R = 3960 mi, omega = 2 pi / 5060 s, g_eff = omega^2 R
+    assert by_key["tilt", "spherical", "max"] == pytest.approx(2 * 3960 * 5280 * math.radians(0.01), rel=1e-12)
+    assert by_key["tilt", "spherical", "max"] == pytest.approx(7_300, rel=0.001)  # source 002 solution text
+    assert by_key["drift", "flat", "at_10120s"] == pytest.approx(2.70e5, rel=0.001)
+    assert 6 * by_key["drift", "flat", "at_10120s"] == pytest.approx(1.62e6, rel=0.002)  # the printed one: no 1/6
+    assert by_key["accelerometer", "flat", "at_10120s"] == pytest.approx(1.65e5, rel=0.001)
+    assert by_key["accelerometer", "spherical", "max"] == pytest.approx(4_181.76, abs=0.01)  # 2 k R exactly
+    assert by_key["azimuth", "spherical", "at_10120s"] == pytest.approx(3_494, abs=0.5)
+    assert by_key["drift", "spherical", "at_10120s"] == pytest.approx(
+        3960 * 5280 * math.radians(0.01) / 3600 * 10_120, rel=1e-12)
+
+
+def test_hover_error_after_one_schuler_period():
+    # source 002, Problem 4: k = 1e-4, t = T, R = 3960 mi: 715.4 mi with z(0) = z'(0) = 0 (printed: 724)
+    z = hover_altitude_error(BOLLAY.schuler_period, -1e-4 * G_BOLLAY, R_BOLLAY, G_BOLLAY)
+    assert -z / STATUTE_MILE == pytest.approx(715.4085, abs=1e-3)
+    sinh = printed_hover_expression(BOLLAY.schuler_period, 1e-4, R_BOLLAY, G_BOLLAY) / STATUTE_MILE
+    assert sinh == pytest.approx(715.6, abs=0.05)  # the source's expression (spec errata)
+    assert sinh * 4000 / 3960 == pytest.approx(722.8, abs=0.05)  # ... with R = 4000 mi
+    # the printed sinh solution violates z(0) = 0 in form only; it is the cosh solution's large-t limit
+    assert float(printed_hover_expression(0.0, 1e-4, R_BOLLAY, G_BOLLAY)) == 0.0
+    assert float(-hover_altitude_error(1.0, -1e-4 * G_BOLLAY, R_BOLLAY, G_BOLLAY)) != pytest.approx(
+        float(printed_hover_expression(1.0, 1e-4, R_BOLLAY, G_BOLLAY)), rel=0.1)
+
+
+def test_hover_closed_form_matches_simulation_of_the_unaided_channel():
+    t = np.linspace(0.0, BOLLAY.schuler_period, 201)
+    b = -1e-4 * G_BOLLAY
+    simulated = simulate(unaided_model(R_BOLLAY, G_BOLLAY), t, inputs=[b])["altitude_error"]
+    np.testing.assert_allclose(simulated, hover_altitude_error(t, b, R_BOLLAY, G_BOLLAY), rtol=1e-9, atol=1e-9)
+
+
+# --- baro-aided vertical loop ----------------------------------------------------------------------
+
+@pytest.mark.parametrize("order", [2, 3])
+def test_critically_damped_gains_put_every_pole_at_minus_one_over_tau(order):
+    gains = critically_damped_gains(order, 80.0, MEAN_RADIUS, STANDARD_GRAVITY)
+    poles = baro_aided_model(gains, MEAN_RADIUS, STANDARD_GRAVITY).eigenvalues()
+    # a repeated root of multiplicity m is found to about eps^(1/m): 1e-5 relative for m = 3
+    np.testing.assert_allclose(poles, -1 / 80.0, atol=1e-5 / 80.0)
+
+
+@pytest.mark.parametrize("order", [2, 3])
+def test_aided_loop_settles_to_its_closed_form_steady_state(order):
+    gains = critically_damped_gains(order, 60.0, MEAN_RADIUS, STANDARD_GRAVITY)
+    b, baro = 1e-3, 4.0
+    t = np.linspace(0.0, 4000.0, 401)
+    h = simulate(baro_aided_model(gains, MEAN_RADIUS, STANDARD_GRAVITY), t, inputs=[b, baro])["altitude_error"]
+    expected = aided_steady_state_error(gains, b, baro, MEAN_RADIUS, STANDARD_GRAVITY)
+    assert h[-1] == pytest.approx(float(expected), rel=1e-9)
+    assert expected == pytest.approx(baro if order == 3 else (b + gains.k2 * baro) / (gains.k2 - 2 * STANDARD_GRAVITY / MEAN_RADIUS))
+
+
+def test_damping_stabilises_the_divergent_vertical_channel():
+    result = api.vertical(-1e-4 * STANDARD_GRAVITY, 5060.0, order=3)
+    assert np.max(result.poles_real_per_s) < 0
+    assert abs(result.unaided_m[-1]) > 1e6  # pure inertial: ~1,100 km after one period
+    assert abs(result.aided_m[-1]) < 1e-6  # third order estimates the bias away
+    np.testing.assert_allclose(result.unaided_m, result.closed_form_m, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    "gains, name",
+    [(BaroLoopGains(-0.1, 1e-3, 0.0, 2), "k1"), (BaroLoopGains(0.1, 1e-6, 0.0, 2), "k2"),
+     (BaroLoopGains(0.01, 1e-4, 1.0, 3), "k3")],
+)
+def test_unstable_gains_are_rejected(gains, name):
+    with pytest.raises(InvalidParameter) as error:
+        check_stable(gains, MEAN_RADIUS, STANDARD_GRAVITY)
+    assert error.value.name == name
+
+
+# --- effective Schuler period (source 002 footnote) -----------------------------------------------
+
+def test_thrust_of_nine_g_divides_the_period_by_three():
+    T0 = effective_schuler_period(MEAN_RADIUS, STANDARD_GRAVITY)
+    T9 = effective_schuler_period(MEAN_RADIUS, thrust_gravity(9.0, STANDARD_GRAVITY))
+    assert T9 == pytest.approx(T0 / 3, rel=1e-14)
+    assert T9 / 60 == pytest.approx(28, abs=0.5)  # source 002 footnote: 84/3 = 28 minutes
+
+
+def test_period_grows_without_bound_towards_orbital_speed():
+    Vc = float(orbital_speed(STANDARD_GRAVITY, MEAN_RADIUS))
+    speeds = Vc * np.array([0.0, 0.5, 0.9, 0.99, 0.9999])
+    periods = effective_schuler_period(MEAN_RADIUS, flight_gravity(STANDARD_GRAVITY, speeds, MEAN_RADIUS))
+    assert np.all(np.diff(periods) > 0)
+    # g_eff = g (1 - (V/Vc)^2): T = T0 / sqrt(1 - (V/Vc)^2)
+    np.testing.assert_allclose(periods, periods[0] / np.sqrt(1 - (speeds / Vc) ** 2), rtol=1e-9)
+    assert np.isinf(effective_schuler_period(MEAN_RADIUS, flight_gravity(STANDARD_GRAVITY, Vc * 1.01, MEAN_RADIUS)))
+
+
+# --- api: run, sweep, report ------------------------------------------------------------------------
+
+def test_run_bollay_velocity_case_and_simulation_agreement():
+    result = api.run(source="velocity", magnitude=FOOT, duration=FLIGHT_TIME, step=10.0, earth="bollay")
+    assert result.schuler_period_s == pytest.approx(5060.0, rel=1e-12)
+    assert result.max_spherical_m / FOOT == pytest.approx(805.32, abs=0.01)
+    assert result.max_simulation_difference_m < 1e-10 * result.max_spherical_m  # exact ZOH: rounding only
+    assert result.t_s[-1] == FLIGHT_TIME and result.t_s.size == 1013
+
+
+def test_run_takes_text_magnitudes_in_the_source_unit():
+    result = api.run(source="drift", magnitude="0.01", duration=3600.0)
+    assert result.magnitude_si == pytest.approx(math.radians(0.01) / 3600, rel=1e-12)
+    with pytest.raises(InvalidParameter):
+        api.run(source="drift", magnitude="1 ft/s")
+
+
+def test_sweep_matches_run_case_by_case():
+    values = {
+        "source": np.array(["tilt", "velocity", "accelerometer", "drift", "azimuth", "drift"]),
+        "magnitude": np.array([MAGNITUDES[s] for s in SOURCES] + [2 * MAGNITUDES["drift"]]),
+        "duration": np.array([5000.0, 7000.0, 9000.0, 3600.0, 10_120.0, 20_000.0]),
+        "speed": np.full(6, SPEED),
+        "earth": np.array(["bollay", "default", "drozdovich", "bollay", "bollay", "default"]),
+        "radius": np.array([np.nan] * 5 + [6.4e6]),
+        "gravity": np.full(6, np.nan),
+    }
+    out = api.sweep(values)
+    for k in range(6):
+        single = api.run(source=values["source"][k], magnitude=values["magnitude"][k],
+                         duration=values["duration"][k], speed=SPEED, earth=values["earth"][k],
+                         radius=None if np.isnan(values["radius"][k]) else values["radius"][k])
+        assert out["final_spherical_m"][k] == pytest.approx(single.final_spherical_m, rel=1e-12)
+        assert out["final_flat_m"][k] == pytest.approx(single.final_flat_m, rel=1e-12)
+        assert out["max_spherical_m"][k] == pytest.approx(single.max_spherical_m, rel=1e-12)
+        assert out["schuler_period_s"][k] == pytest.approx(single.schuler_period_s, rel=1e-12)
+        assert out["max_spherical_m"][k] >= np.max(np.abs(single.spherical_m)) * (1 - 1e-12)
+
+
+def test_system_parameters_are_the_run_keywords():
+    import inspect
+
+    assert [p.name for p in api.SYSTEM.parameters] == list(inspect.signature(api.run).parameters)
+
+
+def test_report_writes_its_figures_and_table(tmp_path):
+    section = api.report(tmp_path)
+    assert section.system == "errors"
+    assert len(section.rows) == 14 and sum(not row.agrees for row in section.rows) == 5
+    for figure in section.figures:
+        assert (tmp_path / figure.path).stat().st_size > 10_000
+    assert all(figure.path.startswith("errors_") for figure in section.figures)

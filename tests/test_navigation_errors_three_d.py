@@ -1,0 +1,120 @@
+"""The 3-D psi-angle INS error model on a rotating Earth: modes and single-channel limit."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from schuler.core.earth import BOLLAY, EARTH_RATE, MEAN_RADIUS, STANDARD_GRAVITY
+from schuler.core.lti import simulate
+from schuler.exceptions import InvalidParameter
+from schuler.navigation_errors.single_channel import flat_error, spherical_error
+from schuler.navigation_errors.three_d import foucault_velocity_response, psi_angle_model, stationary_modes
+
+
+def _sorted_by_frequency(values):
+    values = np.asarray(values)
+    return values[np.lexsort((values.real, values.imag))]
+
+
+@pytest.mark.parametrize("latitude_deg", [0.0, 10.0, 45.0, 60.0, -33.0, 80.0])
+def test_stationary_eigenvalues_match_the_exact_theory(latitude_deg):
+    L = math.radians(latitude_deg)
+    model = psi_angle_model(L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE)
+    computed = _sorted_by_frequency(model.eigenvalues())
+    omega_s = math.sqrt(STANDARD_GRAVITY / MEAN_RADIUS)
+    omega_z = EARTH_RATE * math.sin(L)
+    split = math.sqrt(omega_s**2 + omega_z**2)
+    exact = _sorted_by_frequency(1j * np.array([
+        0.0, EARTH_RATE, -EARTH_RATE, split + omega_z, -(split + omega_z), split - omega_z, -(split - omega_z)]))
+    np.testing.assert_allclose(computed, exact, rtol=0, atol=1e-6 * EARTH_RATE)
+    nonzero = np.abs(exact) > 0
+    np.testing.assert_allclose(computed[nonzero], exact[nonzero], rtol=1e-6)
+    np.testing.assert_allclose(_sorted_by_frequency(stationary_modes(L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE)),
+                               exact, rtol=1e-15)
+
+
+def test_non_rotating_limit_of_a_north_drift_is_the_single_channel_formula():
+    # drift about east makes a north error: (R eps / omega)(omega t - sin omega t), source 002 eq. (4)
+    epsilon = math.radians(0.01) / 3600
+    R, g = BOLLAY.radius, BOLLAY.effective_gravity
+    model = psi_angle_model(math.radians(30.0), R, g, 0.0)
+    t = np.linspace(0.0, 10_120.0, 241)
+    inputs = np.zeros(6)
+    inputs[4] = epsilon
+    response = simulate(model, t, inputs=inputs)
+    closed = spherical_error("drift", epsilon, t, R, g)
+    np.testing.assert_allclose(response["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
+    np.testing.assert_allclose(response["position_error_east"], 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("source, state, input_index", [("tilt", 5, None), ("velocity", 2, None),
+                                                        ("accelerometer", None, 0)])
+def test_non_rotating_limit_reproduces_the_other_channel_sources(source, state, input_index):
+    R, g = MEAN_RADIUS, STANDARD_GRAVITY
+    magnitude = {"tilt": 1e-4, "velocity": 0.5, "accelerometer": 1e-3}[source]
+    model = psi_angle_model(0.7, R, g, 0.0)
+    initial = np.zeros(7)
+    inputs = np.zeros(6)
+    if state is not None:
+        initial[state] = magnitude
+    else:
+        inputs[input_index] = magnitude
+    t = np.linspace(0.0, 8000.0, 161)
+    north = simulate(model, t, initial_state=initial, inputs=inputs)["position_error_north"]
+    closed = spherical_error(source, magnitude, t, R, g)
+    np.testing.assert_allclose(north, closed, rtol=0, atol=1e-9 * np.abs(closed).max())
+
+
+def test_foucault_modulation_of_a_velocity_error():
+    L = math.radians(45.0)
+    model = psi_angle_model(L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE)
+    t = np.linspace(0.0, 86_400.0, 1441)
+    response = simulate(model, t, initial_state=[0, 0, 1.0, 0, 0, 0, 0])
+    north, east = foucault_velocity_response(t, 1.0, L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE)
+    amplitude = 1.0 / math.sqrt(STANDARD_GRAVITY / MEAN_RADIUS)
+    np.testing.assert_allclose(response["position_error_north"], north, atol=1e-7 * amplitude)
+    np.testing.assert_allclose(response["position_error_east"], east, atol=1e-7 * amplitude)
+    # the swing turns east (clockwise from above) in the northern hemisphere: east error builds up
+    assert np.max(east) > 0.5 * amplitude
+
+
+def test_constant_velocity_attitude_modes_follow_the_total_frame_rate():
+    L, V_E, V_N = math.radians(40.0), 250.0, 120.0
+    model = psi_angle_model(L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE, velocity_north=V_N, velocity_east=V_E)
+    frame_rate = np.array([EARTH_RATE * math.cos(L) + V_E / MEAN_RADIUS, -V_N / MEAN_RADIUS,
+                           -EARTH_RATE * math.sin(L) - V_E * math.tan(L) / MEAN_RADIUS])
+    psi_block = model.A[4:, 4:]
+    np.testing.assert_allclose(np.sort(np.linalg.eigvals(psi_block).imag),
+                               [-np.linalg.norm(frame_rate), 0.0, np.linalg.norm(frame_rate)], atol=1e-15)
+    assert not np.allclose(model.A, psi_angle_model(L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE).A)
+    # without speed it is the stationary model
+    np.testing.assert_array_equal(
+        psi_angle_model(L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE, 0.0, 0.0).A,
+        psi_angle_model(L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE).A)
+
+
+def test_flat_limit_of_the_three_d_model_is_the_flat_formula():
+    # radius -> large with g fixed: the Schuler loop opens, a tilt gives g psi t^2 / 2 over a short time
+    model = psi_angle_model(0.3, 1e15, STANDARD_GRAVITY, 0.0)
+    t = np.linspace(0.0, 600.0, 61)
+    north = simulate(model, t, initial_state=[0, 0, 0, 0, 0, 1e-4, 0])["position_error_north"]
+    np.testing.assert_allclose(north, flat_error("tilt", 1e-4, t, STANDARD_GRAVITY), rtol=1e-6)
+
+
+def test_vertical_channel_is_unstable_near_sqrt_two_omega_s():
+    model = psi_angle_model(math.radians(45.0), MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE, vertical_channel=True)
+    assert model.n_states == 9
+    growth = np.max(model.eigenvalues().real)
+    assert growth == pytest.approx(math.sqrt(2 * STANDARD_GRAVITY / MEAN_RADIUS), rel=1e-3)
+
+
+@pytest.mark.parametrize("kwargs, name", [({"latitude": math.pi / 2}, "latitude"), ({"radius": 0.0}, "radius"),
+                                          ({"rate": -1.0}, "rate"), ({"velocity_east": np.nan}, "velocity_east")])
+def test_three_d_bad_input(kwargs, name):
+    arguments = {"latitude": 0.5, "radius": MEAN_RADIUS, "gravity": STANDARD_GRAVITY, "rate": EARTH_RATE} | kwargs
+    with pytest.raises(InvalidParameter) as error:
+        psi_angle_model(**arguments)
+    assert error.value.name == name

@@ -1,0 +1,159 @@
+"""A small stand-in system for testing scenarios, sweeps and the report generically.
+
+Its model is the steady-state gyrocompassing error psi = drift_east / (Omega cos(latitude))
+with a settling time duration / gain, so every number is known in closed form.
+Registered as system "fake" by the ``fake_system`` fixture of the study tests.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+import pytest
+
+from schuler.params import Parameter
+from schuler.registry import SYSTEM_MODULES, FigureRef, ReportSection, ReproductionRow, System
+from schuler.results import Result
+
+EARTH_RATE = 7.292115e-5
+
+PARAMETERS = (
+    Parameter("latitude", "deg", 50.0, "Latitude of the site.", minimum=-89.0, maximum=89.0),
+    Parameter("drift_east", "deg/h", 0.01, "East gyro drift rate.", minimum=0.0),
+    Parameter("gain", "", 1.0, "Loop gain.", minimum=0.0, exclusive_minimum=True),
+    Parameter("method", "", "closed", "How to evaluate.", choices=("closed", "table"), kind="choice"),
+    Parameter("members", "", 1, "Members.", minimum=1, kind="integer"),
+    Parameter("duration", "s", 3600.0, "Simulated time.", minimum=0.0, exclusive_minimum=True),
+    Parameter("step", "s", 1.0, "Time step.", minimum=0.0, exclusive_minimum=True),
+)
+
+CALLS = {"sweep": 0}
+"""Evaluations of fake_sweep in this process (resume tests count them)."""
+
+KILL_ABOVE = "SCHULER_FAKE_KILL_ABOVE"
+"""Environment: a worker process evaluating a chunk with latitude above this (rad) dies, once."""
+KILL_MARKER = "SCHULER_FAKE_KILL_MARKER"
+"""Environment: file created by the worker that killed itself (so it happens once)."""
+
+
+@dataclass
+class FakeResult(Result):
+    azimuth_error_rad: float
+    settling_time_s: float
+    method: str
+
+    units: ClassVar[dict[str, str]] = {}
+
+
+def fake_sweep(values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    CALLS["sweep"] += 1
+    latitude = np.asarray(values["latitude"], dtype=float)
+    threshold = os.environ.get(KILL_ABOVE)
+    marker = os.environ.get(KILL_MARKER)
+    if threshold and marker and latitude.min() > float(threshold) and not Path(marker).exists():
+        Path(marker).write_text(str(os.getpid()))
+        os._exit(1)
+    azimuth = np.asarray(values["drift_east"], dtype=float) / (EARTH_RATE * np.cos(latitude))
+    settling = np.asarray(values["duration"], dtype=float) / np.asarray(values["gain"], dtype=float)
+    return {"azimuth_error_rad": azimuth, "settling_time_s": settling * np.asarray(values["members"])}
+
+
+def fake_run(latitude, drift_east, gain, method, members, duration, step) -> FakeResult:
+    out = fake_sweep(
+        {
+            "latitude": np.array([latitude]),
+            "drift_east": np.array([drift_east]),
+            "gain": np.array([gain]),
+            "members": np.array([members]),
+            "duration": np.array([duration]),
+        }
+    )
+    return FakeResult(float(out["azimuth_error_rad"][0]), float(out["settling_time_s"][0]), method)
+
+
+def fake_reproduce() -> FakeResult:
+    return fake_run(np.radians(50.0), np.radians(0.01) / 3600, 1.0, "closed", 1, 3600.0, 1.0)
+
+
+def fake_report(outdir: Path) -> ReportSection:
+    import matplotlib.pyplot as plt
+
+    from schuler.io import save_figure_formats
+
+    latitude = np.linspace(0, 80, 50)
+    fig, ax = plt.subplots(figsize=(5, 3))
+    ax.plot(latitude, np.degrees(np.radians(0.01) / 3600 / (EARTH_RATE * np.cos(np.radians(latitude)))) * 60)
+    ax.set_xlabel("latitude [deg]")
+    ax.set_ylabel("azimuth error [arcmin]")
+    ax.set_title("Steady-state azimuth error")
+    save_figure_formats(fig, Path(outdir) / "fake_azimuth", ("png", "svg"))
+    computed = fake_reproduce().azimuth_error_rad
+    return ReportSection(
+        system="fake",
+        title="A fake gyrocompass",
+        source="Test fixture <not a real source> & co",
+        summary="Steady-state azimuth error of a gyrocompass.",
+        rows=[
+            ReproductionRow("azimuth error", 3.6, float(np.degrees(computed) * 60), "arcmin", True, "closed form"),
+            ReproductionRow("printed typo", "4.0", 3.6, "arcmin", False, "the source drops a factor"),
+        ],
+        figures=[
+            FigureRef("fake_azimuth.png", "Azimuth error against latitude (PNG)."),
+            FigureRef("fake_azimuth.svg", "Azimuth error against latitude (SVG)."),
+        ],
+        commands=["schuler fake run --latitude 50"],
+        notes=["An erratum, explained."],
+    )
+
+
+FAKE = System(
+    name="fake",
+    title="Fake gyrocompass",
+    source="Test fixture",
+    parameters=PARAMETERS,
+    run=fake_run,
+    reproduce=fake_reproduce,
+    report=fake_report,
+    sweep=fake_sweep,
+)
+SYSTEM = FAKE
+
+FAKE_WITHOUT_SWEEP = System(
+    name="fakerun",
+    title="Fake gyrocompass without a vectorised sweep",
+    source="Test fixture",
+    parameters=PARAMETERS,
+    run=fake_run,
+    reproduce=fake_reproduce,
+    report=fake_report,
+)
+
+
+def register(monkeypatch) -> None:
+    """Make ``get_system("fake")`` return FAKE (this module's SYSTEM)."""
+    monkeypatch.setitem(SYSTEM_MODULES, "fake", __name__)
+
+
+def only_systems(request, modules: dict[str, str]) -> None:
+    """Make the registry hold exactly ``modules`` (name -> module) for one test, then restore it in order."""
+    saved = dict(SYSTEM_MODULES)
+
+    def restore():
+        SYSTEM_MODULES.clear()
+        SYSTEM_MODULES.update(saved)
+
+    request.addfinalizer(restore)
+    SYSTEM_MODULES.clear()
+    SYSTEM_MODULES.update(modules)
+
+
+def test_fake_run_matches_its_closed_form():
+    # psi = drift / (Omega cos(lat)): 0.01 deg/h at 50 deg N: 0.01 / (15.04107 * cos 50) rad = 3.5557 arcmin
+    result = fake_reproduce()
+    expected = np.radians(0.01) / 3600 / (EARTH_RATE * np.cos(np.radians(50.0)))
+    assert result.azimuth_error_rad == pytest.approx(expected, rel=1e-12)
+    assert np.degrees(result.azimuth_error_rad) * 60 == pytest.approx(3.5557, abs=1e-4)
