@@ -50,7 +50,7 @@ EARTHS = {"bollay": (R_BOLLAY, G_BOLLAY), "default": (MEAN_RADIUS, STANDARD_GRAV
 @pytest.mark.parametrize("source", SOURCES)
 def test_spherical_closed_form_matches_simulation(source, earth):
     radius, gravity = EARTHS[earth]
-    t = np.linspace(0.0, 3 * FLIGHT_TIME, 301)
+    t = np.linspace(0.0, 3 * FLIGHT_TIME, 121)
     closed = spherical_error(source, MAGNITUDES[source], t, radius, gravity, SPEED)
     simulated = simulate_error(source, MAGNITUDES[source], t, radius, gravity, SPEED)
     # exact matrix exponential: agreement to rounding, relative to the error's size
@@ -194,7 +194,7 @@ def test_hover_error_after_one_schuler_period():
 
 
 def test_hover_closed_form_matches_simulation_of_the_unaided_channel():
-    t = np.linspace(0.0, BOLLAY.schuler_period, 201)
+    t = np.linspace(0.0, BOLLAY.schuler_period, 101)
     b = -1e-4 * G_BOLLAY
     simulated = simulate(unaided_model(R_BOLLAY, G_BOLLAY), t, inputs=[b])["altitude_error"]
     np.testing.assert_allclose(simulated, hover_altitude_error(t, b, R_BOLLAY, G_BOLLAY), rtol=1e-9, atol=1e-9)
@@ -214,7 +214,7 @@ def test_critically_damped_gains_put_every_pole_at_minus_one_over_tau(order):
 def test_aided_loop_settles_to_its_closed_form_steady_state(order):
     gains = critically_damped_gains(order, 60.0, MEAN_RADIUS, STANDARD_GRAVITY)
     b, baro = 1e-3, 4.0
-    t = np.linspace(0.0, 4000.0, 401)
+    t = np.linspace(0.0, 4000.0, 81)
     h = simulate(baro_aided_model(gains, MEAN_RADIUS, STANDARD_GRAVITY), t, inputs=[b, baro])["altitude_error"]
     expected = aided_steady_state_error(gains, b, baro, MEAN_RADIUS, STANDARD_GRAVITY)
     assert h[-1] == pytest.approx(float(expected), rel=1e-9)
@@ -222,7 +222,7 @@ def test_aided_loop_settles_to_its_closed_form_steady_state(order):
 
 
 def test_damping_stabilises_the_divergent_vertical_channel():
-    result = api.vertical(-1e-4 * STANDARD_GRAVITY, 5060.0, order=3)
+    result = api.vertical(-1e-4 * STANDARD_GRAVITY, 5060.0, step=50.6, order=3)
     assert np.max(result.poles_real_per_s) < 0
     assert abs(result.unaided_m[-1]) > 1e6  # pure inertial: ~1,100 km after one period
     assert abs(result.aided_m[-1]) < 1e-6  # third order estimates the bias away
@@ -289,7 +289,7 @@ def test_sweep_matches_run_case_by_case():
     out = api.sweep(values)
     for k in range(6):
         single = api.run(source=values["source"][k], magnitude=values["magnitude"][k],
-                         duration=values["duration"][k], speed=SPEED, earth=values["earth"][k],
+                         duration=values["duration"][k], step=values["duration"][k] / 50, speed=SPEED, earth=values["earth"][k],
                          radius=None if np.isnan(values["radius"][k]) else values["radius"][k])
         assert out["final_spherical_m"][k] == pytest.approx(single.final_spherical_m, rel=1e-12)
         assert out["final_flat_m"][k] == pytest.approx(single.final_flat_m, rel=1e-12)
@@ -304,10 +304,11 @@ def test_system_parameters_are_the_run_keywords():
     assert [p.name for p in api.SYSTEM.parameters] == list(inspect.signature(api.run).parameters)
 
 
+@pytest.mark.slow
 def test_report_writes_its_figures_and_table(tmp_path):
     section = api.report(tmp_path)
     assert section.system == "errors"
-    assert len(section.rows) == 14 and sum(not row.agrees for row in section.rows) == 5
+    assert len(section.rows) == 14 and sum(not row.agrees for row in section.rows) == 4
     for figure in section.figures:
         assert (tmp_path / figure.path).stat().st_size > 10_000
     assert all(figure.path.startswith("errors_") for figure in section.figures)

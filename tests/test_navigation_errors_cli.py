@@ -67,7 +67,7 @@ def test_run_radius_and_gravity_override_the_preset(run_cli):
 
 
 def test_run_human_output_in_feet_and_files(run_cli, tmp_path):
-    out = run_cli("errors", "run", "--source", "velocity", "--units", "ft", "--out", str(tmp_path))
+    out = run_cli("errors", "run", "--source", "velocity", "--units", "ft", "--step", "101.2", "--out", str(tmp_path))
     assert out.code == 0 and "(ft)" in out.stdout
     assert {p.suffix for p in tmp_path.iterdir()} == {".png", ".svg", ".csv"}
 
@@ -94,6 +94,7 @@ def test_run_bad_input_is_one_line_naming_the_option(run_cli, args, option):
     assert option in out.stderr
 
 
+@pytest.mark.slow
 def test_plot_writes_png_and_svg(run_cli, tmp_path):
     out = run_cli("errors", "plot", "--out", str(tmp_path), "--points", "101", "--json")
     assert out.code == 0, out.stderr
@@ -104,7 +105,7 @@ def test_plot_writes_png_and_svg(run_cli, tmp_path):
 
 
 def test_vertical_command(run_cli):
-    data = run_cli("errors", "vertical", "--order", "2", "--time-constant", "50 s", "--json").json()
+    data = run_cli("errors", "vertical", "--order", "2", "--time-constant", "50 s", "--step", "25", "--json").json()
     assert data["k1_per_s"] == pytest.approx(0.04)
     assert max(data["poles_real_per_s"]) < 0
     assert data["aided_m"][-1] == pytest.approx(data["aided_steady_state_m"], rel=1e-6)

@@ -71,7 +71,7 @@ def test_non_rotating_limit_reproduces_the_other_channel_sources(source, state, 
 def test_foucault_modulation_of_a_velocity_error():
     L = math.radians(45.0)
     model = psi_angle_model(L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE)
-    t = np.linspace(0.0, 86_400.0, 1441)
+    t = np.linspace(0.0, 86_400.0, 481)
     response = simulate(model, t, initial_state=[0, 0, 1.0, 0, 0, 0, 0])
     north, east = foucault_velocity_response(t, 1.0, L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE)
     amplitude = 1.0 / math.sqrt(STANDARD_GRAVITY / MEAN_RADIUS)
@@ -108,7 +108,8 @@ def test_vertical_channel_is_unstable_near_sqrt_two_omega_s():
     model = psi_angle_model(math.radians(45.0), MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE, vertical_channel=True)
     assert model.n_states == 9
     growth = np.max(model.eigenvalues().real)
-    assert growth == pytest.approx(math.sqrt(2 * STANDARD_GRAVITY / MEAN_RADIUS), rel=1e-3)
+    # Coriolis couples it to the horizontal channels: shifted by O((Omega / omega_s)^2) = 3e-3
+    assert growth == pytest.approx(math.sqrt(2 * STANDARD_GRAVITY / MEAN_RADIUS), rel=5e-3)
 
 
 @pytest.mark.parametrize("kwargs, name", [({"latitude": math.pi / 2}, "latitude"), ({"radius": 0.0}, "radius"),

@@ -20,7 +20,15 @@ from schuler.results import Result
 from schuler.units import to_unit
 
 _BY_NAME = {p.name: p for p in api.PARAMETERS}
-_SWEEPABLE = [name for name in api.CASE_FIELDS]
+_SWEEPABLE = [name for name in api.CASE_FIELDS if name != "max_latitude"]
+_SHORT_HEADERS = {
+    "azimuth_error_arcmin": "delta sim [arcmin]",
+    "azimuth_error_analytic_arcmin": "delta (1.21) [arcmin]",
+    "level_error_beta_arcmin": "beta [arcmin]",
+    "settling_time_s": "t 5/h [s]",
+    "settling_time_simulated_s": "t 1 % [s]",
+    "constraints_ok": "constraints",
+}
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -83,10 +91,10 @@ class SweepResult(Result):
     def render(self):
         from rich.table import Table
 
-        table = Table(title=f"Gyrocompassing sweep, {self.model} model")
-        names = list(self.columns)
+        table = Table(title=f"Gyrocompassing sweep, {self.model} model (all columns in --json)")
+        names = [name for name in self.columns if name in _SHORT_HEADERS or name.startswith(tuple(self.swept))]
         for name in names:
-            table.add_column(name, justify="right")
+            table.add_column(_SHORT_HEADERS.get(name, name), justify="right")
         for i in range(len(self.columns[names[0]])):
             table.add_row(*(_cell(self.columns[name][i]) for name in names))
         return table

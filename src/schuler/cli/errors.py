@@ -36,7 +36,7 @@ def group():
     """Schuler-tuned INS errors: five sources on a flat and a spherical Earth, vertical channel, periods."""
 
 
-@group.command()
+@group.command(short_help="One error source versus time (flat, spherical, simulated).")
 @parameter_options(api.PARAMETERS)
 @units_option
 @json_option
@@ -57,7 +57,7 @@ def run(units, as_json, out_dir, **options):
     emit(result, as_json, inputs=inputs, files=files)
 
 
-@group.command()
+@group.command(short_help="Bollay's Problem 3 table and hover error, printed vs computed.")
 @units_option
 @json_option
 def reproduce(units, as_json):
@@ -71,7 +71,7 @@ def reproduce(units, as_json):
     emit(result, as_json)
 
 
-@group.command()
+@group.command(short_help="Problem 3's figures (PNG and SVG).")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False), required=True,
               help="Folder for the figures (created if missing).")
 @click.option("--points", type=click.IntRange(min=3, max=100_001), default=1013, show_default=True,
@@ -88,7 +88,7 @@ def plot(out_dir, points, units, as_json):
         click.echo(f"wrote {len(files)} files to {out_dir}")
 
 
-@group.command()
+@group.command(short_help="Vertical channel: divergence vs baro-aided loop.")
 @parameter_options(api.VERTICAL_PARAMETERS)
 @units_option
 @json_option
@@ -101,7 +101,7 @@ def vertical(units, as_json, **options):
     emit(result, as_json, inputs=inputs)
 
 
-@group.command()
+@group.command(short_help="Effective Schuler period under thrust or fast flight.")
 @parameter_options(api.PERIOD_PARAMETERS)
 @json_option
 def period(as_json, **options):

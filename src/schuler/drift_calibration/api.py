@@ -236,11 +236,11 @@ def report(outdir: Path) -> ReportSection:
     values = parse_parameters(PARAMETERS, {"monte_carlo": 1000})
     result = run(**values)
     files = write_figures(result, outdir)
-    positions, az_positions, _ = error_versus_positions(trials=300)
-    cycle_times, az_tau, _ = error_versus_tau(trials=300)
+    positions, az_positions, _ = error_versus_positions(trials=200)
+    cycle_times, az_tau, _ = error_versus_tau(trials=200)
     files += save_figure_formats(plot_trade_offs(positions, az_positions, cycle_times, az_tau),
                                  outdir / "calibrate_trade_offs")
-    repro = reproduce(trials=1000)
+    repro = reproduce(trials=500)
     scaled = repro.scaled_budget["three-axis"]
     rows = [
         ReproductionRow("mean relative drift error (three-axis)", SOURCE_RELATIVE_DRIFT_ERROR_PERCENT,

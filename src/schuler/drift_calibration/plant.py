@@ -68,8 +68,8 @@ def initial_attitude(azimuth: float, pitch: float = 0.0, roll: float = 0.0) -> n
 
     ``pitch`` turns about the platform Y axis, ``roll`` about X (small tilts, rad).
 
-    >>> np.round(initial_attitude(np.pi / 2) @ [0.0, 1.0, 0.0], 12)   # Y axis east
-    array([ 1., -0.,  0.])
+    >>> np.round(initial_attitude(np.pi / 2) @ [0.0, 1.0, 0.0], 12) + 0.0   # Y axis east
+    array([1., 0., 0.])
     """
     return _rotation_z(-azimuth) @ _rotation_y(pitch) @ _rotation_x(roll)
 

@@ -87,7 +87,7 @@ def rate_from_reading(reading, k1: float, tau: float):
     tau : float
         Pulse duration, s.
 
-    >>> rate_from_reading(-57.3 * 25 * 1e-5, 57.3, 5.0)
+    >>> float(rate_from_reading(-57.3 * 25 * 1e-5, 57.3, 5.0))
     1e-05
     """
     return -np.asarray(reading) / (k1 * tau**2)
@@ -98,8 +98,8 @@ def separate_drift(reading_1, reading_2, k1: float, tau: float):
 
     omega_d = -(Delta U1 + Delta U2) / (2 K1 tau^2),  omega_X0 = -(Delta U1 - Delta U2) / (2 K1 tau^2).
 
-    >>> separate_drift(-25.0 * 3.0, -25.0 * (-1.0), 1.0, 5.0)
-    (1.0, 2.0)
+    >>> [float(w) for w in separate_drift(-25.0 * 3.0, -25.0 * (-1.0), 1.0, 5.0)]
+    [1.0, 2.0]
     """
     total = np.asarray(reading_1) + np.asarray(reading_2)
     difference = np.asarray(reading_1) - np.asarray(reading_2)

@@ -26,10 +26,15 @@ from schuler.params import Parameter
 from schuler.registry import FigureRef, ReportSection, ReproductionRow, System
 from schuler.results import Result
 
-SOURCE = "Fedorov, Kikot, Shtefan: meridian by a two-degree ground gyrocompass during natural rotor run-down (source 004)"
+SOURCE = (
+    "Fedorov, Kikot, Shtefan: meridian by a two-degree ground gyrocompass during natural rotor run-down"
+    " (source 004)"
+)
 
 MOTION_PARAMETERS = (
-    Parameter("alpha0", "rad", motion.SOURCE_ALPHA0, "True initial angle of the rotor axis from north.", -0.5, 0.5),
+    Parameter("alpha0", "rad", motion.SOURCE_ALPHA0,
+              "True initial angle alpha0 of the rotor axis from north (source: 3.69 pi/540; small angles).",
+              -0.5, 0.5),
     Parameter("alpha0_dot", "rad/s", motion.SOURCE_ALPHA0_DOT, "True initial azimuth rate.", -0.01, 0.01),
     Parameter("torque", "N*m", 0.0, "Constant harmful torque about the suspension axis (simulated)."),
 )
@@ -278,17 +283,17 @@ def report(outdir) -> ReportSection:
         abs(result.alpha0_error_rad) < 1e-9, f"{result.estimate.nfev} model evaluations, no grid",
     ))
     table = result.table1
+    relative, absolute = table["experiment_shape"]["relative"], table["experiment_shape"]["absolute"]
     notes = [
         "Table 1: the plain sum of squares of alpha - alpha0 finds the printed minimum cell (4 pi/540, 4e-4) with "
-        f"F = {table['computed_sum_of_squares'][13, 10]:.4g} (printed 0.9751e-3), but grows quadratically away from it "
-        f"(at k = m = 0: {table['computed_sum_of_squares'][9, 6]:.3g}, printed 12.4e-3). No reading of the misfit "
+        f"F = {table['computed_sum_of_squares'][13, 10]:.4g} (printed 0.9751e-3), but grows quadratically away from "
+        f"it (at k = m = 0: {table['computed_sum_of_squares'][9, 6]:.3g}, printed 12.4e-3). No reading of the misfit "
         "(sum of squares, its root, mean, rms, sum of |r|, max |r|; relative or absolute coordinate) matches the table "
         "within 5 % after one scale factor. Away from the minimum the squared table fits a quadratic form in "
         f"(alpha0, alpha0_dot) to {100 * table['quadratic_fit_max_deviation']:.1f} %, i.e. it is the norm of some "
         f"residual linear in the initial conditions, but of shape {table['table_shape'][0]:.2f}, "
         f"{table['table_shape'][1]:.0f} s^2 (cross / alpha0^2, alpha0_dot^2 / alpha0^2) where this experiment gives "
-        f"{table['experiment_shape']['relative'][0]:.2f}, {table['experiment_shape']['relative'][1]:.0f} s^2 (relative) "
-        f"or {table['experiment_shape']['absolute'][0]:.2f}, {table['experiment_shape']['absolute'][1]:.0f} s^2 "
+        f"{relative[0]:.2f}, {relative[1]:.0f} s^2 (relative) or {absolute[0]:.2f}, {absolute[1]:.0f} s^2 "
         "(absolute). Cells (k, m) = (-5, -1) and (1, -6) are misprints.",
         "4 unknowns, first stage: the printed best cell is not the grid's minimum; "
         f"F there is {result.four_unknowns_first_stage['printed_best_misfit']:.4g} while cell "

@@ -28,6 +28,7 @@ from schuler.ground_gyrocompass.identification import (
     check_record,
     covariance,
     design,
+    full_jacobian,
     parameter_order,
 )
 from schuler.ground_gyrocompass.motion import basis, simulate
@@ -272,6 +273,7 @@ def identify_grid(time, observed, unknowns, decay_rate, coefficient, reading="re
         values.update(dict(zip(names[2:], extra)))
         fixed = fixed + phi[:, 2:] @ extra
     residual = observed - fixed
-    cov = covariance(time, values, unknowns, reading, residual)
+    cov = covariance(full_jacobian(time, values, unknowns, reading), residual, unknowns)
     message = f"{stages}-stage grid refinement, {cells} cells"
-    return Fit(values, parameter_order(unknowns, reading), cov, float(residual @ residual), residual, cells, True, message)
+    order = parameter_order(unknowns, reading)
+    return Fit(values, order, cov, float(residual @ residual), residual, cells, True, message)

@@ -37,8 +37,6 @@ from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
-from scipy.linalg import solve_triangular
 from scipy.optimize import least_squares
 
 from schuler.exceptions import IdentificationError, InvalidParameter
@@ -112,6 +110,12 @@ def design(time, decay_rate, coefficient, unknowns: int, reading: str, derivativ
     return phi, d_lam, d_b, names
 
 
+def _cumulative_trapezoid(values, time):
+    """Running trapezoid integral from time[0] of each column of ``values`` (n, k)."""
+    steps = 0.5 * (values[1:] + values[:-1]) * np.diff(time)[:, None]
+    return np.vstack([np.zeros((1, values.shape[1])), np.cumsum(steps, axis=0)])
+
+
 def initial_estimate(time, observed):
     """Start values of (lambda, B) from a linear regression, no grid (1/s, 1/s^2).
 
@@ -139,21 +143,19 @@ def initial_estimate(time, observed):
     if span <= 0.0 or time.size < 12:
         return None
     tau = time / span  # scaled time keeps the polynomial columns well conditioned
-    columns = [np.ones_like(tau), tau]
-    for k in range(4):
-        inner = cumulative_trapezoid(tau**k * observed, time, initial=0.0)
-        columns.append(cumulative_trapezoid(inner, time, initial=0.0))
-    columns += [tau**j for j in range(2, 6)]
-    matrix = np.column_stack(columns)
+    powers = tau[:, None] ** np.arange(6)
+    twice = _cumulative_trapezoid(_cumulative_trapezoid(powers[:, :4] * observed[:, None], time), time)
+    matrix = np.hstack([powers[:, :2], twice, powers[:, 2:]])
     norms = np.linalg.norm(matrix, axis=0)
     if np.any(norms == 0.0):
         return None
     solution = np.linalg.lstsq(matrix / norms, observed, rcond=None)[0] / norms
-    q = -np.polyval(solution[2:6][::-1], tau)
+    q = -(powers[:, :4] @ solution[2:6])
     usable = q > 0.0
     if usable.sum() < 3:
         return None
-    slope, intercept = np.polyfit(time[usable], np.log(q[usable]), 1)
+    line = np.column_stack([np.ones(usable.sum()), time[usable]])
+    intercept, slope = np.linalg.lstsq(line, np.log(q[usable]), rcond=None)[0]
     decay_rate, coefficient = -slope, math.exp(intercept)
     if not (0.0 < decay_rate < 10.0 / span and math.isfinite(coefficient) and coefficient > 0.0):
         return None
@@ -193,17 +195,16 @@ class Fit:
 
 def _linear_solve(phi, observed):
     q, r = np.linalg.qr(phi)
-    coefficients = solve_triangular(r, q.T @ observed)
+    coefficients = np.linalg.solve(r, q.T @ observed)  # r is at most 4x4: a plain solve is cheapest
     return q, r, coefficients
 
 
-def covariance(time, values, unknowns, reading, observed_residuals):
-    """cov = s^2 (J^T J)^-1 of the identified parameters at ``values`` (column-scaled SVD).
+def covariance(jacobian, observed_residuals, unknowns):
+    """cov = s^2 (J^T J)^-1 from the full Jacobian J (n, p) and the residuals (column-scaled SVD).
 
     Raises IdentificationError when J is (numerically) rank deficient: the unknowns
     are not identifiable from this record.
     """
-    jacobian = full_jacobian(time, values, unknowns, reading)
     n, p = jacobian.shape
     scale = np.linalg.norm(jacobian, axis=0)
     if np.any(scale == 0.0):
@@ -226,8 +227,12 @@ def covariance(time, values, unknowns, reading, observed_residuals):
 def full_jacobian(time, values, unknowns, reading):
     """d model / d (identified parameters), shape (n, p), columns in ``names`` order."""
     phi, d_lam, d_b, linear = design(time, values["decay_rate"], values["coefficient"], unknowns, reading)
-    coefficients = np.array([values[name] for name in linear])
-    columns = [phi[:, k] for k in range(len(linear))]
+    return jacobian_from_design(phi, d_lam, d_b, np.array([values[name] for name in linear]), unknowns)
+
+
+def jacobian_from_design(phi, d_lam, d_b, coefficients, unknowns):
+    """Full Jacobian: the linear columns, then d model / d lambda and d model / d B if identified."""
+    columns = [phi[:, k] for k in range(phi.shape[1])]
     nonlinear = [name for name in UNKNOWN_SETS[unknowns] if name in ("decay_rate", "coefficient")]
     for name in nonlinear:
         columns.append((d_lam if name == "decay_rate" else d_b) @ coefficients)
@@ -275,10 +280,11 @@ class _Projected:
             derivative = d_lam if name == "decay_rate" else d_b
             a = derivative @ coefficients
             a_perp = a - q @ (q.T @ a)
-            b = q @ solve_triangular(r, derivative.T @ residual, trans="T")
+            b = q @ np.linalg.solve(r.T, derivative.T @ residual)
             jacobian.append(-(a_perp + b) * values[name])  # chain rule for the ln parameter
         self._cache_key = key
         self._cache = (residual, np.column_stack(jacobian) if jacobian else None, coefficients, names, values)
+        self.design = (phi, d_lam, d_b)
         return self._cache
 
     def residual(self, x):
@@ -286,6 +292,10 @@ class _Projected:
 
     def jacobian(self, x):
         return self._evaluate(x)[1]
+
+
+def _close(first, second, tolerance):
+    return all(abs(a / b - 1.0) <= tolerance for a, b in zip(first, second))
 
 
 def fit_least_squares(time, observed, unknowns, decay_rate, coefficient, reading="relative", start=None) -> Fit:
@@ -304,7 +314,8 @@ def fit_least_squares(time, observed, unknowns, decay_rate, coefficient, reading
         unknown ones.
     reading : {"relative", "absolute"}
     start : (float, float), optional
-        (lambda, B) start; by default :func:`initial_estimate` and the nominal values.
+        (lambda, B) start; by default :func:`initial_estimate` and the nominal values
+        (both are descended from, and the better fit kept, unless they agree within 5 %).
 
     Examples
     --------
@@ -321,7 +332,13 @@ def fit_least_squares(time, observed, unknowns, decay_rate, coefficient, reading
     problem = _Projected(time, observed, unknowns, reading, decay_rate, coefficient)
     best = None
     if problem.free:
-        starts = [start] if start is not None else [initial_estimate(time, observed), (decay_rate, coefficient)]
+        if start is not None:
+            starts = [start]
+        else:
+            estimate = initial_estimate(time, observed)
+            starts = [estimate, (decay_rate, coefficient)]
+            if estimate is not None and _close(estimate, (decay_rate, coefficient), 0.05):
+                starts = [estimate]  # both starts in one basin: a second descent adds nothing
         for guess in starts:
             if guess is None:
                 continue
@@ -343,7 +360,7 @@ def fit_least_squares(time, observed, unknowns, decay_rate, coefficient, reading
     values = {"specific_torque": 0.0, "offset": 0.0, **values}
     values.update({name: float(value) for name, value in zip(names, coefficients)})
     order = parameter_order(unknowns, reading)
-    cov = covariance(time, values, unknowns, reading, residual)
+    cov = covariance(jacobian_from_design(*problem.design, coefficients, unknowns), residual, unknowns)
     return Fit(values, order, cov, float(residual @ residual), residual, problem.evaluations, converged, message)
 
 

@@ -56,7 +56,8 @@ def plot_misfit_map(stage, stem, formats=("png", "svg")):
     levels = np.log10(np.maximum(stage.surface, 1e-30))
     mesh = ax.pcolormesh(rate, alpha0, levels, shading="nearest", cmap="viridis")
     fig.colorbar(mesh, ax=ax, label="log10 misfit F, rad^2")
-    ax.plot(stage.best["alpha0_dot"] * 1e4, stage.best["alpha0"] * ARCMIN_PER_RAD, "r+", ms=14, mew=2, label="best cell")
+    best_rate, best_angle = stage.best["alpha0_dot"] * 1e4, stage.best["alpha0"] * ARCMIN_PER_RAD
+    ax.plot(best_rate, best_angle, "r+", ms=14, mew=2, label="best cell")
     ax.set_xlabel("initial rate alpha0_dot, 1e-4 rad/s")
     ax.set_ylabel("initial angle alpha0, arcmin")
     ax.set_title(f"First grid stage ({stage.cells} cells), at the best lambda and B")

@@ -110,7 +110,8 @@ def stage_comparison(time, observed, unknowns: int) -> list[dict]:
     rows = []
     for number, (stage, (printed_best, printed_f)) in enumerate(zip(stages, PRINTED_STAGES[unknowns]), start=1):
         computed = _in_source_units(stage.best, unknowns)
-        steps = [stage.box[name][2] for name in ("alpha0", "alpha0_dot", "decay_rate", "coefficient") if name in stage.box]
+        names = [name for name in ("alpha0", "alpha0_dot", "decay_rate", "coefficient") if name in stage.box]
+        steps = [stage.box[name][2] for name in names]
         scale = [STEP_ALPHA0, 1e-4, 1e-3, motion.SOURCE_OMEGA_H / motion.SOURCE_INERTIA][: len(steps)]
         same_cell = all(
             abs(p - c) * s < 0.5 * step for p, c, s, step in zip(printed_best, computed, scale, steps)

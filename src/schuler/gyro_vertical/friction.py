@@ -33,12 +33,22 @@ only when its tilts also balance the input; its velocity errors then lie inside
 the dead zone |Delta v_x| <= R q_1, |Delta v_y| <= R q_2 (32, with the factor R
 the source drops). Where inside depends on the history.
 
+The rest is not stable, though: in slip, each bearing's friction drives the other
+axis's Schuler loop in step with the motion, which feeds one circular sense of
+the coning motion of the spin axis and starves the other. The velocity-error
+amplitude then grows on average by (q_1 + q_2) sqrt(g R) / pi per second, i.e.
+by 2 R (q_1 + q_2) per Schuler period (:func:`friction_growth_rate`). The source's
+model has no damping to stop it.
+
 Examples
 --------
+A tilt of 1e-6 rad: the gimbals stick while the x integrator runs up to the edge
+-R q_1 = -0.01 m/s, where the gyro breaks away:
+
 >>> sim = simulate_friction(q=(1.5625e-9, 1.5625e-9), initial_tilt=(0.0, 1e-6),
 ...                         time=np.linspace(0, 3600, 7))
->>> bool(np.all(np.abs(sim.velocity_error_x) < 1e-2))
-True
+>>> sim.stick_intervals[0].round(1).tolist(), round(float(sim.stick_velocity_errors[0, 2]), 9)
+([0.0, 1019.4], -0.01)
 """
 
 from __future__ import annotations
@@ -59,6 +69,10 @@ _SIGNS = {
     (0, 1): (1, -1), (0, -1): (-1, 1),
 }
 _MAX_EVENTS = 100_000
+# Each cell's exits lie this far (as a velocity error, m/s) beyond its edges, so that a
+# state resting exactly on an edge (e.g. q = 0 on a quiet axis) cannot trigger an exit
+# that is no crossing; it shifts the dead zone's edges by a negligible 1e-12 m/s.
+EVENT_HYSTERESIS = 1e-12
 
 
 def friction_from_velocity_error(velocity_error, radius):
@@ -79,6 +93,31 @@ def friction_from_velocity_error(velocity_error, radius):
     1.5625e-09
     """
     return np.asarray(velocity_error) / radius if np.ndim(velocity_error) else velocity_error / radius
+
+
+def friction_growth_rate(q, gravity, radius):
+    """Mean growth rate of the velocity-error amplitude under coupled Coulomb friction, m/s^2.
+
+    In the pumped circular mode beta = rho cos(w t), alpha = -rho sin(w t) the
+    friction terms feed the Schuler loops at the mean rate w^2 rho (2/pi) (q_1 + q_2),
+    so the tilt amplitude grows as rho' = (q_1 + q_2)/pi and the velocity amplitude
+    rho sqrt(g R) as (q_1 + q_2) sqrt(g R)/pi. Stick phases are neglected (they
+    are short once the amplitude exceeds R q).
+
+    Parameters
+    ----------
+    q : pair of float or ndarray
+        (q_1, q_2), 1/s.
+    gravity, radius : float or ndarray
+        g (m/s^2), R (m).
+
+    Examples
+    --------
+    >>> rate = friction_growth_rate((1.5625e-9, 1.5625e-9), 9.81, 6.4e6)
+    >>> round(float(rate * 2 * np.pi * np.sqrt(6.4e6 / 9.81)), 4)   # per Schuler period: 4 R q
+    0.04
+    """
+    return (np.asarray(q[0]) + np.asarray(q[1])) * np.sqrt(np.asarray(gravity) * radius) / np.pi
 
 
 @dataclass(frozen=True)
@@ -257,8 +296,10 @@ def _exit_events(cell, q_1, q_2, R):
         # (line crossed, direction of crossing, step to the next cell) for each way out
         exits = {0: ((limit, 1.0, 1), (-limit, -1.0, -1)), 1: ((limit, -1.0, -1),), -1: ((-limit, 1.0, 1),)}[side]
         for line, direction, step in exits:
-            def event(t, x, axis=axis, line=line):
-                return (x[2] if axis == 0 else -x[3]) / R - line
+            shifted = line + direction * EVENT_HYSTERESIS / R
+
+            def event(t, x, axis=axis, shifted=shifted):
+                return (x[2] if axis == 0 else -x[3]) / R - shifted
 
             event.terminal = True
             event.direction = direction

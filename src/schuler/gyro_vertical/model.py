@@ -467,7 +467,14 @@ class GyroVertical:
     gyro_drift : tuple of float
         (eps_x, eps_y): drift rates of the housing about x and y, rad/s.
     initial_tilt : tuple of float
-        (alpha_0, beta_0), rad.
+        (alpha_0, beta_0), rad: the tilt at t = 0, measured from the levelled
+        position when ``levelled_start`` is set, else from the geocentric vertical.
+    levelled_start : bool
+        Start from the position where both accelerometers read zero,
+        beta = (W*_x + b_x)/g, alpha = -(W*_y + b_y)/g (after the compensation), as a
+        vertical erected on its accelerometers would. Otherwise the start is the
+        geocentric vertical, about 1.5e-3 rad off at mid latitudes: a Schuler
+        oscillation of about 11 m/s then hides the systematic error.
     preset_integrators : bool
         Start the integrators at the true initial velocity (what (24) assumes);
         otherwise at zero.
@@ -489,6 +496,7 @@ class GyroVertical:
     accelerometer_bias: tuple[float, float] = (0.0, 0.0)
     gyro_drift: tuple[float, float] = (0.0, 0.0)
     initial_tilt: tuple[float, float] = (0.0, 0.0)
+    levelled_start: bool = True
     preset_integrators: bool = True
 
     def __post_init__(self):
@@ -525,7 +533,11 @@ class GyroVertical:
         """(alpha, beta, V_x, V_y) at t = 0 (integrator outputs, m/s)."""
         k = self.trajectory.kinematics(0.0)
         preset = 1.0 if self.preset_integrators else 0.0
-        return np.array([self.initial_tilt[0], self.initial_tilt[1], preset * float(k.v_x), preset * float(k.v_y)])
+        alpha, beta = self.initial_tilt
+        if self.levelled_start:
+            f_x, f_y, _, _ = self.forcing(k)
+            alpha, beta = alpha - float(f_y) / self.gravity, beta + float(f_x) / self.gravity
+        return np.array([alpha, beta, preset * float(k.v_x), preset * float(k.v_y)])
 
     def derivative(self, t: float, state: np.ndarray, kinematics: Kinematics) -> np.ndarray:
         """Right-hand side of the full equations for the state (alpha, beta, V_x, V_y).
@@ -546,7 +558,7 @@ class GyroVertical:
             W_star_y + k.a_y + g * alpha + self.accelerometer_bias[1] - (1.0 - keep) * W_star_y,
         ])
 
-    def simulate(self, time, method: str = "auto") -> VerticalResponse:
+    def simulate(self, time, method: str = "auto", initial_state=None) -> VerticalResponse:
         """Simulate the vertical on the time grid ``time`` (s, starting at 0).
 
         Parameters
@@ -559,6 +571,9 @@ class GyroVertical:
             constant speed); "ode": solve_ivp (DOP853) on the full equations, piece
             by piece between the speed profile's knots; "auto" picks "exact" when
             it applies.
+        initial_state : array_like, optional
+            (alpha, beta, V_x, V_y) at t = 0 (rad, rad, m/s, m/s) instead of
+            :meth:`initial_state`.
 
         Raises
         ------
@@ -570,27 +585,29 @@ class GyroVertical:
         t = np.asarray(time, dtype=float)
         if t.ndim != 1 or t.size < 2 or not np.all(np.isfinite(t)) or t[0] != 0.0 or np.any(np.diff(t) <= 0):
             raise InvalidParameter("duration", "the time grid must start at 0 and increase")
+        start = self.initial_state() if initial_state is None else np.asarray(initial_state, dtype=float)
+        if start.shape != (4,) or not np.all(np.isfinite(start)):
+            raise InvalidParameter("initial_state", "needs four finite values (alpha, beta, V_x, V_y)")
         stationary = self.trajectory.is_stationary
         if method == "auto":
             method = "exact" if stationary else "ode"
         if method == "exact":
             if not stationary:
                 raise InvalidParameter("method", "'exact' needs a time-invariant (stationary or frozen) trajectory")
-            return self._simulate_exact(t)
+            return self._simulate_exact(t, start)
         if method != "ode":
             raise InvalidParameter("method", f"{method!r} is not one of auto, exact, ode")
-        return self._simulate_ode(t)
+        return self._simulate_ode(t, start)
 
     def _true_velocity(self, t):
         k = self.trajectory.kinematics(t)
         return k, np.broadcast_to(k.v_x, t.shape), np.broadcast_to(k.v_y, t.shape)
 
-    def _simulate_exact(self, t: np.ndarray) -> VerticalResponse:
+    def _simulate_exact(self, t: np.ndarray, start: np.ndarray) -> VerticalResponse:
         k0 = self.trajectory.kinematics(0.0)
         system = error_state_space(float(k0.omega_2), self.gravity, self.radius, self.schuler_tuning)
         u = np.array([float(x) for x in self.forcing(k0)])
-        x0 = self.initial_state()
-        x0[2:] -= [float(k0.v_x), float(k0.v_y)]
+        x0 = start - [0.0, 0.0, float(k0.v_x), float(k0.v_y)]
         # a time series (not a constant vector) selects the engine's step-by-step propagation
         # (one matrix exponential per distinct step) instead of one exponential per output time
         response = simulate(system, t, initial_state=x0, inputs=np.broadcast_to(u, (t.size, u.size)))
@@ -624,11 +641,10 @@ class GyroVertical:
 
         return kinematics
 
-    def _simulate_ode(self, t: np.ndarray) -> VerticalResponse:
+    def _simulate_ode(self, t: np.ndarray, state: np.ndarray) -> VerticalResponse:
         path = self.trajectory
         knots = np.zeros(1) if path.frozen else path.speed.times
         edges = np.concatenate([knots[knots < t[-1]], [t[-1]]])
-        state = self.initial_state()
         out = np.empty((t.size, 4))
         out[0] = state
         nfev = n_steps = 0

@@ -25,7 +25,7 @@ and refined by :func:`fit_modes` (non-linear least squares on the frequencies).
 Examples
 --------
 >>> w_fast, w_slow = split_schuler_frequencies(9.81, 6.4e6, 7.3e-5 * np.sin(np.radians(60)))
->>> round(2 * np.pi / w_fast / 60, 2), round(2 * np.pi / w_slow / 60, 2)
+>>> round(float(2 * np.pi / w_fast / 60), 2), round(float(2 * np.pi / w_slow / 60), 2)
 (82.45, 86.77)
 """
 
@@ -154,7 +154,7 @@ def tilt_oscillation(beta_0, time, gravity, radius, omega_2=0.0):
     --------
     >>> t = np.array([0.0, 5075.0 / 4])
     >>> _, beta, dv_x, _ = tilt_oscillation(1e-4, t, 9.81, 6.4e6)
-    >>> round(float(dv_x[1]), 4), round(-1e-4 * np.sqrt(9.81 * 6.4e6), 4)
+    >>> round(float(dv_x[1]), 4), round(float(-1e-4 * np.sqrt(9.81 * 6.4e6)), 4)
     (-0.7924, -0.7924)
     """
     t = np.asarray(time, dtype=float)
@@ -358,3 +358,64 @@ def fit_modes(time, dv_x, dv_y, guesses, max_samples: int = 20000) -> ModeFit:
     coef = np.linalg.lstsq(basis(w), u, rcond=None)[0]
     rms = float(np.sqrt(np.mean(solution.fun**2) * 2))
     return ModeFit(w, np.abs(coef[1:]), complex(coef[0]), rms)
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """A simulation with its forced motion, the oscillation about it, and the modes found.
+
+    Attributes
+    ----------
+    response : VerticalResponse
+    quasi_steady : QuasiSteady
+    spectrum : Spectrum or None
+        Of the oscillation (simulation minus forced motion); None for short records.
+    fit : ModeFit or None
+        The two split Schuler modes fitted to the oscillation; None when there is no
+        oscillation to speak of or the record is shorter than two Schuler periods.
+    eigen_periods : ndarray
+        Periods (s) of the error model's modes at the mean omega_2, fastest first.
+    """
+
+    response: object
+    quasi_steady: QuasiSteady
+    spectrum: Spectrum | None
+    fit: ModeFit | None
+    eigen_periods: np.ndarray
+
+    @property
+    def oscillation(self):
+        """(Delta v_x, Delta v_y) minus the quasi-steady error (29), m/s."""
+        r, q = self.response, self.quasi_steady
+        return r.velocity_error_x - q.dv_x, r.velocity_error_y - q.dv_y
+
+
+def analyse(vertical: GyroVertical, time, method: str = "auto") -> Analysis:
+    """Simulate ``vertical`` on ``time`` (s) and identify the oscillation modes of its velocity error.
+
+    The spectrum's strongest line on each side of zero frequency seeds
+    :func:`fit_modes` (with records under six Schuler periods the model's
+    eigenfrequencies seed it instead, the FFT being too coarse).
+    """
+    from schuler.gyro_vertical.model import error_state_space
+
+    response = vertical.simulate(time, method=method)
+    t = response.time
+    q = quasi_steady_response(vertical, t)
+    omega_2 = float(np.mean(np.broadcast_to(vertical.trajectory.kinematics(t).omega_2, t.shape)))
+    system = error_state_space(omega_2, vertical.gravity, vertical.radius, vertical.schuler_tuning)
+    eigen = mode_frequencies(system)
+    periods = 2 * np.pi / eigen
+    ox, oy = response.velocity_error_x - q.dv_x, response.velocity_error_y - q.dv_y
+    uniform = np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0)
+    spectrum = velocity_error_spectrum(t, ox, oy) if uniform and t[-1] >= 2 * periods[-1] else None
+    fit = None
+    moving = np.sqrt(np.mean(ox**2 + oy**2)) > 1e-9
+    if moving and t[-1] >= 2 * periods[-1]:
+        # sign of each mode on the complex axis: the fast one turns with omega_2
+        signs = (1.0, -1.0) if omega_2 >= 0 else (-1.0, 1.0)
+        guesses = [s * w for s, w in zip(signs, eigen)]
+        if spectrum is not None and t[-1] >= 6 * periods[-1]:
+            guesses = [2 * np.pi * spectrum.peak(s) for s in signs]
+        fit = fit_modes(t, ox, oy, guesses)
+    return Analysis(response, q, spectrum, fit, periods)

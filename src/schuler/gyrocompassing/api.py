@@ -269,16 +269,17 @@ def sweep(values: dict, *, simulate_runs: bool = False) -> dict[str, np.ndarray]
         arrays[name] = float(array) if name == "max_latitude" and array.ndim == 0 else np.broadcast_to(array, (n,))
     if np.ndim(arrays.get("max_latitude", 0.0)) > 0:
         arrays["max_latitude"] = float(np.max(arrays["max_latitude"]))
-    names = np.broadcast_to(np.asarray(values.get("model", defaults["model"]), dtype=object), (n,))
-    case = study.AlignmentCase(**arrays)
+    model_values = values.get("model", defaults["model"])
     duration = values.get("duration", defaults["duration"])
     time_step = values.get("time_step", defaults["time_step"])
     duration = None if duration is None or np.all(np.isnan(duration)) else float(np.max(duration))
     time_step = float(np.min(time_step))
-    models_used = [str(m) for m in dict.fromkeys(names)]
-    if len(models_used) == 1:
-        return study.evaluate_cases(case, models_used[0], simulate_runs=simulate_runs, duration=duration,
+    case = study.AlignmentCase(**arrays)
+    if np.ndim(model_values) == 0:
+        return study.evaluate_cases(case, str(model_values), simulate_runs=simulate_runs, duration=duration,
                                     time_step=time_step)
+    names = np.broadcast_to(np.asarray(model_values, dtype=str), (n,))
+    models_used = [str(m) for m in np.unique(names)]
     output: dict[str, np.ndarray] = {}
     for model in models_used:
         chosen = names == model

@@ -370,8 +370,9 @@ def write_problem3_figures(outdir: Path, unit: str = "ft", points: int = 1013) -
 def write_vertical_figure(outdir: Path, unit: str = "ft") -> list[Path]:
     """Hover divergence (Problem 4) against the second- and third-order baro-aided loops, PNG and SVG."""
     bias = -1e-4 * BOLLAY.effective_gravity
-    second = vertical(bias, BOLLAY.schuler_period, order=2, earth="bollay")
-    third = vertical(bias, BOLLAY.schuler_period, order=3, earth="bollay")
+    step = BOLLAY.schuler_period / 150
+    second = vertical(bias, BOLLAY.schuler_period, step, order=2, earth="bollay")
+    third = vertical(bias, BOLLAY.schuler_period, step, order=3, earth="bollay")
     fig = plots.plot_vertical(second.t_s, second.unaided_m,
                               {"baro-aided, 2nd order (tau = 100 s)": second.aided_m,
                                "baro-aided, 3rd order (tau = 100 s)": third.aided_m},
@@ -381,7 +382,7 @@ def write_vertical_figure(outdir: Path, unit: str = "ft") -> list[Path]:
 
 def write_foucault_figure(outdir: Path, unit: str = "ft") -> list[Path]:
     """The 3-D model's Schuler swing turning at the Foucault rate (1 ft/s north, 45 deg, 24 h)."""
-    t = np.linspace(0.0, 86_400.0, 4001)
+    t = np.linspace(0.0, 86_400.0, 1441)
     north, east = foucault_velocity_response(t, FOOT, math.radians(45.0), PRESETS["default"].radius,
                                              PRESETS["default"].gravity, PRESETS["default"].rate)
     fig = plots.plot_foucault(t, north, east, unit, "3-D model: 1 ft/s north velocity error at 45 deg N, 24 h")

@@ -112,16 +112,17 @@ def plot_vertical(time, unaided, aided: dict, unit: str, title: str):
         Display unit.
     title : str
     """
+    large = {"ft": "mi", "m": "km"}.get(unit, unit)  # the divergence reaches hundreds of miles
     fig, (left, right) = _figure(1, 2, figsize=(11, 4.2))
-    left.plot(time, to_unit(unaided, unit), color="C3", lw=1.8, label="pure inertial")
+    left.plot(time, to_unit(unaided, large), color="C3", lw=1.8, label="pure inertial")
     for index, (label, values) in enumerate(aided.items()):
-        left.plot(time, to_unit(values, unit), color=f"C{index}", lw=1.4, label=label)
+        left.plot(time, to_unit(values, large), color=f"C{index}", lw=1.4, label=label)
         right.plot(time, to_unit(values, unit), color=f"C{index}", lw=1.4, label=label)
     left.set_title("pure inertial diverges")
     right.set_title("baro-aided loops, enlarged")
-    for axis in (left, right):
+    for axis, shown in ((left, large), (right, unit)):
         axis.set_xlabel("time [s]")
-        axis.set_ylabel(f"altitude error [{unit}]")
+        axis.set_ylabel(f"altitude error [{shown}]")
         axis.grid(True, alpha=0.3)
         axis.legend()
     fig.suptitle(title)
@@ -141,9 +142,11 @@ def plot_foucault(time, north, east, unit: str, title: str):
     unit : str
     title : str
     """
-    fig, axis = _figure(figsize=(6, 6))
-    points = axis.scatter(to_unit(east, unit), to_unit(north, unit), c=np.asarray(time) / 3600.0, s=2,
-                          cmap="viridis")
+    fig, axis = _figure(figsize=(6.4, 6))
+    hours = np.asarray(time) / 3600.0
+    east_shown, north_shown = to_unit(np.asarray(east), unit), to_unit(np.asarray(north), unit)
+    axis.plot(east_shown, north_shown, lw=0.5, color="0.6")
+    points = axis.scatter(east_shown, north_shown, c=hours, s=3, cmap="viridis")
     fig.colorbar(points, ax=axis, label="time [h]")
     axis.set_xlabel(f"east error [{unit}]")
     axis.set_ylabel(f"north error [{unit}]")

@@ -95,7 +95,7 @@ def x_minus_sin(x):
     """x - sin x, by its Taylor series where the subtraction would cancel (|x| < 0.25).
 
     >>> float(x_minus_sin(1e-3))
-    1.6666666583333335e-10
+    1.66666658333e-10
     """
     x = np.asarray(x, dtype=float)
     small = np.abs(x) < 0.25

@@ -164,7 +164,7 @@ def stationary_modes(latitude: float, radius: float, gravity: float, rate: float
 
     >>> modes = stationary_modes(0.0, 6.371e6, 9.80665, 7.292115e-5)
     >>> round(float(modes.imag.max()) * 1e3, 6)
-    1.240681
+    1.240671
     """
     omega_z = rate * np.sin(latitude)
     split = np.sqrt(gravity / radius + omega_z**2)

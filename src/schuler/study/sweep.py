@@ -41,6 +41,7 @@ import json
 import math
 import re
 import time
+import warnings
 import zlib
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -447,9 +448,22 @@ class ChunkTask:
     evaluate: Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]]
 
 
-def evaluate_chunk(task: ChunkTask):
-    """Evaluate one chunk: a DataFrame with ``case``, one column per parameter and per result.
+@dataclass(frozen=True)
+class ChunkResult:
+    """A finished chunk: its Parquet file's bytes and the warnings raised meanwhile."""
 
+    index: int
+    cases: int
+    parquet: bytes
+    warnings: list[tuple[type, str]]
+
+
+def evaluate_chunk(task: ChunkTask) -> ChunkResult:
+    """Evaluate one chunk: a table with ``case``, one column per parameter and per result.
+
+    The worker encodes the table as Parquet (compact to send, and the client
+    only writes the bytes); the warnings raised meanwhile come back as
+    (category, message) pairs so that the client reports each once.
     Errors a user can cause come back as a :class:`ScenarioError` naming the
     cases (it pickles across processes and Dask workers).
     """
@@ -457,8 +471,10 @@ def evaluate_chunk(task: ChunkTask):
 
     start, stop = task.plan.chunk_range(task.index)
     try:
-        values = task.plan.case_values(start, stop)
-        results = task.evaluate(dict(values))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            values = task.plan.case_values(start, stop)
+            results = task.evaluate(dict(values))
     except SchulerError as error:
         raise ScenarioError(f"cases {start}..{stop - 1}: {error}") from None
     columns: dict[str, np.ndarray] = {"case": np.arange(start, stop, dtype=np.int64)}
@@ -476,7 +492,8 @@ def evaluate_chunk(task: ChunkTask):
             )
         # a result named like a parameter column (e.g. the damping actually used) keeps both
         columns[f"{name}_result" if name in columns else name] = array
-    return pd.DataFrame(columns)
+    data = _parquet_bytes(pd.DataFrame(columns))
+    return ChunkResult(task.index, stop - start, data, [(w.category, str(w.message)) for w in caught])
 
 
 # -------------------------------------------------------------------- executors
@@ -605,10 +622,28 @@ def _require_parquet() -> None:
         raise ScenarioError("sweeps store Parquet files: install pyarrow (pip install schuler[dask])") from None
 
 
-def _write_chunk(frame, out_dir: Path, index: int) -> Path:
-    path = chunk_path(out_dir, index)
+def _text_columns(schema) -> list[str]:
+    """Columns worth dictionary encoding in Parquet: the text ones (choices)."""
+    import pyarrow as pa
+
+    return [f.name for f in schema if pa.types.is_string(f.type) or pa.types.is_large_string(f.type)]
+
+
+def _parquet_bytes(frame) -> bytes:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    sink = pa.BufferOutputStream()
+    # dictionary encoding of float columns costs five times the write time for no gain
+    pq.write_table(table, sink, use_dictionary=_text_columns(table.schema))
+    return sink.getvalue().to_pybytes()
+
+
+def _write_chunk(result: ChunkResult, out_dir: Path) -> Path:
+    path = chunk_path(out_dir, result.index)
     with atomic_path(path) as tmp:
-        frame.to_parquet(tmp, index=False)
+        tmp.write_bytes(result.parquet)
     return path
 
 
@@ -656,18 +691,19 @@ class SweepSummary(Result):
     def render(self):
         from rich.table import Table
 
+        missing = {name: stats["nan_count"] for name, stats in self.statistics.items() if stats["nan_count"]}
         table = Table(
-            title=f"{self.system} sweep: {self.cases} cases in {self.chunks} chunks "
-            f"({self.chunks_computed} computed, {self.chunks_resumed} resumed) on {self.executor}, "
-            f"{self.seconds:.3g} s",
+            title=f"{self.system} sweep: {self.cases} cases",
+            caption=f"{self.chunks} chunks ({self.chunks_computed} computed, {self.chunks_resumed} resumed) "
+            f"on {self.executor} in {self.seconds:.3g} s; results in {self.out_dir}"
+            + (f"; not finite: {missing}" if missing else ""),
         )
-        for heading in ("result", "count", "mean", "std", "min", "p50", "max"):
-            table.add_column(heading, justify="left" if heading == "result" else "right")
+        table.add_column("result", no_wrap=True)
+        for heading in ("mean", "std", "min", "max"):
+            table.add_column(heading, justify="right", no_wrap=True)
         for name, stats in self.statistics.items():
             table.add_row(
-                name,
-                str(stats["count"]),
-                *(f"{stats[k]:.6g}" if stats[k] is not None else "-" for k in ("mean", "std", "min", "p50", "max")),
+                name, *(f"{stats[k]:.4g}" if stats[k] is not None else "-" for k in ("mean", "std", "min", "max"))
             )
         return table
 
@@ -695,10 +731,12 @@ class _Accumulator:
             for name in names
         }
 
-    def update(self, frame) -> None:
-        index = dict(zip((a.name for a in self.plan.axes), self.plan.grid_index(frame["case"].to_numpy())))
+    def update(self, table) -> None:
+        """Add one chunk (an Arrow table)."""
+        cases = table.column("case").to_numpy()
+        index = dict(zip((a.name for a in self.plan.axes), self.plan.grid_index(cases)))
         for name in self.names:
-            values = frame[name].to_numpy(dtype=float)
+            values = table.column(name).to_numpy().astype(float)
             finite = np.isfinite(values)
             self.nan_count[name] += int((~finite).sum())
             kept = values[finite]
@@ -738,9 +776,16 @@ class _Accumulator:
         return out
 
 
-def _result_columns(frame, plan: SweepPlan) -> list[str]:
+def _result_columns(schema, plan: SweepPlan) -> list[str]:
+    """The numeric result columns of a chunk's Arrow schema (not the case number or parameters)."""
+    import pyarrow as pa
+
     parameter_columns = {"case", *(column_name(spec) for spec in plan.parameters)}
-    return [c for c in frame.columns if c not in parameter_columns and np.issubdtype(frame[c].dtype, np.number)]
+    return [
+        f.name
+        for f in schema
+        if f.name not in parameter_columns and (pa.types.is_integer(f.type) or pa.types.is_floating(f.type))
+    ]
 
 
 def gather(plan: SweepPlan, out_dir: Path, *, write_csv: bool = True) -> tuple[dict, dict, list[Path]]:
@@ -763,16 +808,17 @@ def gather(plan: SweepPlan, out_dir: Path, *, write_csv: bool = True) -> tuple[d
         for index in range(plan.chunks):
             table = pq.read_table(chunk_path(out_dir, index))
             if writer is None:
-                writer = stack.enter_context(pq.ParquetWriter(parquet_tmp, table.schema))
+                writer = stack.enter_context(
+                    pq.ParquetWriter(parquet_tmp, table.schema, use_dictionary=_text_columns(table.schema))
+                )
             else:
                 table = table.cast(writer.schema)
             writer.write_table(table)
-            frame = table.to_pandas()
             if accumulator is None:
-                accumulator = _Accumulator(plan, _result_columns(frame, plan))
-            accumulator.update(frame)
+                accumulator = _Accumulator(plan, _result_columns(table.schema, plan))
+            accumulator.update(table)
             if csv_file is not None:
-                frame.to_csv(csv_file, header=index == 0, index=False, lineterminator="\n")
+                table.to_pandas().to_csv(csv_file, header=index == 0, index=False, lineterminator="\n")
     return accumulator.statistics(), accumulator.per_axis(), targets
 
 
@@ -828,17 +874,19 @@ def run_sweep(
     evaluate = system.sweep if system.sweep is not None else RunLoop(system.run)
     tasks = (ChunkTask(plan, index, evaluate) for index in todo)
     began = time.perf_counter()
+    caught: dict = {}
     executor = make_executor(scheduler, workers) if todo else InProcess()
     try:
         with _progress_bar(plan, done, enabled=progress) as advance:
-            for frame in executor.map(evaluate_chunk, tasks):
-                index = int(frame["case"].iloc[0]) // plan.chunk_size
-                _write_chunk(frame, out_dir, index)
-                advance(len(frame))
+            for result in executor.map(evaluate_chunk, tasks):
+                _write_chunk(result, out_dir)
+                caught.update(dict.fromkeys(result.warnings))
+                advance(result.cases)
                 if on_chunk is not None:
-                    on_chunk(index)
+                    on_chunk(result.index)
     finally:
         executor.close()
+        _report_warnings(caught)
     seconds = time.perf_counter() - began
     statistics, per_axis, files = gather(plan, out_dir, write_csv=write_csv)
     files.append(write_json(out_dir / "summary.json", json_safe({"manifest": plan.manifest(), "statistics": statistics})))
@@ -858,6 +906,18 @@ def run_sweep(
         statistics=statistics,
         files=[str(f) for f in files],
     )
+
+
+_WARNINGS_SHOWN = 3
+
+
+def _report_warnings(caught: dict) -> None:
+    """Re-raise the distinct warnings of all chunks here, the first few of them."""
+    distinct = list(caught)
+    for category, message in distinct[:_WARNINGS_SHOWN]:
+        warnings.warn(message, category, stacklevel=3)
+    if len(distinct) > _WARNINGS_SHOWN:
+        warnings.warn(f"... and {len(distinct) - _WARNINGS_SHOWN} more warnings like these", UserWarning, stacklevel=3)
 
 
 class _progress_bar:

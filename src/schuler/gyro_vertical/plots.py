@@ -1,0 +1,100 @@
+"""Figures of the gyro vertical: tilts, velocity errors, spectrum, friction (matplotlib, Agg).
+
+Each function returns a Figure; saving goes through :mod:`schuler.io`. Time is
+shown in hours, tilts in arcmin, velocities in m/s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+ARCMIN = np.pi / 180 / 60
+HOUR = 3600.0
+
+
+def _figure(rows: int, height: float = 2.6):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(rows, 1, sharex=True, squeeze=False, figsize=(9, height * rows))
+    return fig, axes[:, 0]
+
+
+def plot_tilts(analysis, title: str = "Gyro vertical: tilts"):
+    """alpha and beta (arcmin) against time, with the forced motion (26)."""
+    r, q = analysis.response, analysis.quasi_steady
+    hours = r.time / HOUR
+    fig, axes = _figure(2)
+    for axis, name, simulated, forced in ((axes[0], "alpha", r.alpha, q.alpha_r), (axes[1], "beta", r.beta, q.beta_r)):
+        axis.plot(hours, simulated / ARCMIN, lw=0.8, label="simulation")
+        axis.plot(hours, forced / ARCMIN, "--", lw=1.2, label="forced motion (26)")
+        axis.set_ylabel(f"{name} [arcmin]")
+        axis.grid(True, alpha=0.3)
+        axis.legend(loc="upper right", fontsize=8)
+    axes[0].set_title(title)
+    axes[-1].set_xlabel("time [h]")
+    return fig
+
+
+def plot_velocity_errors(analysis, compensated=None, title: str = "Gyro vertical: velocity errors"):
+    """Delta v_x and Delta v_y (m/s) against time, with (29), its slowly-varying form and the compensated run."""
+    r, q = analysis.response, analysis.quasi_steady
+    hours = r.time / HOUR
+    fig, axes = _figure(2)
+    channels = (("Delta v_x", r.velocity_error_x, q.dv_x, q.slow_dv_x, "velocity_error_x"),
+                ("Delta v_y", r.velocity_error_y, q.dv_y, q.slow_dv_y, "velocity_error_y"))
+    for axis, (name, simulated, forced, slow, attribute) in zip(axes, channels):
+        axis.plot(hours, simulated, lw=0.8, label="simulation")
+        axis.plot(hours, forced, "--", lw=1.2, label="quasi-steady (29)")
+        axis.plot(hours, slow, ":", lw=1.2, label="slowly varying R omega_2 (alpha_r, beta_r)")
+        if compensated is not None:
+            axis.plot(hours, getattr(compensated.response, attribute), lw=0.8,
+                      label="transport + Coriolis compensated")
+        axis.set_ylabel(f"{name} [m/s]")
+        axis.grid(True, alpha=0.3)
+        axis.legend(loc="upper right", fontsize=8)
+    axes[0].set_title(title)
+    axes[-1].set_xlabel("time [h]")
+    return fig
+
+
+def plot_spectrum(analysis, title: str = "Spectrum of the velocity-error oscillation"):
+    """Amplitude of u = Delta v_x - i Delta v_y minus (29) against signed frequency (cycles/h)."""
+    fig, axes = _figure(1, height=3.6)
+    axis = axes[0]
+    spectrum = analysis.spectrum
+    cycles_per_hour = spectrum.frequency * HOUR
+    shown = np.abs(cycles_per_hour) < 2.0
+    axis.semilogy(cycles_per_hour[shown], np.maximum(spectrum.amplitude[shown], 1e-12), lw=0.8, label="simulation")
+    for sign, period in zip((1, -1), analysis.eigen_periods):
+        axis.axvline(sign * HOUR / period, color="C1", ls="--", lw=0.8)
+    axis.axvline(HOUR / 86400, color="C3", ls=":", lw=1.0, label="24 h (source's claim)")
+    axis.axvline(-HOUR / 86400, color="C3", ls=":", lw=1.0)
+    axis.plot([], [], color="C1", ls="--", label="eigenvalues (split Schuler modes)")
+    axis.set_xlabel("frequency [cycles/h] (sign: sense of rotation of the error vector)")
+    axis.set_ylabel("amplitude [m/s]")
+    axis.set_title(title)
+    axis.grid(True, alpha=0.3)
+    axis.legend(fontsize=8)
+    return fig
+
+
+def plot_friction(response, q, radius, title: str = "Coulomb friction: velocity errors and the dead zone +-R q"):
+    """Delta v_x, Delta v_y (m/s) with the dead zone and stick intervals, and the growth of the slip."""
+    hours = response.time / HOUR
+    fig, axes = _figure(2)
+    for axis, name, values, limit in ((axes[0], "Delta v_x", response.velocity_error_x, radius * q[0]),
+                                      (axes[1], "Delta v_y", response.velocity_error_y, radius * q[1])):
+        axis.plot(hours, values, lw=0.8, label="simulation")
+        axis.axhspan(-limit, limit, color="C2", alpha=0.25, label="dead zone +-R q")
+        for begin, end in response.stick_intervals:
+            axis.axvspan(begin / HOUR, end / HOUR, color="0.6", alpha=0.3, lw=0)
+        axis.set_ylabel(f"{name} [m/s]")
+        axis.grid(True, alpha=0.3)
+    axes[0].plot([], [], color="0.6", alpha=0.5, lw=6, label="both gimbals stuck")
+    axes[0].legend(loc="upper left", fontsize=8)
+    axes[0].set_title(title)
+    axes[-1].set_xlabel("time [h]")
+    return fig
