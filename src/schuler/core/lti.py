@@ -223,18 +223,54 @@ def _apply(M: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.matmul(M, v[..., None])[..., 0]
 
 
+def _uniform_step(t: np.ndarray) -> float | None:
+    """The grid's step if all steps agree to rounding (linspace grids), else None."""
+    dt = np.diff(t)
+    step = (t[-1] - t[0]) / dt.size
+    # a linspace grid's steps scatter by a few ulp of the largest time, not of the step
+    tolerance = 1e-12 * step + 8 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
+    return step if np.all(np.abs(dt - step) <= tolerance) else None
+
+
+def _transition_matrices(M: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """expm(M (t_k - t_0)) for every k, shape (n_time, q, q).
+
+    On a uniform grid the k-th matrix is Phi^k, Phi = expm(M dt), built by
+    doubling: the block of powers 2^j..2^(j+1)-1 is the block 0..2^j-1 times
+    expm(M 2^j dt). That takes log2(n_time) exponentials and batched products;
+    each power is a product of at most log2(n_time) exact exponentials, so
+    rounding stays at a few ulp times log2(n_time).
+    Otherwise one exponential per time point.
+    """
+    q = M.shape[-1]
+    step = _uniform_step(t) if t.size > 2 else None
+    if step is None:
+        return scipy.linalg.expm(M * (t - t[0])[:, None, None])
+    powers = np.empty((t.size, q, q))
+    powers[0] = np.eye(q)
+    filled = 1
+    while filled < t.size:
+        block = min(filled, t.size - filled)
+        # the factor Phi^filled is itself an exact exponential, not a repeated square
+        powers[filled : filled + block] = powers[:block] @ scipy.linalg.expm(M * (step * filled))
+        filled += block
+    return powers
+
+
 def _propagate_constant_input(system: StateSpace, t: np.ndarray, x0: np.ndarray, u0: np.ndarray, members):
     """States at every time for inputs constant in time, shape ([N,] n_time, n).
 
-    With z = [x; u] and u' = 0, z(t) = expm(M (t - t0)) z(t0): one matrix
-    exponential per time point (not per member), applied to all members in a
-    single matrix product. No error accumulates from step to step.
+    With z = [x; u] and u' = 0, z(t) = expm(M (t - t0)) z(t0), M = [[A, B], [0, 0]]:
+    the transition matrices are computed once per time point (not per member)
+    and applied to all members in a single matrix product.
     """
-    n = system.n_states
-    Ad, Bd = zoh_discretize(system.A, system.B, t - t[0])  # (n_time, n, n), (n_time, n, m)
-    transition = np.concatenate([Ad, Bd], axis=-1).reshape(t.size * n, -1)
+    n, m = system.n_states, system.n_inputs
+    M = np.zeros((n + m, n + m))
+    M[:n, :n] = system.A
+    M[:n, n:] = system.B
+    transition = _transition_matrices(M, t)[:, :n, :].reshape(t.size * n, n + m)
     lead = () if members is None else (members,)
-    z0 = np.concatenate([np.broadcast_to(x0, (*lead, n)), np.broadcast_to(u0, (*lead, system.n_inputs))], axis=-1)
+    z0 = np.concatenate([np.broadcast_to(x0, (*lead, n)), np.broadcast_to(u0, (*lead, m))], axis=-1)
     return (z0 @ transition.T).reshape(*lead, t.size, n)
 
 
@@ -248,7 +284,11 @@ def _propagate(system: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray,
     if t.size == 1:
         return out
     dt = np.diff(t)
-    unique_dt, step_kind = np.unique(dt, return_inverse=True)
+    step = _uniform_step(t)
+    if step is not None:  # steps equal to rounding share one discretisation
+        unique_dt, step_kind = np.array([step]), np.zeros(dt.size, dtype=int)
+    else:
+        unique_dt, step_kind = np.unique(dt, return_inverse=True)
     Ad_all, Bd_all = zoh_discretize(system.A, system.B, unique_dt)
     has_input = system.n_inputs > 0 and np.any(u)
     # inputs as (n_time, [N,] m) so that u_t[k] is the input on step k

@@ -34,11 +34,11 @@ the dead zone |Delta v_x| <= R q_1, |Delta v_y| <= R q_2 (32, with the factor R
 the source drops). Where inside depends on the history.
 
 The rest is not stable, though: in slip, each bearing's friction drives the other
-axis's Schuler loop in step with the motion, which feeds one circular sense of
-the coning motion of the spin axis and starves the other. The velocity-error
-amplitude then grows on average by (q_1 + q_2) sqrt(g R) / pi per second, i.e.
-by 2 R (q_1 + q_2) per Schuler period (:func:`friction_growth_rate`). The source's
-model has no damping to stop it.
+axis's Schuler loop with a square wave at that loop's own frequency. The coning
+of the spin axis locks into the sense in which both drives are in resonant phase,
+and the velocity-error amplitudes grow by 2 q_i sqrt(g R) / pi per second, 4 R q_i
+per Schuler period (:func:`friction_growth_rate`). The source's model has no
+damping to stop it.
 
 Examples
 --------
@@ -96,28 +96,37 @@ def friction_from_velocity_error(velocity_error, radius):
 
 
 def friction_growth_rate(q, gravity, radius):
-    """Mean growth rate of the velocity-error amplitude under coupled Coulomb friction, m/s^2.
+    """Growth rate of the velocity-error amplitudes under coupled Coulomb friction, m/s^2.
 
-    In the pumped circular mode beta = rho cos(w t), alpha = -rho sin(w t) the
-    friction terms feed the Schuler loops at the mean rate w^2 rho (2/pi) (q_1 + q_2),
-    so the tilt amplitude grows as rho' = (q_1 + q_2)/pi and the velocity amplitude
-    rho sqrt(g R) as (q_1 + q_2) sqrt(g R)/pi. Stick phases are neglected (they
-    are short once the amplitude exceeds R q).
+    In slip the x bearing's friction drives the beta loop (Delta v_x) with the
+    square wave -q_1 sign(alpha'), and the y bearing's the alpha loop (Delta v_y)
+    with q_2 sign(beta'). Both loops run at the Schuler frequency, so the motion
+    locks into the sense in which each square wave is in resonant phase: the
+    fundamental 4 q_i / pi of a square wave raises a tilt amplitude by
+    (4 q_i / pi) / 2 per second, and the velocity amplitudes grow by
+    2 q_i sqrt(g R) / pi per second, i.e. by 4 R q_i per Schuler period. Stick
+    phases are neglected (they are short once the amplitude exceeds R q).
 
     Parameters
     ----------
     q : pair of float or ndarray
-        (q_1, q_2), 1/s.
+        (q_1, q_2), 1/s (both > 0 for the lock-in).
     gravity, radius : float or ndarray
         g (m/s^2), R (m).
 
+    Returns
+    -------
+    rate_x, rate_y : float or ndarray
+        Growth of the amplitudes of Delta v_x and Delta v_y, m/s per s.
+
     Examples
     --------
-    >>> rate = friction_growth_rate((1.5625e-9, 1.5625e-9), 9.81, 6.4e6)
-    >>> round(float(rate * 2 * np.pi * np.sqrt(6.4e6 / 9.81)), 4)   # per Schuler period: 4 R q
+    >>> rate_x, _ = friction_growth_rate((1.5625e-9, 1.5625e-9), 9.81, 6.4e6)
+    >>> round(float(rate_x * 2 * np.pi * np.sqrt(6.4e6 / 9.81)), 4)   # per Schuler period: 4 R q_1
     0.04
     """
-    return (np.asarray(q[0]) + np.asarray(q[1])) * np.sqrt(np.asarray(gravity) * radius) / np.pi
+    scale = 2.0 * np.sqrt(np.asarray(gravity) * radius) / np.pi
+    return scale * np.asarray(q[0]), scale * np.asarray(q[1])
 
 
 @dataclass(frozen=True)

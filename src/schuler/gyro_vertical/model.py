@@ -411,6 +411,59 @@ def error_state_space(omega_2, gravity: float, radius: float, schuler_tuning: fl
     return StateSpace(A, B, states=STATE_NAMES, inputs=("f_x", "f_y", "e_x", "e_y"), state_units=STATE_UNITS)
 
 
+def forcing(kinematics: Kinematics, radius, schuler_tuning=1.0, earth_rate_compensation=True,
+            transport_coriolis_compensation=False, accelerometer_bias=(0.0, 0.0), gyro_drift=(0.0, 0.0)):
+    """Inputs (f_x, f_y, e_x, e_y) of :func:`error_state_space` along a trajectory (vectorised).
+
+    f = (1 - C) W* + b, m/s^2 (C = 1 when W* (21) is compensated);
+    e = eps - (1 - E) omega_1 (cos theta, sin theta) + (kappa - 1)(-v_y, v_x)/R, rad/s
+    (E = 1 when the torques (8) are applied): the drift, the Earth rate (8) leaves,
+    and the transport rate a mistuned gain leaves.
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+    radius : float or ndarray
+        R, m.
+    schuler_tuning : float or ndarray
+        kappa.
+    earth_rate_compensation, transport_coriolis_compensation : bool or ndarray of bool
+    accelerometer_bias : pair of float or ndarray
+        (b_x, b_y), m/s^2.
+    gyro_drift : pair of float or ndarray
+        (eps_x, eps_y), rad/s.
+    """
+    k = kinematics
+    W_x, W_y = transport_coriolis_acceleration(k, radius)
+    keep = np.where(transport_coriolis_compensation, 0.0, 1.0)
+    leak = np.where(earth_rate_compensation, 0.0, 1.0)
+    mistuning = (np.asarray(schuler_tuning) - 1.0) / radius
+    f_x = keep * W_x + accelerometer_bias[0]
+    f_y = keep * W_y + accelerometer_bias[1]
+    e_x = gyro_drift[0] - leak * k.omega_1x - mistuning * k.v_y
+    e_y = gyro_drift[1] - leak * k.omega_1y + mistuning * k.v_x
+    return np.broadcast_arrays(f_x, f_y, e_x, e_y)
+
+
+def start_kinematics(latitude, azimuth, velocity_angle, speed, rate) -> Kinematics:
+    """Kinematics at the start of many paths at once (arrays of equal length, SI).
+
+    Parameters
+    ----------
+    latitude, azimuth, velocity_angle : ndarray
+        phi_0, theta_0, gamma, rad.
+    speed : ndarray
+        m/s.
+    rate : ndarray or float
+        Omega, rad/s.
+    """
+    latitude, azimuth, velocity_angle, speed = np.broadcast_arrays(latitude, azimuth, velocity_angle, speed)
+    omega_1 = rate * np.cos(latitude)
+    zero = np.zeros_like(speed)
+    return Kinematics(latitude, omega_1 * np.cos(azimuth), omega_1 * np.sin(azimuth), rate * np.sin(latitude),
+                      speed * np.cos(velocity_angle), speed * np.sin(velocity_angle), zero, zero)
+
+
 @dataclass(frozen=True)
 class VerticalResponse:
     """Time histories of a gyro-vertical simulation (SI).
@@ -514,20 +567,9 @@ class GyroVertical:
         return self.trajectory.radius
 
     def forcing(self, kinematics: Kinematics):
-        """Error-model inputs (f_x, f_y, e_x, e_y) along a trajectory (see :func:`error_state_space`).
-
-        f = W* (1 - C) + b (m/s^2); e = eps plus what (8) leaves uncompensated
-        and the transport rate not cancelled by a mistuned gain (rad/s).
-        """
-        k, R, kappa = kinematics, self.radius, self.schuler_tuning
-        W_x, W_y = transport_coriolis_acceleration(k, R)
-        keep = 0.0 if self.transport_coriolis_compensation else 1.0
-        leak = 0.0 if self.earth_rate_compensation else 1.0
-        f_x = keep * W_x + self.accelerometer_bias[0]
-        f_y = keep * W_y + self.accelerometer_bias[1]
-        e_x = self.gyro_drift[0] - leak * k.omega_1x - (kappa - 1.0) * k.v_y / R
-        e_y = self.gyro_drift[1] - leak * k.omega_1y + (kappa - 1.0) * k.v_x / R
-        return np.broadcast_arrays(f_x, f_y, e_x, e_y)
+        """Error-model inputs (f_x, f_y, e_x, e_y) along a trajectory (see :func:`forcing`)."""
+        return forcing(kinematics, self.radius, self.schuler_tuning, self.earth_rate_compensation,
+                       self.transport_coriolis_compensation, self.accelerometer_bias, self.gyro_drift)
 
     def initial_state(self) -> np.ndarray:
         """(alpha, beta, V_x, V_y) at t = 0 (integrator outputs, m/s)."""

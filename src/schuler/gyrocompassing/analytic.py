@@ -193,7 +193,10 @@ def full_steady_state(latitude, c_gamma, c_a, drift_east=0.0, drift_north=0.0, d
 
     with dU_z = U cos(phi) dphi, dU_eta = -U sin(phi) dphi. Unlike (1.21), the
     azimuth error now feels the accelerometers through alpha U_z: about
-    eps_alpha tan(phi) (e.g. 100 micro-g gives 24.6 arcsec at 50 deg).
+    eps_alpha tan(phi) (e.g. 100 micro-g gives 24.6 arcsec at 50 deg); and the
+    latitude error tilts alpha by dU_eta / c_gamma, adding U_z^2 dphi / (c_gamma U_eta)
+    to (1.21)'s -(c_gamma / c_a) dphi (at 50 deg, T = 30 s, zeta = 0.8: +0.075 vs
+    -0.135 arcsec per arcmin).
 
     Parameters
     ----------

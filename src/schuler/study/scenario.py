@@ -12,7 +12,7 @@ as the command-line options (underscores instead of dashes)::
     drift_east = "0.01 deg/h"
 
     [simulation]        # optional: the run's duration and step parameter (step may
-    duration = "6 h"    # stand for time_step); each may be set here or in
+    duration = "6 h"    # stand for time_step or output_step); each may be set here or in
     step = "1 s"        # [parameters], not both
 
     [outputs]           # optional
@@ -56,7 +56,10 @@ from schuler.params import Parameter
 from schuler.registry import SYSTEM_MODULES, System, get_system
 from schuler.study.systems import load_system
 
-SIMULATION_KEYS: dict[str, tuple[str, ...]] = {"duration": ("duration",), "step": ("step", "time_step")}
+SIMULATION_KEYS: dict[str, tuple[str, ...]] = {
+    "duration": ("duration",),
+    "step": ("step", "time_step", "output_step"),
+}
 """Keys of the ``[simulation]`` table and the run parameter each may stand for."""
 
 

@@ -148,7 +148,7 @@ class SweepPlan:
             elif spec.name in self.distributions:
                 values[spec.name] = self._draw(spec, cases)
             else:
-                values[spec.name] = _constant(self.base[spec.name], n)
+                values[spec.name] = _constant(spec, self.base[spec.name], n)
         return values
 
     def _draw(self, spec: Parameter, cases: np.ndarray) -> np.ndarray:
@@ -188,10 +188,14 @@ def _plain(value):
     return value.item() if isinstance(value, np.generic) else value
 
 
-def _constant(value, n: int) -> np.ndarray:
-    """``n`` copies of a scalar, as a float, int, bool or string array (None -> NaN)."""
+def _constant(spec: Parameter, value, n: int) -> np.ndarray:
+    """``n`` copies of a parameter's value.
+
+    A value left unset (None) is NaN for a number and None (in an object
+    array) for a text or choice, so that ``System.sweep`` applies its default.
+    """
     if value is None:
-        return np.full(n, np.nan)
+        return np.full(n, np.nan) if spec.kind in ("quantity", "integer") else np.full(n, None, dtype=object)
     return np.full(n, value)
 
 
@@ -436,6 +440,7 @@ def column_name(spec: Parameter) -> str:
     if spec.kind != "quantity" or not spec.unit:
         return spec.name
     unit = spec.unit.replace("**", "").replace("^", "").replace("/", "_per_").replace("*", "_").replace(" ", "")
+    unit = unit.replace(".", "p")
     return f"{spec.name}_{unit}"
 
 
@@ -794,6 +799,7 @@ def gather(plan: SweepPlan, out_dir: Path, *, write_csv: bool = True) -> tuple[d
     One chunk is in memory at a time. Returns the statistics per result, the
     per-axis means and extremes, and the files written.
     """
+    import pyarrow.csv as pa_csv
     import pyarrow.parquet as pq
 
     out_dir = Path(out_dir)
@@ -801,9 +807,8 @@ def gather(plan: SweepPlan, out_dir: Path, *, write_csv: bool = True) -> tuple[d
     accumulator = None
     with contextlib.ExitStack() as stack:
         parquet_tmp = stack.enter_context(atomic_path(targets[0]))
-        csv_file = None
-        if write_csv:
-            csv_file = stack.enter_context(open(stack.enter_context(atomic_path(targets[1])), "w", encoding="utf-8"))
+        csv_tmp = stack.enter_context(atomic_path(targets[1])) if write_csv else None
+        csv_writer = None
         writer = None
         for index in range(plan.chunks):
             table = pq.read_table(chunk_path(out_dir, index))
@@ -817,8 +822,11 @@ def gather(plan: SweepPlan, out_dir: Path, *, write_csv: bool = True) -> tuple[d
             if accumulator is None:
                 accumulator = _Accumulator(plan, _result_columns(table.schema, plan))
             accumulator.update(table)
-            if csv_file is not None:
-                table.to_pandas().to_csv(csv_file, header=index == 0, index=False, lineterminator="\n")
+            if csv_tmp is not None:
+                if csv_writer is None:
+                    options = pa_csv.WriteOptions(quoting_style="needed")
+                    csv_writer = stack.enter_context(pa_csv.CSVWriter(str(csv_tmp), writer.schema, write_options=options))
+                csv_writer.write_table(table)
     return accumulator.statistics(), accumulator.per_axis(), targets
 
 

@@ -1,0 +1,67 @@
+"""Every example scenario runs, through ``schuler run`` and through a small sweep."""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from schuler.registry import SYSTEM_MODULES
+from schuler.study.scenario import load_scenario
+from schuler.study.systems import load_system
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+FILES = sorted(EXAMPLES.glob("*.toml"))
+
+
+def system_of(path: Path) -> str:
+    return tomllib.loads(path.read_text())["system"]
+
+
+def require_system(path: Path):
+    name = system_of(path)
+    system = load_system(name)
+    if system is None:
+        pytest.skip(f"system {name!r} is not installed yet")
+    return system
+
+
+def test_there_is_an_example_per_system():
+    names = {system_of(path) for path in FILES}
+    assert names <= set(SYSTEM_MODULES)
+    for path in FILES:
+        assert system_of(path) in path.name  # file names contain the system name
+    missing = [name for name in SYSTEM_MODULES if load_system(name) is not None and name not in names]
+    assert missing == []
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", FILES, ids=[p.stem for p in FILES])
+def test_example_runs_like_the_system_command(path, run_cli, tmp_path):
+    require_system(path)
+    out = run_cli("run", path, "--json", "--out", tmp_path / "out")
+    assert out.code == 0, out.stderr
+    data = out.json()
+    scenario = load_scenario(path)
+    expected = json.loads(json.dumps(scenario.run().to_dict()))
+    scalars = {k: v for k, v in expected.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
+    assert scalars, "the result has no scalar to compare"
+    assert {k: data[k] for k in scalars} == pytest.approx(scalars, rel=1e-9)
+    assert any((tmp_path / "out").iterdir())  # --out reaches the system's command
+
+
+@pytest.mark.parametrize("path", FILES, ids=[p.stem for p in FILES])
+def test_example_sweeps_with_its_monte_carlo_table(path, tmp_path):
+    from schuler.study.sweep import run_sweep
+
+    system = require_system(path)
+    scenario = load_scenario(path)
+    assert scenario.monte_carlo is not None and scenario.monte_carlo.distributions
+    summary = run_sweep(scenario, tmp_path, (), monte_carlo=3, progress=False, plots=False)
+    frame = pd.read_parquet(tmp_path / "results.parquet")
+    assert summary.cases == len(frame) == 3
+    assert len(frame.columns) > len(system.parameters) + 1  # parameters, case number and results
+    assert summary.statistics and all(s["count"] + s["nan_count"] == 3 for s in summary.statistics.values())
