@@ -22,8 +22,10 @@ demo: $(VENV)/.installed
 	$(BIN)/schuler report --out $(OUT)
 	@echo "Open $(OUT)/index.html in a browser."
 
+# one BLAS thread per test process: the models' matrices are small, and two
+# processes already use both cores
 test: $(VENV)/.installed-test
-	$(BIN)/python -m pytest -n 2 -q
+	OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2 -q
 
 bench: $(VENV)/.installed-test
 	for b in benchmarks/bench_*.py; do $(BIN)/python $$b || exit 1; done

@@ -95,7 +95,7 @@ def main() -> int:
 
         began = time.perf_counter()
         with LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=50
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=50
         ) as cluster:
             startup = time.perf_counter() - began
             print(f"{'LocalCluster start-up':>28}: {startup:6.2f} s")

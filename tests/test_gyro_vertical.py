@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -241,6 +242,16 @@ def test_compensation_removes_the_systematic_error(reproduction):
     assert np.mean(plain.velocity_error_y) > 0.4
 
 
+@pytest.mark.parametrize("azimuth, gamma", [(50.0, 30.0), (-120.0, 200.0)])
+def test_one_azimuth_in_torques_and_accelerations_leaves_no_error(azimuth, gamma):
+    """theta in (8) and (21) alike: for gamma != 0 nothing of the horizontal Earth rate is left over."""
+    path = GreatCircleTrajectory(0.9, math.radians(azimuth), math.radians(gamma), SpeedProfile.constant(50.0),
+                                 R, OMEGA)
+    r = GyroVertical(path, G, transport_coriolis_compensation=True).simulate(HOURS_48)
+    assert np.max(np.abs(r.velocity_error_x)) < 1e-7 and np.max(np.abs(r.velocity_error_y)) < 1e-7
+    assert np.max(np.abs(r.alpha)) < 1e-12
+
+
 # --- initial-tilt oscillation error (22)/(23) -----------------------------------------------
 
 def test_tilt_oscillation_at_the_equator_is_the_source_formula():
@@ -317,7 +328,10 @@ def test_cli_run_summary_json_and_figures(run_cli, tmp_path):
     assert data["fitted_period_fast_min"] == pytest.approx(data["eigen_period_fast_min"], rel=1e-3)
     assert data["inputs"]["latitude"] == pytest.approx(LAT60)
     names = {p.name for p in tmp_path.iterdir()}
-    assert {"vertical_tilts.png", "vertical_velocity_errors.svg", "vertical_spectrum.png"} <= names
+    assert {"vertical_tilts.png", "vertical_velocity_errors.svg", "vertical_spectrum.png",
+            "vertical_timeseries.csv"} <= names
+    table = pd.read_csv(tmp_path / "vertical_timeseries.csv")
+    assert len(table) == 12 * 120 + 1 and table["true_velocity_y"].iloc[0] == pytest.approx(10.0)
     text = run_cli("vertical", "run", "--duration", "3 h", "--speed-profile", "0: 0, 1: 20")
     assert text.code == 0 and "split Schuler periods" in text.stdout
 
@@ -338,3 +352,23 @@ def test_cli_bad_input_is_one_line_exit_2(run_cli, args, option):
     assert out.code == 2
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("schuler: error:") and option in lines[0]
+
+
+# --- registry: report and parameters ------------------------------------------------------------
+
+def test_report_section_writes_its_figures(tmp_path):
+    section = api.SYSTEM.report(tmp_path)
+    assert section.system == "vertical" and section.rows and section.commands
+    for figure in section.figures:
+        assert (tmp_path / figure.path).exists() and figure.path.startswith("vertical")
+    flagged = [row for row in section.rows if "ERRATUM" in row.note]
+    assert len(flagged) == 3 and not any(row.agrees for row in flagged)
+
+
+def test_system_parameters_are_the_run_keywords():
+    values = {p.name: (p.parse(p.default) if p.default is not None else None) for p in api.SYSTEM.parameters}
+    values.update(duration=3 * 3600.0, output_step=60.0, trajectory="frozen")
+    result = api.SYSTEM.run(**values)
+    assert result.method == "exact" and result.duration_h == pytest.approx(3.0)
+    with pytest.raises(InvalidParameter, match="output_step"):
+        api.run(duration=60.0, output_step=120.0)

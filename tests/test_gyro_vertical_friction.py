@@ -68,7 +68,8 @@ def test_static_errors_stay_in_the_dead_zone(alpha_0, beta_0, dv_x, dv_y, q_1, q
         assert abs(errors[0]) <= R * q[0] + 1e-9 and abs(errors[2]) <= R * q[0] + 1e-9
         assert abs(errors[1]) <= R * q[1] + 1e-9 and abs(errors[3]) <= R * q[1] + 1e-9
         inside = (time > begin) & (time < end)
-        assert np.ptp(r.alpha[inside], initial=0.0) < 1e-13 and np.ptp(r.beta[inside], initial=0.0) < 1e-13
+        if inside.any():
+            assert np.ptp(r.alpha[inside]) < 1e-13 and np.ptp(r.beta[inside]) < 1e-13
     # no chattering: a handful of switches per Schuler period
     assert len(r.switch_times) <= 12 * time[-1] / SCHULER_PERIOD + 4
 

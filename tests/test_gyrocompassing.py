@@ -373,3 +373,23 @@ def test_report_writes_its_figures(tmp_path):
     assert section.system == "align" and len(section.rows) >= 8
     for figure in section.figures:
         assert (tmp_path / figure.path).stat().st_size > 10_000
+
+
+def test_system_sweep_accepts_every_parameter_as_an_array():
+    # as a generic sweep passes them: every run parameter, unset numbers as NaN, choices as strings
+    from schuler.gyrocompassing.api import PARAMETERS
+    from schuler.params import parse_parameters
+
+    n = 4
+    defaults = parse_parameters(PARAMETERS, {})
+    values = {p.name: np.full(n, np.nan) if defaults[p.name] is None else np.full(n, defaults[p.name])
+              for p in PARAMETERS}
+    values["latitude"] = np.radians([0.0, 20.0, 40.0, 60.0])
+    values["drift_east"] = np.full(n, 0.01 * DEG_PER_H)
+    out = sweep(values)
+    expected = 0.01 * DEG_PER_H / (EARTH_RATE * np.cos(values["latitude"]))
+    np.testing.assert_allclose(out["azimuth_error_rad"], expected, rtol=1e-12)
+    np.testing.assert_allclose(out["settling_time_s"], 187.5, rtol=1e-12)
+    values["latitude"][-1] = math.radians(87.0)
+    with pytest.raises(NotObservable):
+        sweep(values)

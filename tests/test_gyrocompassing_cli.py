@@ -84,6 +84,10 @@ def test_sweep_grid_includes_stop_on_grid(run_cli):
     assert columns["azimuth_error_analytic_arcmin"][5] == pytest.approx(3.556, abs=5e-4)
     off_grid = run_cli("align", "sweep", "damping=0.5:1:0.3", "--analytic", "--json").json()["columns"]
     assert off_grid["damping"] == pytest.approx([0.5, 0.8])
+    drifts = run_cli("align", "sweep", "drift_east=0:0.05:0.01", "--analytic", "--json").json()["columns"]
+    assert drifts["drift_east_deg_per_h"] == pytest.approx([0, 0.01, 0.02, 0.03, 0.04, 0.05])
+    in_degrees = run_cli("align", "sweep", "latitude_error=0:1:0.5 deg", "--analytic", "--json").json()["columns"]
+    assert in_degrees["latitude_error_arcmin"] == pytest.approx([0, 30, 60])
 
 
 def test_sweep_simulated_two_axes_with_files(run_cli, tmp_path):
@@ -128,3 +132,16 @@ def test_reproduce(run_cli):
     assert rows["c_Gamma for T = 30 s, zeta = 0.8"]["agrees"] is False
     human = run_cli("align", "reproduce")
     assert "c_a for T = 30 s" in human.stdout
+
+
+def test_sweep_compares_models_case_by_case(run_cli):
+    # lab tasks 2 and 3: the same cases on (1.17) in (mu, nu) and on (1.19)
+    out = run_cli("align", "sweep", "model=full,simplified", "latitude=20,60", "--accel-error-x", "1e-4", "--json")
+    assert out.code == 0, out.stderr
+    columns = out.json()["columns"]
+    assert columns["model"] == ["full", "full", "simplified", "simplified"]
+    simulated, analytic = columns["azimuth_error_arcmin"], columns["azimuth_error_analytic_arcmin"]
+    assert simulated[2:] == pytest.approx([0.0, 0.0], abs=1e-12)  # (1.19): no accelerometer effect
+    # (1.17): about eps_alpha tan(latitude) = -1e-4 tan(latitude) rad
+    assert simulated[0] == pytest.approx(-0.3438 * 0.36397, rel=3e-3)
+    assert analytic == pytest.approx([0.0] * 4, abs=1e-12)

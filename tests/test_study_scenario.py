@@ -160,3 +160,23 @@ def test_every_parameter_value_is_checked_by_its_parameter(tmp_path):
     assert scenario.values["latitude"] == pytest.approx(-math.radians(89))
     assert scenario.values["drift_east"] == 0.0
     assert np.isfinite(scenario.run().azimuth_error_rad)
+
+
+@pytest.mark.parametrize("name", ["errors", "vertical", "calibrate", "align", "north"])
+def test_every_real_system_gets_a_schema_from_its_parameters(name, tmp_path, run_cli):
+    from schuler.study.systems import load_system
+
+    system = load_system(name)
+    if system is None:
+        pytest.skip(f"system {name!r} is not installed yet")
+    path = write(tmp_path, f'system = "{name}"\n[parameters]\nno_such_option = 1\n')
+    out = run_cli("run", path)
+    assert out.code == 2
+    assert f"[parameters] no_such_option: unknown key; allowed: {', '.join(p.name for p in system.parameters)}" in out.stderr
+    latitude = next((p for p in system.parameters if p.name == "latitude"), None)
+    if latitude is not None:
+        out = run_cli("run", write(tmp_path, f'system = "{name}"\n[parameters]\nlatitude = "95 deg"\n'))
+        assert out.code == 2
+        assert f"[parameters] latitude: '95 deg' is outside {latitude.range_text()}" in out.stderr
+        out = run_cli("run", write(tmp_path, f'system = "{name}"\n[parameters]\nlatitude = "95 m"\n'))
+        assert out.code == 2 and "[parameters] latitude: '95 m' is not an angle" in out.stderr

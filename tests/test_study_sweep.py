@@ -18,6 +18,7 @@ from schuler.study.sweep import (
     RunLoop,
     chunk_path,
     grid_values,
+    histograms,
     parse_axis,
     plan_sweep,
     run_sweep,
@@ -142,6 +143,11 @@ def test_sweep_results_are_the_closed_form_per_case(scenario, tmp_path):
     assert stats["p50"] == pytest.approx(frame["azimuth_error_rad"].median(), rel=1e-12)
     for name in ("sweep.json", "summary.json", "summary_azimuth_error_rad.png", "summary_settling_time_s.png"):
         assert (tmp_path / name).stat().st_size > 0
+    # the streamed histogram is exact
+    counts, edges = histograms(plan_sweep(scenario, fake.FAKE, GRID, 5, 16), tmp_path, summary.statistics)[
+        "azimuth_error_rad"
+    ]
+    assert counts.tolist() == np.histogram(frame["azimuth_error_rad"], bins=edges)[0].tolist()
 
 
 def test_draws_do_not_depend_on_chunking(scenario, tmp_path):
@@ -222,7 +228,7 @@ def test_a_killed_dask_worker_loses_no_finished_chunk(scenario, tmp_path, monkey
     finished = []
     args = dict(params=GRID, monte_carlo=5, chunk_size=10, progress=False, plots=False)
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=50
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=50
     ) as cluster:
         summary = run_sweep(scenario, tmp_path / "dask", scheduler=cluster.scheduler_address, on_chunk=finished.append, **args)
     assert marker.exists() and int(marker.read_text()) != os.getpid()  # a worker process died

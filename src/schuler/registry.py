@@ -14,7 +14,7 @@ from typing import Callable
 import numpy as np
 
 from schuler.exceptions import InvalidParameter
-from schuler.params import Parameter
+from schuler.params import Parameter, parse_parameters
 
 SYSTEM_MODULES: dict[str, str] = {
     "errors": "schuler.navigation_errors.api",
@@ -94,6 +94,22 @@ class System:
     reproduce: Callable
     report: Callable[[Path], ReportSection]
     sweep: Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]] | None = None
+
+    def run_case(self, **si_values):
+        """``run`` with every parameter not given set to its default (SI values in, Result out).
+
+        Raises
+        ------
+        InvalidParameter
+            For a name that is not one of the system's parameters.
+        """
+        names = {p.name for p in self.parameters}
+        unknown = sorted(set(si_values) - names)
+        if unknown:
+            raise InvalidParameter(unknown[0], f"unknown parameter of {self.name}; allowed: {', '.join(sorted(names))}")
+        values = parse_parameters(self.parameters, {})
+        values.update(si_values)
+        return self.run(**values)
 
 
 def get_system(name: str) -> System:

@@ -46,10 +46,12 @@ def _run_files(result: api.AlignmentResult, out_dir) -> list:
     import pandas as pd
 
     run = result.run
-    label = f"{result.model} model"
+    runs = {f"{result.model} model": run}
+    if result.model != "simplified":
+        runs["simplified model (1.19)"] = result.simplified_run
     figures = {
-        "align_time_history": plots.time_history({label: run}),
-        "align_phase_trajectory": plots.phase_trajectory({label: run}),
+        "align_time_history": plots.time_history(runs),
+        "align_phase_trajectory": plots.phase_trajectory(runs),
     }
     if result.monte_carlo is not None:
         mc = result.monte_carlo
@@ -101,6 +103,8 @@ class SweepResult(Result):
 
 
 def _cell(value) -> str:
+    if isinstance(value, str):
+        return value
     if isinstance(value, (bool, np.bool_)):
         return "ok" if value else "VIOLATED"
     value = float(value)
@@ -108,17 +112,24 @@ def _cell(value) -> str:
 
 
 def _parse_axis(spec: str) -> tuple[str, np.ndarray]:
-    """``name=start:stop:step`` (stop included when on the grid) or ``name=v1,v2,...``, in display units."""
+    """``name=start:stop:step`` (stop included when on the grid) or ``name=v1,v2,...``.
+
+    Numbers are in the parameter's display unit unless a unit follows them
+    (``drift_east=1:5:1 mdeg/h``). Returns the name and the SI values.
+    """
     name, sep, text = spec.partition("=")
     name = name.strip().replace("-", "_")
     if not sep or not text:
         raise InvalidParameter("sweep", f"{spec!r}: expected PARAM=start:stop:step or PARAM=v1,v2,...")
+    if name == "model":
+        return name, np.array([_BY_NAME[name].parse(choice, "model") for choice in text.split(",")])
     if name not in _SWEEPABLE:
-        raise InvalidParameter(name, f"cannot be swept; choose from {', '.join(_SWEEPABLE)}")
+        raise InvalidParameter(name, f"cannot be swept; choose from {', '.join(_SWEEPABLE + ['model'])}")
     parameter = _BY_NAME[name]
+    numbers, _, unit = text.strip().partition(" ")  # an optional unit after the numbers: "0:0.05:0.01 deg/h"
     try:
-        parts = [float(p) for p in text.split(":")] if ":" in text else None
-        listed = None if parts else [float(p) for p in text.split(",")]
+        parts = [float(p) for p in numbers.split(":")] if ":" in numbers else None
+        listed = None if parts else [float(p) for p in numbers.split(",")]
     except ValueError:
         raise InvalidParameter(name, f"{text!r}: numbers in {parameter.unit or 'plain units'} expected")
     if parts is not None:
@@ -131,8 +142,14 @@ def _parse_axis(spec: str) -> tuple[str, np.ndarray]:
         if count > 100_000:
             raise InvalidParameter(name, f"{text!r}: {count} values; at most 100000 per axis")
         listed = (start + step * np.arange(count)).tolist()
-    label = parameter.option
-    return name, np.array([parameter.parse(value, label) for value in listed])
+    unit = unit.strip()
+    return name, np.array([parameter.parse(f"{value!r} {unit}" if unit else value, parameter.option) for value in listed])
+
+
+def _shown(name: str, value) -> str:
+    """A swept value in its display unit, for labels."""
+    unit = _BY_NAME[name].unit
+    return _cell(to_unit(value, unit) if unit and name != "model" else value)
 
 
 @group.command("sweep")
@@ -146,9 +163,11 @@ def sweep_command(axes, analytic_only, out_dir, as_json, **options):
     """Vary parameters over a grid (lab task 1): accuracy, time and constraints per case.
 
     Each PARAM=start:stop:step (or PARAM=v1,v2,...) is in the option's display
-    unit, e.g. latitude=0:80:10 (deg), drift_east=0:0.05:0.01 (deg/h); stop is
+    unit, e.g. latitude=0:80:10 (deg), drift_east=0:0.05:0.01 (deg/h), or in
+    the unit written after them ("latitude_error=0:2:0.5 deg"); stop is
     included when it falls on the grid. Several PARAMs make a grid; the other
-    options fix the remaining parameters.
+    options fix the remaining parameters. model=full,simplified compares the
+    models case by case (lab tasks 2 and 3).
     """
     parameters = [p for p in api.PARAMETERS if p.name in options]
     fixed = parse_options(parameters, options)
@@ -160,9 +179,11 @@ def sweep_command(axes, analytic_only, out_dir, as_json, **options):
     values = {k: v for k, v in fixed.items() if v is not None and k not in grid} | grid
     out = api.sweep(values, simulate_runs=not analytic_only)
     columns = {}
+    keys = {}
     for name in grid:
-        unit = _BY_NAME[name].unit
-        columns[f"{name}_{unit.replace('/', '_per_')}" if unit else name] = to_unit(grid[name], unit) if unit else grid[name]
+        unit = _BY_NAME[name].unit if name != "model" else ""
+        keys[name] = f"{name}_{unit.replace('/', '_per_')}" if unit else name
+        columns[keys[name]] = to_unit(grid[name], unit) if unit else grid[name]
     columns["azimuth_error_analytic_arcmin"] = to_unit(out["azimuth_error_analytic_rad"], "arcmin")
     columns["azimuth_error_closed_form_arcmin"] = to_unit(out["azimuth_error_rad"], "arcmin")
     if not analytic_only:
@@ -176,7 +197,7 @@ def sweep_command(axes, analytic_only, out_dir, as_json, **options):
     columns["c_gamma"] = out["c_gamma"]
     columns["c_a"] = out["c_a"]
     result = SweepResult(
-        model=str(fixed["model"]), swept=list(grid), simulated=not analytic_only,
+        model="by case" if "model" in grid else str(fixed["model"]), swept=list(grid), simulated=not analytic_only,
         columns={k: np.asarray(v) for k, v in columns.items()},
         all_constraints_ok=None if analytic_only else bool(np.all(out["constraints_ok"])),
         notes=[f"{n} cases"],
@@ -187,13 +208,12 @@ def sweep_command(axes, analytic_only, out_dir, as_json, **options):
         from schuler.io import write_dataframe_csv
         import pandas as pd
 
-        first = list(grid)[0]
-        x_name = list(columns)[0]
-        others = list(grid)[1:]
+        first = next((name for name in grid if name != "model"), "model")
+        x_name = keys[first]
+        others = [name for name in grid if name != first]
         groups = None
         if others:
-            groups = np.array([", ".join(f"{o}={_cell(to_unit(grid[o][i], _BY_NAME[o].unit))}" for o in others)
-                               for i in range(n)])
+            groups = np.array([", ".join(f"{o}={_shown(o, grid[o][i])}" for o in others) for i in range(n)])
         unit = _BY_NAME[first].unit
         figure = plots.sweep_curves(columns[x_name], f"{first} [{unit}]" if unit else first, columns, groups)
         files = plots.write_figures({"align_sweep": figure}, out_dir)

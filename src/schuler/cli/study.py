@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from schuler import __version__
-from schuler.cli.common import emit, json_option
+from schuler.cli.common import emit, json_option, warn
 from schuler.registry import SYSTEM_MODULES
 
 _SCENARIO = click.argument("scenario", metavar="SCENARIO.toml", type=click.Path(dir_okay=False, path_type=Path))
@@ -43,6 +43,8 @@ def run_scenario(scenario: Path, out_dir: Path | None, as_json: bool):
         args.append("--json")
     command = _system_run_command(loaded.system)
     if command is None:
+        if out_dir is not None:
+            warn(f"--out: system {loaded.system!r} has no command of its own here, so no files are written")
         result = loaded.run()
         emit(result, as_json or loaded.as_json, inputs=loaded.values)
         return

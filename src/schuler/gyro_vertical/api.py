@@ -34,7 +34,7 @@ from schuler.gyro_vertical.model import (
 )
 from schuler.gyro_vertical.quasi_steady import Analysis, analyse, split_schuler_frequencies, steady_errors
 from schuler.gyro_vertical.reproduction import SOURCE, reproduce
-from schuler.io import save_figure_formats
+from schuler.io import save_figure_formats, write_dataframe_csv
 from schuler.params import Parameter
 from schuler.registry import FigureRef, ReportSection, ReproductionRow, System
 from schuler.results import Result
@@ -242,9 +242,20 @@ def run(**values) -> VerticalRun:
 
 
 def write_run_figures(analysis: Analysis, out_dir, prefix: str = "vertical", compensated=None) -> list[Path]:
-    """Tilts, velocity errors and (for long enough runs) the spectrum, as PNG and SVG."""
+    """Tilts, velocity errors and (for long enough runs) the spectrum as PNG and SVG; the histories as CSV."""
+    import pandas as pd
+
     out_dir = Path(out_dir)
-    files = save_figure_formats(plots.plot_tilts(analysis), out_dir / f"{prefix}_tilts")
+    r, q = analysis.response, analysis.quasi_steady
+    table = pd.DataFrame({
+        "time_s": r.time, "alpha_rad": r.alpha, "beta_rad": r.beta, "latitude_deg": np.degrees(r.latitude),
+        "measured_velocity_x": r.measured_velocity_x, "measured_velocity_y": r.measured_velocity_y,
+        "true_velocity_x": r.true_velocity_x, "true_velocity_y": r.true_velocity_y,
+        "velocity_error_x": r.velocity_error_x, "velocity_error_y": r.velocity_error_y,
+        "quasi_steady_dv_x": q.dv_x, "quasi_steady_dv_y": q.dv_y,
+    })
+    files = [write_dataframe_csv(table, out_dir / f"{prefix}_timeseries.csv")]
+    files += save_figure_formats(plots.plot_tilts(analysis), out_dir / f"{prefix}_tilts")
     files += save_figure_formats(plots.plot_velocity_errors(analysis, compensated),
                                  out_dir / f"{prefix}_velocity_errors")
     if analysis.spectrum is not None:
@@ -326,7 +337,8 @@ def report(outdir: Path) -> ReportSection:
         "vertical_example_tilts": "Tilts of the worked example (60 deg, 10 m/s due west, 48 h on the great "
                                   "circle) about the forced motion (26).",
         "vertical_example_velocity_errors": "Velocity errors: simulation, the quasi-steady error (29), its "
-                                            "slowly-varying form, and the run with W* compensated.",
+                                            "slowly-varying form, and the run with W* compensated (with a "
+                                            "1-arcsec levelling error, hence its small oscillation).",
         "vertical_example_spectrum": "Spectrum of the oscillation about (29): the split Schuler lines at "
                                      "82.5 and 86.8 min on either side of zero; nothing at 24 h.",
     }
@@ -374,6 +386,12 @@ def sweep(values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     (missing ones take their defaults). The results are evaluated at the start of
     each path by the slowly-varying form of (29) and the mode formulas of (27); no
     simulation is run.
+
+    Examples
+    --------
+    >>> out = sweep({"latitude": np.radians([30.0, 60.0]), "earth": np.array(["drozdovich"] * 2)})
+    >>> out["dv_y"].round(3).tolist(), (out["split_period_fast_s"] / 60).round(2).tolist()
+    ([0.334, 0.557], [83.35, 82.45])
     """
     n = max((np.size(v) for v in values.values()), default=1)
     v = {name: np.broadcast_to(np.asarray(values.get(name, DEFAULTS[name])), (n,)) for name in DEFAULTS}

@@ -69,7 +69,7 @@ _SIGNS = {
     (0, 1): (1, -1), (0, -1): (-1, 1),
 }
 _MAX_EVENTS = 100_000
-# Each cell's exits lie this far (as a velocity error, m/s) beyond its edges, so that a
+# Each cell's exits lie up to this far (as a velocity error, m/s) beyond its edges, so that a
 # state resting exactly on an edge (e.g. q = 0 on a quiet axis) cannot trigger an exit
 # that is no crossing; it shifts the dead zone's edges by a negligible 1e-12 m/s.
 EVENT_HYSTERESIS = 1e-12
@@ -305,7 +305,9 @@ def _exit_events(cell, q_1, q_2, R):
         # (line crossed, direction of crossing, step to the next cell) for each way out
         exits = {0: ((limit, 1.0, 1), (-limit, -1.0, -1)), 1: ((limit, -1.0, -1),), -1: ((-limit, 1.0, 1),)}[side]
         for line, direction, step in exits:
-            shifted = line + direction * EVENT_HYSTERESIS / R
+            # exits from the zone lie a full step out, exits back into it half a step in: the
+            # point where a cell is entered then never lies on one of its own exits, even for q = 0
+            shifted = line + direction * EVENT_HYSTERESIS / R * (1.0 if side == 0 else 0.5)
 
             def event(t, x, axis=axis, shifted=shifted):
                 return (x[2] if axis == 0 else -x[3]) / R - shifted

@@ -432,6 +432,12 @@ def forcing(kinematics: Kinematics, radius, schuler_tuning=1.0, earth_rate_compe
         (b_x, b_y), m/s^2.
     gyro_drift : pair of float or ndarray
         (eps_x, eps_y), rad/s.
+
+    Examples
+    --------
+    >>> k = GreatCircleTrajectory.from_source(np.radians(60), 10.0).kinematics(0.0)
+    >>> [round(float(x), 5) for x in forcing(k, 6.4e6, transport_coriolis_compensation=True)]
+    [0.0, 0.0, 0.0, 0.0]
     """
     k = kinematics
     W_x, W_y = transport_coriolis_acceleration(k, radius)
@@ -456,6 +462,12 @@ def start_kinematics(latitude, azimuth, velocity_angle, speed, rate) -> Kinemati
         m/s.
     rate : ndarray or float
         Omega, rad/s.
+
+    Examples
+    --------
+    >>> k = start_kinematics(np.radians([0.0, 90.0]), 0.0, np.pi / 2, 10.0, 7.3e-5)
+    >>> k.omega_2.round(7).tolist(), k.v_y.tolist()
+    ([0.0, 7.3e-05], [10.0, 10.0])
     """
     latitude, azimuth, velocity_angle, speed = np.broadcast_arrays(latitude, azimuth, velocity_angle, speed)
     omega_1 = rate * np.cos(latitude)
@@ -590,14 +602,15 @@ class GyroVertical:
         alpha, beta, V_x, V_y = state
         kappa = self.schuler_tuning
         W_star_x, W_star_y = transport_coriolis_acceleration(k, R)
-        m1x = k.omega_1y if self.earth_rate_compensation else 0.0
+        W_x, W_y = W_star_x + k.a_x, W_star_y + k.a_y  # (19)
+        m1x = k.omega_1y if self.earth_rate_compensation else 0.0  # (8), divided by H
         m1y = -k.omega_1x if self.earth_rate_compensation else 0.0
-        keep = 0.0 if self.transport_coriolis_compensation else 1.0
+        compensated = (W_star_x, W_star_y) if self.transport_coriolis_compensation else (0.0, 0.0)
         return np.array([
             -kappa * V_y / R - m1y - (k.omega_1x - k.v_y / R) + k.omega_2 * beta + self.gyro_drift[0],
             kappa * V_x / R + m1x - (k.omega_1y + k.v_x / R) - k.omega_2 * alpha + self.gyro_drift[1],
-            W_star_x + k.a_x - g * beta + self.accelerometer_bias[0] - (1.0 - keep) * W_star_x,
-            W_star_y + k.a_y + g * alpha + self.accelerometer_bias[1] - (1.0 - keep) * W_star_y,
+            W_x - g * beta + self.accelerometer_bias[0] - compensated[0],
+            W_y + g * alpha + self.accelerometer_bias[1] - compensated[1],
         ])
 
     def simulate(self, time, method: str = "auto", initial_state=None) -> VerticalResponse:
@@ -650,23 +663,18 @@ class GyroVertical:
         system = error_state_space(float(k0.omega_2), self.gravity, self.radius, self.schuler_tuning)
         u = np.array([float(x) for x in self.forcing(k0)])
         x0 = start - [0.0, 0.0, float(k0.v_x), float(k0.v_y)]
-        # a time series (not a constant vector) selects the engine's step-by-step propagation
-        # (one matrix exponential per distinct step) instead of one exponential per output time
-        response = simulate(system, t, initial_state=x0, inputs=np.broadcast_to(u, (t.size, u.size)))
+        response = simulate(system, t, initial_state=x0, inputs=u)
         k, v_x, v_y = self._true_velocity(t)
         s = response.states
         return VerticalResponse(t, s[:, 0], s[:, 1], v_x + s[:, 2], v_y + s[:, 3], v_x, v_y,
                                 np.broadcast_to(k.latitude, t.shape), "exact", 0, t.size - 1)
 
     def _piece_kinematics(self, index: int):
-        """Fast scalar kinematics on one piece of the speed profile (for the ODE right-hand side)."""
+        """Scalar kinematics on one piece of the speed profile, where it is a quadratic in time."""
         path = self.trajectory
         start, s0, v0, accel = path.speed.piece(index)
         if path.frozen:
             start, s0, accel = 0.0, 0.0, 0.0
-        kr0 = math.sin(path.latitude)
-        pole = math.cos(path.latitude) * math.sin(path.course)
-        kt0 = math.cos(path.latitude) * math.cos(path.course)
         cg, sg = math.cos(path.velocity_angle), math.sin(path.velocity_angle)
         R, rate, moving = path.radius, path.rate, not path.frozen
 
@@ -674,12 +682,9 @@ class GyroVertical:
             tau = t - start
             speed = v0 + accel * tau
             sigma = (s0 + v0 * tau + 0.5 * accel * tau * tau) / R if moving else 0.0
-            c, s = math.cos(sigma), math.sin(sigma)
-            kr = kr0 * c + kt0 * s
-            kt = -kr0 * s + kt0 * c
-            return Kinematics(math.asin(max(-1.0, min(1.0, kr))), rate * (kt * cg - pole * sg),
-                              rate * (pole * cg + kt * sg), rate * kr, speed * cg, speed * sg,
-                              accel * cg, accel * sg)
+            kr, kx, ky = path._geometry(sigma)
+            return Kinematics(math.asin(max(-1.0, min(1.0, kr))), rate * kx, rate * ky, rate * kr,
+                              speed * cg, speed * sg, accel * cg, accel * sg)
 
         return kinematics
 

@@ -22,6 +22,19 @@ def _figure(rows: int, height: float = 2.6):
     return fig, axes[:, 0]
 
 
+def _dress(axis, ylabel: str, legend_location: str | None = "upper right") -> None:
+    axis.set_ylabel(ylabel)
+    axis.grid(True, alpha=0.3)
+    if legend_location:
+        axis.legend(loc=legend_location, fontsize=8)
+
+
+def _finish(fig, axes, title: str, xlabel: str = "time [h]"):
+    axes[0].set_title(title)
+    axes[-1].set_xlabel(xlabel)
+    return fig
+
+
 def plot_tilts(analysis, title: str = "Gyro vertical: tilts"):
     """alpha and beta (arcmin) against time, with the forced motion (26)."""
     r, q = analysis.response, analysis.quasi_steady
@@ -30,12 +43,8 @@ def plot_tilts(analysis, title: str = "Gyro vertical: tilts"):
     for axis, name, simulated, forced in ((axes[0], "alpha", r.alpha, q.alpha_r), (axes[1], "beta", r.beta, q.beta_r)):
         axis.plot(hours, simulated / ARCMIN, lw=0.8, label="simulation")
         axis.plot(hours, forced / ARCMIN, "--", lw=1.2, label="forced motion (26)")
-        axis.set_ylabel(f"{name} [arcmin]")
-        axis.grid(True, alpha=0.3)
-        axis.legend(loc="upper right", fontsize=8)
-    axes[0].set_title(title)
-    axes[-1].set_xlabel("time [h]")
-    return fig
+        _dress(axis, f"{name} [arcmin]")
+    return _finish(fig, axes, title)
 
 
 def plot_velocity_errors(analysis, compensated=None, title: str = "Gyro vertical: velocity errors"):
@@ -52,12 +61,8 @@ def plot_velocity_errors(analysis, compensated=None, title: str = "Gyro vertical
         if compensated is not None:
             axis.plot(hours, getattr(compensated.response, attribute), lw=0.8,
                       label="transport + Coriolis compensated")
-        axis.set_ylabel(f"{name} [m/s]")
-        axis.grid(True, alpha=0.3)
-        axis.legend(loc="upper right", fontsize=8)
-    axes[0].set_title(title)
-    axes[-1].set_xlabel("time [h]")
-    return fig
+        _dress(axis, f"{name} [m/s]")
+    return _finish(fig, axes, title)
 
 
 def plot_spectrum(analysis, title: str = "Spectrum of the velocity-error oscillation"):
@@ -73,28 +78,46 @@ def plot_spectrum(analysis, title: str = "Spectrum of the velocity-error oscilla
     axis.axvline(HOUR / 86400, color="C3", ls=":", lw=1.0, label="24 h (source's claim)")
     axis.axvline(-HOUR / 86400, color="C3", ls=":", lw=1.0)
     axis.plot([], [], color="C1", ls="--", label="eigenvalues (split Schuler modes)")
-    axis.set_xlabel("frequency [cycles/h] (sign: sense of rotation of the error vector)")
-    axis.set_ylabel("amplitude [m/s]")
-    axis.set_title(title)
-    axis.grid(True, alpha=0.3)
-    axis.legend(fontsize=8)
-    return fig
+    _dress(axis, "amplitude [m/s]", "best")
+    return _finish(fig, axes, title, "frequency [cycles/h] (sign: sense of rotation of the error vector)")
 
 
-def plot_friction(response, q, radius, title: str = "Coulomb friction: velocity errors and the dead zone +-R q"):
-    """Delta v_x, Delta v_y (m/s) with the dead zone and stick intervals, and the growth of the slip."""
+def plot_friction(response, q, radius, title: str = "Coulomb friction: velocity errors and the dead zone +-R q",
+                  zoom_hours: float = 3.0):
+    """Delta v_x, Delta v_y (m/s) with the dead zone and stick intervals; below, the first hours enlarged."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
     hours = response.time / HOUR
-    fig, axes = _figure(2)
-    for axis, name, values, limit in ((axes[0], "Delta v_x", response.velocity_error_x, radius * q[0]),
-                                      (axes[1], "Delta v_y", response.velocity_error_y, radius * q[1])):
+    fig = plt.figure(figsize=(9, 8))
+    grid = fig.add_gridspec(3, 1)
+    top = fig.add_subplot(grid[0])
+    axes = [top, fig.add_subplot(grid[1], sharex=top)]
+    zoom = fig.add_subplot(grid[2])
+    limits = (radius * q[0], radius * q[1])
+    for axis, name, values, limit in zip(axes, ("Delta v_x", "Delta v_y"),
+                                         (response.velocity_error_x, response.velocity_error_y), limits):
         axis.plot(hours, values, lw=0.8, label="simulation")
         axis.axhspan(-limit, limit, color="C2", alpha=0.25, label="dead zone +-R q")
         for begin, end in response.stick_intervals:
             axis.axvspan(begin / HOUR, end / HOUR, color="0.6", alpha=0.3, lw=0)
-        axis.set_ylabel(f"{name} [m/s]")
-        axis.grid(True, alpha=0.3)
+        _dress(axis, f"{name} [m/s]", None)
     axes[0].plot([], [], color="0.6", alpha=0.5, lw=6, label="both gimbals stuck")
     axes[0].legend(loc="upper left", fontsize=8)
     axes[0].set_title(title)
-    axes[-1].set_xlabel("time [h]")
+    early = hours <= zoom_hours
+    for name, values, colour in (("Delta v_x", response.velocity_error_x, "C0"),
+                                 ("Delta v_y", response.velocity_error_y, "C1")):
+        zoom.plot(hours[early], values[early], lw=1.0, color=colour, label=name)
+    for limit, style in zip(limits, ("--", ":")):
+        zoom.axhline(limit, color="C2", ls=style, lw=1.0)
+        zoom.axhline(-limit, color="C2", ls=style, lw=1.0)
+    for begin, end in response.stick_intervals:
+        if begin / HOUR < zoom_hours:
+            zoom.axvspan(begin / HOUR, min(end / HOUR, zoom_hours), color="0.6", alpha=0.3, lw=0)
+    _dress(zoom, "velocity error [m/s]", "upper left")
+    zoom.set_xlabel(f"time [h] (first {zoom_hours:g} h; lines: +-R q_1 dashed, +-R q_2 dotted)")
+    fig.tight_layout()
     return fig

@@ -103,7 +103,27 @@ class MonteCarloSummary:
 
 @dataclass
 class AlignmentResult(Result):
-    """One gyrocompassing run: accuracy, time, constraint check (and a Monte Carlo)."""
+    """One gyrocompassing run: accuracy, time, constraint check (and a Monte Carlo).
+
+    Attributes
+    ----------
+    azimuth_error_arcmin : float
+        Simulated steady state of the chosen model (the azimuth error at the end of the run).
+    azimuth_error_analytic_arcmin, level_error_beta_analytic_arcmin : float
+        (1.21) and (1.25).
+    azimuth_error_closed_form_arcmin : float
+        Closed-form steady state of the chosen model ((1.21) for the simplified one).
+    full_minus_simplified_arcsec : float
+        Full-model steady state minus (1.21): what alpha U_z adds from accelerometer
+        errors (about eps_alpha tan(latitude)) and from the latitude error.
+    settling_time_s, settling_time_simulated_s : float
+        5/h (or the corrected aperiodic formula) and the simulated 1 % band time
+        (inf, null in JSON, if the run ends before the band is reached).
+    c_gamma, c_a : float
+        Gains used, 1/s.
+    constraints_ok : bool
+        |delta| < 0.4 rad, |beta| < 0.01 rad and |delta'| < 0.2 rad/s over the whole run.
+    """
 
     model: str
     azimuth_error_arcmin: float
@@ -127,6 +147,7 @@ class AlignmentResult(Result):
     duration_s: float
     monte_carlo: MonteCarloSummary | None = None
     run: study.CaseRun | None = field(default=None, repr=False)
+    simplified_run: study.CaseRun | None = field(default=None, repr=False)
 
     units = {"c_gamma": "1/s", "c_a": "1/s", "damping": "1"}
 
@@ -169,8 +190,19 @@ def case_from_values(values: dict) -> study.AlignmentCase:
     return study.AlignmentCase(**{name: values[name] for name in CASE_FIELDS if values.get(name) is not None})
 
 
-def run(**values) -> AlignmentResult:
-    """What ``schuler align run`` does: one case (SI keyword values as parsed from PARAMETERS).
+def run(
+    *, latitude=None, azimuth=None, drift_east=None, drift_north=None, drift_x=None, drift_y=None, drift_z=None,
+    latitude_error=None, accel_error_x=None, accel_error_y=None, time_constant=None, damping=None, c_gamma=None,
+    c_a=None, initial_azimuth_error=None, initial_beta=None, initial_alpha=None, model=None, duration=None,
+    time_step=None, max_latitude=None, monte_carlo=None, sigma_drift=None, sigma_drift_z=None, sigma_accel=None,
+    seed=None,
+) -> AlignmentResult:
+    """What ``schuler align run`` does: one case, from SI values as parsed from :data:`PARAMETERS`.
+
+    Every argument is the SI value of the parameter of the same name (rad, rad/s,
+    m/s^2, s, 1/s); None takes the parameter's default. The case is simulated on
+    ``model`` with the constraint check; ``monte_carlo`` > 0 adds a Monte Carlo
+    of that many members with the sigmas given.
 
     Examples
     --------
@@ -178,10 +210,8 @@ def run(**values) -> AlignmentResult:
     >>> round(r.azimuth_error_arcmin, 3), r.constraints_ok
     (3.556, True)
     """
-    si = parse_parameters(PARAMETERS, {}) | {k: v for k, v in values.items() if v is not None}
-    unknown = sorted(set(si) - {p.name for p in PARAMETERS})
-    if unknown:
-        raise InvalidParameter(unknown[0], "unknown parameter")
+    given = {name: value for name, value in locals().items() if value is not None}  # only the arguments so far
+    si = parse_parameters(PARAMETERS, {}) | given
     case = case_from_values(si)
     model = si["model"]
     case_run = study.run_case(case, model, duration=si["duration"], time_step=si["time_step"])
@@ -227,6 +257,8 @@ def run(**values) -> AlignmentResult:
         duration_s=case_run.duration,
         monte_carlo=summary,
         run=case_run,
+        simplified_run=case_run if model == "simplified" else study.run_case(
+            case, "simplified", duration=case_run.duration, time_step=si["time_step"]),
     )
 
 
@@ -279,7 +311,10 @@ def sweep(values: dict, *, simulate_runs: bool = False) -> dict[str, np.ndarray]
         return study.evaluate_cases(case, str(model_values), simulate_runs=simulate_runs, duration=duration,
                                     time_step=time_step)
     names = np.broadcast_to(np.asarray(model_values, dtype=str), (n,))
-    models_used = [str(m) for m in np.unique(names)]
+    models_used = [str(names[0])] if np.all(names == names[0]) else [str(m) for m in np.unique(names)]
+    if len(models_used) == 1:
+        return study.evaluate_cases(case, models_used[0], simulate_runs=simulate_runs, duration=duration,
+                                    time_step=time_step)
     output: dict[str, np.ndarray] = {}
     for model in models_used:
         chosen = names == model

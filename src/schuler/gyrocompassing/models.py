@@ -81,9 +81,9 @@ def earth_rate_components(latitude, azimuth, earth_rate=EARTH_RATE):
 
     Examples
     --------
-    >>> c = earth_rate_components(0.0, 0.0)
-    >>> float(c["U_eta"]) == EARTH_RATE, float(c["U_x"])
-    (True, -0.0)
+    >>> c = earth_rate_components(0.0, np.pi / 2)
+    >>> float(c["U_eta"]) == EARTH_RATE, round(float(c["U_x"] / EARTH_RATE), 12)
+    (True, -1.0)
     """
     phi, A = _broadcast(latitude, azimuth)
     U_eta = earth_rate * np.cos(phi)

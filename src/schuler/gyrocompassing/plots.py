@@ -24,13 +24,18 @@ def _figure(rows: int = 1, height: float = 3.2):
     return fig, axes[:, 0]
 
 
-def time_history(runs: dict, title: str = "Gyrocompassing: azimuth and level errors"):
-    """delta and beta against time for one or more runs (label -> :class:`study.CaseRun`), Fig. 1.4 style."""
+def time_history(runs: dict, title: str = "Gyrocompassing: azimuth and level errors", settling_times: float = 4.0):
+    """delta and beta against time for one or more runs (label -> :class:`study.CaseRun`), Fig. 1.4 style.
+
+    The time axis spans ``settling_times`` analytic settling times (or the whole
+    run if shorter), so that the transient is visible.
+    """
     fig, (ax_delta, ax_beta) = _figure(2)
     for label, run in runs.items():
-        minutes = run.time / 60.0
-        ax_delta.plot(minutes, to_unit(run.delta, "arcmin"), label=label)
-        ax_beta.plot(minutes, to_unit(run.beta, "arcsec"), label=label)
+        shown = run.time <= max(settling_times * run.analytic["settling_time_s"], run.time[min(10, run.time.size - 1)])
+        minutes = run.time[shown] / 60.0
+        ax_delta.plot(minutes, to_unit(run.delta[shown], "arcmin"), label=label)
+        ax_beta.plot(minutes, to_unit(run.beta[shown], "arcsec"), label=label)
         steady = run.analytic["azimuth_error_analytic_rad"]
     ax_delta.axhline(to_unit(steady, "arcmin"), color="k", ls=":", lw=0.8, label="delta_y (1.21)")
     ax_delta.set_ylabel("azimuth error delta [arcmin]")
@@ -92,6 +97,7 @@ def sweep_curves(x, x_label: str, columns: dict, groups=None):
                          mfc="none", label=f"simulated 1 % band{suffix}")
     ax_error.set_ylabel("azimuth error [arcmin]")
     ax_time.set_ylabel("settling time [s]")
+    ax_time.set_ylim(bottom=0)
     ax_time.set_xlabel(x_label)
     ax_error.set_title("Gyrocompassing accuracy and time (task 1)")
     for axis in (ax_error, ax_time):

@@ -5,7 +5,9 @@ array of length N, SI). :func:`run_case` simulates one case on the chosen model
 and checks the lab's constraints over the whole run; :func:`evaluate_cases`
 evaluates many cases at once, in closed form (pure numpy, for 10^6 cases) and
 optionally by simulating them in batches on :mod:`schuler.core.lti`;
-:func:`monte_carlo` samples residual drifts and accelerometer errors.
+:func:`monte_carlo` samples residual drifts and accelerometer errors. The phase
+trajectory of task 5 is the (delta, beta) history of a :class:`CaseRun`
+(plotted by :func:`schuler.gyrocompassing.plots.phase_trajectory`).
 
 Constraints (task 1): |delta| < 0.4 rad, |beta| < 0.01 rad and an azimuth
 slew rate |delta'| < 0.2 rad/s. The source writes the last "0.2 1/s" in the
@@ -87,6 +89,12 @@ class AlignmentCase:
         Latitude limit, rad, above which azimuth is reported not observable.
     earth_rate, gravity : float
         U (rad/s) and g (m/s^2).
+
+    Examples
+    --------
+    >>> case = AlignmentCase(latitude=np.radians([30.0, 60.0]))
+    >>> case.size, case.inputs().shape, case.model("full").A.shape
+    (2, (2, 6), (2, 3, 3))
     """
 
     latitude: object = DEFAULT_LATITUDE
@@ -174,9 +182,10 @@ class AlignmentCase:
     def inputs(self) -> np.ndarray:
         """The six model inputs (:data:`models.INPUTS`), shape (6,) or (N, 6), SI."""
         drift_x, drift_y = self.platform_drifts()
-        return np.stack(np.broadcast_arrays(
+        columns = np.stack(np.broadcast_arrays(
             drift_x, drift_y, self.drift_z, self.latitude_error, self.accel_error_x, self.accel_error_y
         ), axis=-1).astype(float)
+        return columns if self.size is None else np.broadcast_to(columns, (self.size, 6)).copy()
 
     def model(self, name: str) -> StateSpace:
         """The state-space model ``name`` (one of :data:`models.MODELS`) of this case (batched for N cases)."""
@@ -185,6 +194,7 @@ class AlignmentCase:
                                   earth_rate=self.earth_rate, gravity=self.gravity)
 
     def initial_state(self, name: str) -> np.ndarray:
+        """Initial state of the model ``name``: (delta0, beta0, alpha0) in its coordinates, rad."""
         return models.initial_state(name, self.initial_azimuth_error, self.initial_beta, self.initial_alpha, self.azimuth)
 
 
@@ -242,7 +252,11 @@ def analytic_results(case: AlignmentCase, model: str = "full") -> dict[str, np.n
 
 
 def time_grid(duration: float, time_step: float) -> np.ndarray:
-    """Output times 0, dt, ..., duration (the last step shortened to end exactly at duration), s."""
+    """Output times 0, dt, ..., duration (the last step shortened to end exactly at duration), s.
+
+    >>> time_grid(2.5, 1.0)
+    array([0. , 1. , 2. , 2.5])
+    """
     if not duration > 0:
         raise InvalidParameter("duration", "must be positive")
     if not time_step > 0:
@@ -255,7 +269,11 @@ def time_grid(duration: float, time_step: float) -> np.ndarray:
 
 
 def automatic_duration(settling_time) -> float:
-    """2 h, or 3 analytic settling times when longer, at most 48 h (s)."""
+    """2 h, or 3 analytic settling times when longer, at most 48 h (s).
+
+    >>> automatic_duration(187.5), automatic_duration(1e4), automatic_duration(1e9)
+    (7200.0, 30000.0, 172800.0)
+    """
     longest = float(np.max(settling_time))
     return float(min(max(DEFAULT_DURATION, 3.0 * longest), MAX_DURATION))
 
@@ -399,6 +417,14 @@ def simulate_cases(system: StateSpace, time: np.ndarray, initial_state: np.ndarr
         N.
     chunk_size : int, optional
         Members per chunk (default: about 120 MB of history).
+
+    Examples
+    --------
+    >>> case = AlignmentCase(latitude=np.radians([20.0, 60.0]), drift_east=1e-8)
+    >>> out = simulate_cases(case.model("simplified"), time_grid(1800, 1.0), case.initial_state("simplified"),
+    ...                      case.inputs(), 2)
+    >>> np.allclose(out.azimuth_error, 1e-8 / (7.292115e-5 * np.cos(np.radians([20.0, 60.0]))), rtol=1e-9)
+    True
     """
     n = system.n_states
     chunk = chunk_size or max(1, _CHUNK_FLOATS // (time.size * (n + 4)))
@@ -638,16 +664,6 @@ def monte_carlo(case: AlignmentCase, model: str = "full", members: int = 1000, *
     )
 
 
-def phase_trajectory(run: CaseRun) -> tuple[np.ndarray, np.ndarray]:
-    """The platform's path in the (delta, beta) plane (task 5), rad: (delta(t), beta(t)).
-
-    >>> d, b = phase_trajectory(run_case(AlignmentCase(), "simplified", duration=300))
-    >>> d.shape == b.shape == (301,)
-    True
-    """
-    return run.delta, run.beta
-
-
 def sweep_grid(axes: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The Cartesian product of parameter axes as flat arrays of equal length (first axis slowest).
 
@@ -655,5 +671,6 @@ def sweep_grid(axes: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     >>> g["a"].tolist(), g["b"].tolist()
     ([1.0, 1.0, 1.0, 2.0, 2.0, 2.0], [10.0, 20.0, 30.0, 10.0, 20.0, 30.0])
     """
-    mesh = np.meshgrid(*axes.values(), indexing="ij")
-    return {name: grid.ravel() for name, grid in zip(axes, mesh)}
+    # mesh the indices, so that axes of names (models) work like numbers
+    mesh = np.meshgrid(*(np.arange(len(values)) for values in axes.values()), indexing="ij")
+    return {name: np.asarray(values)[index.ravel()] for (name, values), index in zip(axes.items(), mesh)}

@@ -13,24 +13,20 @@ MAX_RESULTS_PLOTTED = 8
 """Results plotted at most (all of them are in results.csv and summary.json)."""
 
 
-def plot_sweep_summary(plan, statistics: dict, per_axis: dict, out_dir) -> list[Path]:
-    """One PNG per result: its mean and range against each swept parameter.
+def plot_sweep_summary(plan, statistics: dict, per_axis: dict, histograms: dict, out_dir) -> list[Path]:
+    """One PNG per result: its mean and range against each swept parameter, and its histogram.
 
-    A sweep without grid axes (a pure Monte Carlo) gets the percentiles of each
-    result instead. Returns the files written (``summary_<result>.png``).
+    Returns the files written (``summary_<result>.png``).
     """
     import matplotlib.pyplot as plt
 
     files: list[Path] = []
     for name in list(statistics)[:MAX_RESULTS_PLOTTED]:
-        stats = statistics[name]
-        panels = len(plan.axes) or 1
+        panels = len(plan.axes) + 1
         fig, axes = plt.subplots(1, panels, figsize=(4.5 * panels, 3.6), squeeze=False)
-        if plan.axes:
-            for ax, axis in zip(axes[0], plan.axes):
-                _axis_panel(ax, plan, axis, per_axis[(axis.name, name)], name)
-        else:
-            _percentile_panel(axes[0][0], stats, name)
+        for ax, axis in zip(axes[0], plan.axes):
+            _axis_panel(ax, plan, axis, per_axis[(axis.name, name)], name)
+        _histogram_panel(axes[0][-1], statistics[name], histograms.get(name), name)
         fig.suptitle(f"{plan.system} sweep: {name} ({plan.total} cases)")
         fig.tight_layout()
         files.extend(save_figure_formats(fig, Path(out_dir) / f"summary_{name}", ("png",), dpi=100))
@@ -56,13 +52,21 @@ def _axis_panel(ax, plan, axis, summary: dict, name: str) -> None:
     ax.legend(fontsize="small")
 
 
-def _percentile_panel(ax, stats: dict, name: str) -> None:
-    keys = ["min", "p05", "p50", "p95", "max"]
-    values = [np.nan if stats[k] is None else stats[k] for k in keys]
-    ax.bar(keys, values, color="tab:blue", alpha=0.7)
-    if stats["mean"] is not None:
-        ax.axhline(stats["mean"], color="tab:red", label=f"mean {stats['mean']:.4g}")
-        ax.legend(fontsize="small")
-    ax.set_ylabel(name)
-    ax.set_xlabel("statistic over all cases")
-    ax.grid(True, axis="y", alpha=0.3)
+def _histogram_panel(ax, stats: dict, histogram, name: str) -> None:
+    if histogram is None:
+        # every case gave the same value (or none was finite): say so instead of drawing one bar
+        shown = "no finite value" if stats["mean"] is None else f"every case: {stats['mean']:.6g}"
+        ax.text(0.5, 0.5, shown, ha="center", va="center", transform=ax.transAxes)
+        ax.set_axis_off()
+        return
+    counts, edges = histogram
+    ax.stairs(counts, edges, fill=True, alpha=0.6, label=f"{int(counts.sum())} cases")
+    for key, style in (("p05", ":"), ("p50", "--"), ("p95", ":")):
+        if stats[key] is not None:
+            ax.axvline(stats[key], color="black", linestyle=style, linewidth=1)
+    ax.axvline(stats["mean"], color="tab:red", label=f"mean {stats['mean']:.4g}")
+    ax.set_xlabel(name)
+    ax.set_ylabel("cases")
+    ax.set_title("distribution (dotted: 5 % and 95 %, dashed: median)", fontsize="small")
+    ax.legend(fontsize="small")
+    ax.grid(True, alpha=0.3)

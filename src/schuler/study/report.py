@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from schuler import __version__
+from schuler.exceptions import SchulerError
 from schuler.io import write_text
 from schuler.registry import SYSTEM_MODULES, ReportSection, System
 from schuler.study.systems import load_system
@@ -79,7 +80,11 @@ def build_report(out_dir, systems=None, jobs: int = 1) -> Path:
 def build_section(module: str, figures: Path) -> tuple[ReportSection, float]:
     """The report section of the system defined in ``module`` and the seconds it took."""
     began = time.perf_counter()
-    section = importlib.import_module(module).SYSTEM.report(figures)
+    try:
+        section = importlib.import_module(module).SYSTEM.report(figures)
+    except SchulerError as error:
+        # re-raised as the base class: it crosses process boundaries intact (one argument)
+        raise SchulerError(f"report of {module}: {error}") from None
     return section, time.perf_counter() - began
 
 
