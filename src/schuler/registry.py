@@ -82,8 +82,9 @@ class System:
     sweep : callable or None
         ``sweep(values: dict[str, ndarray]) -> dict[str, ndarray]``: vectorised
         evaluation of many cases at once; ``values`` holds every parameter in SI
-        as an array of length n_cases, the result one array per output (length
-        n_cases, SI, names with their unit where not SI-obvious).
+        as an array of length n_cases (a parameter left unset arrives as NaN for
+        numbers and None for text or choices), the result one array per output
+        (length n_cases, SI, names with their unit where not SI-obvious).
     """
 
     name: str

@@ -15,7 +15,8 @@ DISPLAY_UNITS = ("ft", "m", "mi")
 
 
 def _length(value_si: float, unit: str) -> str:
-    return f"{to_unit(value_si, unit):,.6g}"
+    value = to_unit(value_si, unit)
+    return f"{value:,.0f}" if abs(value) >= 1e5 else f"{value:,.6g}"
 
 
 def _sample_indices(size: int, count: int = 11) -> np.ndarray:
@@ -87,12 +88,18 @@ class ReproductionResult(Result):
         unit = self.display_unit
         table = Table(title=f"Bollay, Problems 3 and 4: printed vs computed ({unit})")
         for column in ("source", "earth", "quantity", "printed", "computed", "agrees", "note"):
-            table.add_column(column, justify="right" if column in ("printed", "computed") else "left",
-                             overflow="fold")
+            table.add_column(column, justify="right" if column in ("printed", "computed") else "left")
+        # notes are long: the table refers to them by number and lists them below it
+        footnotes = []
         for row in self.rows:
+            computed_ft = 0.0 if abs(row.computed_ft) < 1e-6 else row.computed_ft  # rounding at omega t = 4 pi
+            reference = ""
+            if row.note:
+                footnotes.append(f"[{len(footnotes) + 1}] {row.source}, {row.earth}, {row.quantity}: {row.note}")
+                reference = f"[{len(footnotes)}]"
             table.add_row(row.source, row.earth, row.quantity, _length(row.printed_ft * 0.3048, unit),
-                          _length(row.computed_ft * 0.3048, unit), "yes" if row.agrees else "NO", row.note)
-        return Group(table, *self.notes)
+                          _length(computed_ft * 0.3048, unit), "yes" if row.agrees else "NO", reference)
+        return Group(table, *footnotes, *self.notes)
 
 
 @dataclass

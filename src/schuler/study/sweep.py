@@ -625,13 +625,6 @@ def chunk_path(out_dir: Path, index: int) -> Path:
     return Path(out_dir) / "chunks" / f"chunk-{index:06d}.parquet"
 
 
-def _require_parquet() -> None:
-    try:
-        import pyarrow  # noqa: F401
-    except ImportError:
-        raise ScenarioError("sweeps store Parquet files: install pyarrow (pip install schuler[dask])") from None
-
-
 def _text_columns(schema) -> list[str]:
     """Columns worth dictionary encoding in Parquet: the text ones (choices)."""
     import pyarrow as pa
@@ -902,7 +895,6 @@ def run_sweep(
     on_chunk : callable, optional
         Called with each chunk index once its file is stored.
     """
-    _require_parquet()
     from schuler.study.plots import plot_sweep_summary
 
     system = scenario.definition()
