@@ -55,3 +55,23 @@ def test_library_errors_become_one_line(run_cli, failing_command):
 def test_module_entry_point_runs():
     done = subprocess.run([sys.executable, "-m", "schuler", "--version"], capture_output=True, text=True, check=True)
     assert __version__ in done.stdout
+
+
+def test_emit_uses_120_columns_when_stdout_is_not_a_terminal(capsys):
+    from dataclasses import dataclass
+
+    from schuler.cli.common import emit
+    from schuler.results import Result
+
+    @dataclass
+    class Wide(Result):
+        text: str
+
+        def render(self):
+            return self.text
+
+    line = " ".join(["word"] * 23)  # 114 characters: rich's default 80 would wrap it
+    emit(Wide(line), as_json=False)
+    assert capsys.readouterr().out == line + "\n"
+    emit(Wide(line + " overflow"), as_json=False)
+    assert [row.rstrip() for row in capsys.readouterr().out.splitlines()] == [line, "overflow"]  # wraps at 120

@@ -70,6 +70,21 @@ def test_reproduce_json_keys(run_cli):
     assert data["table1"]["any_reading_reproduces"] is False
 
 
+def test_reproduce_human_explains_each_disagreement(run_cli):
+    out = run_cli("north", "reproduce", "--unknowns", "2")
+    assert out.code == 0, out.stderr
+    lines = out.stdout.splitlines()
+    # source 004, Table 2 (2 unknowns, stage 2): printed F 3.62e-5 against the computed sum of squares
+    row = next(line for line in lines if line.replace(" ", "").startswith("│2│2│900│"))
+    assert "3.62e-05" in row and "✗" in row and "[1]" in row
+    assert next(line for line in lines if line.startswith("[1] ")).startswith("[1] erratum: the printed F is not")
+    # 4 unknowns, stage 1: the printed best cell is not the grid's minimum
+    row = next(line for line in lines if line.replace(" ", "").startswith("│4│1│"))
+    number = row.rsplit("[", 1)[1].split("]")[0]
+    note = next(line for line in lines if line.startswith(f"[{number}] "))
+    assert "the printed best (4, 4, 2.2, 0.43) is not the grid's minimum" in note
+
+
 def test_run_is_simulate_plus_identify(run_cli):
     out = run_cli("north", "run", "--noise", "1 arcsec", "--latitude", "50", "--unknowns", "5", "--json")
     assert out.code == 0, out.stderr

@@ -372,3 +372,15 @@ def test_system_parameters_are_the_run_keywords():
     assert result.method == "exact" and result.duration_h == pytest.approx(3.0)
     with pytest.raises(InvalidParameter, match="output_step"):
         api.run(duration=60.0, output_step=120.0)
+
+
+def test_cli_reproduce_human_lists_errata_below_the_table(run_cli):
+    out = run_cli("vertical", "reproduce")
+    assert out.code == 0, out.stderr
+    lines = out.stdout.splitlines()
+    # the row keeps printed 0.67 beside computed 0.557 and refers to its note by number
+    row = next(line for line in lines if line.startswith("│ Delta v_y = R omega_2 beta_r (29)"))
+    assert "0.67" in row and "0.557" in row and "NO" in row and "[3]" in row
+    note = next(line for line in lines if line.startswith("[3] "))
+    assert "ERRATUM: the source's own chain gives 0.569 m/s; 0.67 is a misprint of 0.57" in note
+    assert any(line.startswith("[6] ERRATUM: 0.01 / 6.4e6 = 1.56e-9 1/s") for line in lines)

@@ -132,6 +132,21 @@ def test_reproduce(run_cli):
     assert rows["c_Gamma for T = 30 s, zeta = 0.8"]["agrees"] is False
     human = run_cli("align", "reproduce")
     assert "c_a for T = 30 s" in human.stdout
+    # each note is numbered in the table and printed below it; a disagreeing row's note is its erratum
+    lines = human.stdout.splitlines()
+    c_gamma = next(line for line in lines if line.startswith("│ c_Gamma for T = 30 s"))
+    assert "NO" in c_gamma and "[1]" in c_gamma
+    assert any(line.startswith("[1] erratum: c_Gamma = 2 zeta / T; the printed 0.08 needs zeta = 1.20")
+               for line in lines)
+    assert "(1.24) C1 has 'delta_2'" in human.stdout  # the equation errata without a number follow
+
+
+def test_degradation_warning_is_printed_once(run_cli):
+    # the full model's run and its simplified companion share the case: one warning, not two
+    out = run_cli("align", "run", "--latitude", "80")
+    assert out.code == 0
+    assert out.stderr.count("schuler: warning: latitude 80 deg: azimuth accuracy degrades") == 1
+    assert len(out.stderr.splitlines()) == 1
 
 
 def test_sweep_compares_models_case_by_case(run_cli):

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import click
 import numpy as np
 
-from schuler.cli.common import emit, json_option, out_option, parameter_options, parse_options
+from schuler.cli.common import emit, json_option, options_named, out_option, parameter_options, parse_options
 from schuler.exceptions import InvalidParameter
 from schuler.gyrocompassing import api
 from schuler.results import Result
@@ -72,7 +72,8 @@ def _run_files(result: api.AlignmentResult, out_dir) -> list:
 def run_command(out_dir, as_json, **options):
     """One gyrocompassing case: accuracy (arcmin), settling time and the constraint check."""
     values = parse_options(api.PARAMETERS, options)
-    result = api.run(**values)
+    with options_named(api.PARAMETERS):
+        result = api.run(**values)
     files = _run_files(result, out_dir) if out_dir else []
     emit(result, as_json, inputs=values, files=files)
 

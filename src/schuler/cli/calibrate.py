@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from schuler.cli.common import emit, json_option, out_option, parameter_options, parse_options
+from schuler.cli.common import emit, json_option, options_named, out_option, parameter_options, parse_options
 from schuler.drift_calibration.api import PARAMETERS, SYSTEM, write_figures
 
 
@@ -20,7 +20,8 @@ def group():
 def run(as_json, out_dir, **options):
     """One procedure: own drifts, Earth-rate component, azimuth and its error; --monte-carlo N for statistics."""
     values = parse_options(PARAMETERS, options)
-    result = SYSTEM.run(**values)
+    with options_named(PARAMETERS):
+        result = SYSTEM.run(**values)
     files = write_figures(result, out_dir) if out_dir else []
     emit(result, as_json, inputs=values, files=files)
 

@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import json
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 import click
 
 from schuler import __version__
+from schuler.exceptions import InvalidParameter, SchulerError
 from schuler.params import Parameter, parse_parameters
 from schuler.results import json_safe
 
@@ -48,6 +50,40 @@ def parse_options(parameters, values: dict) -> dict:
     return parse_parameters(parameters, {k: v for k, v in values.items() if k in names}, labels="option")
 
 
+@contextmanager
+def options_named(parameters):
+    """Re-raise library errors under the CLI option's name (``speed`` -> ``--speed``).
+
+    Library code names a parameter as the API knows it; at the command line the
+    user typed an option. An :class:`InvalidParameter` whose ``name`` is one of
+    ``parameters`` is raised again with the option; any other :class:`SchulerError`
+    whose message starts with ``"name: "`` gets the option in front instead.
+    Errors naming nothing in ``parameters`` pass unchanged.
+
+    Examples
+    --------
+    >>> speed = Parameter("speed", "m/s", 10.0, "Ground speed.")
+    >>> try:
+    ...     with options_named([speed]):
+    ...         raise InvalidParameter("speed", "must be finite")
+    ... except InvalidParameter as error:
+    ...     print(error)
+    --speed: must be finite
+    """
+    options = {spec.name: spec.option for spec in parameters}
+    try:
+        yield
+    except InvalidParameter as error:
+        if error.name not in options:
+            raise
+        raise InvalidParameter(options[error.name], error.reason) from None
+    except SchulerError as error:
+        name, _, rest = str(error).partition(": ")
+        if name not in options or not rest:
+            raise
+        raise type(error)(f"{options[name]}: {rest}") from None
+
+
 json_option = click.option("--json", "as_json", is_flag=True, help="Print a machine-readable JSON result on stdout.")
 out_option = click.option(
     "--out",
@@ -69,7 +105,8 @@ def emit(result, as_json: bool, inputs: dict | None = None, files=()) -> None:
         return
     from rich.console import Console
 
-    console = Console()
+    # a terminal keeps its own width; pipes and logs get 120 columns instead of rich's 80
+    console = Console() if sys.stdout.isatty() else Console(width=120)
     console.print(result.render())
     if files:
         folders = sorted({str(Path(f).parent) for f in files})
@@ -81,4 +118,5 @@ def warn(message: str) -> None:
     print(f"schuler: warning: {message}", file=sys.stderr)
 
 
-__all__ = ["Parameter", "parameter_options", "parse_options", "json_option", "out_option", "emit", "warn"]
+__all__ = ["Parameter", "parameter_options", "parse_options", "options_named", "json_option", "out_option", "emit",
+           "warn"]

@@ -3,27 +3,13 @@
 from __future__ import annotations
 
 import json
-from contextlib import contextmanager
 
 import click
 
 from schuler import __version__
-from schuler.cli.common import emit, json_option, out_option, parameter_options, parse_options, warn
-from schuler.exceptions import InvalidParameter
+from schuler.cli.common import emit, json_option, options_named, out_option, parameter_options, parse_options, warn
 from schuler.navigation_errors import api
 from schuler.navigation_errors.results import DISPLAY_UNITS
-
-@contextmanager
-def options_named(parameters):
-    """Re-raise a library InvalidParameter under the CLI option's name (``k2`` -> ``--k2``)."""
-    by_name = {spec.name: spec for spec in parameters}
-    try:
-        yield
-    except InvalidParameter as error:
-        if error.name not in by_name:
-            raise
-        raise InvalidParameter(by_name[error.name].option, error.reason) from None
-
 
 units_option = click.option(
     "--units", "units", type=click.Choice(DISPLAY_UNITS), default=None,

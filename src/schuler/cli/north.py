@@ -11,26 +11,9 @@ from pathlib import Path
 
 import click
 
-from schuler.cli.common import emit, json_option, out_option, parameter_options, parse_options
-from schuler.exceptions import InvalidParameter, SchulerError
+from schuler.cli.common import emit, json_option, options_named, out_option, parameter_options, parse_options
 from schuler.ground_gyrocompass import api, motion
 from schuler.ground_gyrocompass.observations import read_record, write_record
-
-
-def _named_by_option(call, parameters):
-    """Run ``call``; re-raise errors that name a parameter with its ``--option`` instead."""
-    options = {p.name: p.option for p in parameters}
-    try:
-        return call()
-    except InvalidParameter as error:
-        if error.name in options:
-            raise InvalidParameter(options[error.name], error.reason) from None
-        raise
-    except SchulerError as error:
-        name, _, rest = str(error).partition(": ")
-        if name in options and rest:
-            raise type(error)(f"{options[name]}: {rest}") from None
-        raise
 
 
 @click.group(name="north")
@@ -52,7 +35,8 @@ def group():
 def simulate(output, as_json, **raw):
     """Simulate a run-down and write the observation record (CSV: t_s, alpha_rad)."""
     values = parse_options(api.SIMULATE_PARAMETERS, raw)
-    record = _named_by_option(lambda: api.simulate_record(**values), api.SIMULATE_PARAMETERS)
+    with options_named(api.SIMULATE_PARAMETERS):
+        record = api.simulate_record(**values)
     path = write_record(output, record.time, record.observed)
     record.file = str(path)
     emit(record, as_json, inputs=values, files=[path])
@@ -71,7 +55,8 @@ def identify(record, out_dir, as_json, **raw):
     """
     values = parse_options(api.IDENTIFY_PARAMETERS, raw)
     time, observed = read_record(record)
-    estimate = _named_by_option(lambda: api.identify_record(time, observed, **values), api.IDENTIFY_PARAMETERS)
+    with options_named(api.IDENTIFY_PARAMETERS):
+        estimate = api.identify_record(time, observed, **values)
     files = []
     if out_dir is not None:
         files = api.write_figures(estimate, out_dir, "north", values["lambda"], _nominal_b(values))
@@ -106,7 +91,8 @@ def reproduce(unknowns, method, out_dir, as_json):
 def run(out_dir, as_json, **raw):
     """Simulate a run-down record and identify north from it (a user case)."""
     values = parse_options(api.PARAMETERS, raw)
-    result = _named_by_option(lambda: api.run(**values), api.PARAMETERS)
+    with options_named(api.PARAMETERS):
+        result = api.run(**values)
     files = []
     if out_dir is not None:
         files = api.write_figures(result.estimate, out_dir, "north", values["lambda"], _nominal_b(values))

@@ -2,25 +2,10 @@
 
 from __future__ import annotations
 
-from contextlib import contextmanager
-
 import click
 
-from schuler.cli.common import emit, json_option, out_option, parameter_options, parse_options
-from schuler.exceptions import InvalidParameter
+from schuler.cli.common import emit, json_option, options_named, out_option, parameter_options, parse_options
 from schuler.gyro_vertical import api
-
-
-@contextmanager
-def _named_as_options(parameters):
-    """Report a library InvalidParameter under the option the user typed (``speed`` -> ``--speed``)."""
-    options = {spec.name: spec.option for spec in parameters}
-    try:
-        yield
-    except InvalidParameter as error:
-        if error.name not in options:
-            raise
-        raise InvalidParameter(options[error.name], error.reason) from None
 
 
 @click.group(name="vertical")
@@ -38,7 +23,7 @@ def run(as_json, out_dir, **options):
     Example: schuler vertical run --latitude 60 --speed 10 --earth drozdovich --duration "48 h" --out results
     """
     inputs = parse_options(api.PARAMETERS, options)
-    with _named_as_options(api.PARAMETERS):
+    with options_named(api.PARAMETERS):
         result = api.run(**inputs)
     files = api.write_run_figures(result.analysis, out_dir) if out_dir is not None else []
     emit(result, as_json, inputs=inputs, files=files)
@@ -71,7 +56,7 @@ def friction(as_json, out_dir, **options):
     Example: schuler vertical friction --dead-zone 0.01 --initial-beta "0.2 arcsec" --out results
     """
     inputs = parse_options(api.FRICTION_PARAMETERS, options)
-    with _named_as_options(api.FRICTION_PARAMETERS):
+    with options_named(api.FRICTION_PARAMETERS):
         result = api.run_friction(**inputs)
     files = []
     if out_dir is not None:

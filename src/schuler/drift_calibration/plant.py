@@ -44,6 +44,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from schuler.core.earth import EARTH_RATE
+from schuler.core.rotation import skew
 from schuler.drift_calibration.pulses import PulseShape
 from schuler.exceptions import SimulationError
 
@@ -72,10 +73,6 @@ def initial_attitude(azimuth: float, pitch: float = 0.0, roll: float = 0.0) -> n
     array([1., 0., 0.])
     """
     return _rotation_z(-azimuth) @ _rotation_y(pitch) @ _rotation_x(roll)
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
 def plant_reading(
@@ -127,7 +124,7 @@ def plant_reading(
         inertial = earth_platform.copy()  # correction loops hold the other axes to the base
         inertial[axis] = own_drift + pulse_rate * current(t)
         relative = inertial - earth_platform
-        return np.concatenate([(c @ _skew(relative)).ravel(), [switch * gimbal_angle(c)]])
+        return np.concatenate([(c @ skew(relative)).ravel(), [switch * gimbal_angle(c)]])
 
     state = np.concatenate([attitude.ravel(), [0.0]])
     for phase, (switch, sign) in enumerate(((1.0, 1.0), (-1.0, -1.0))):

@@ -22,7 +22,7 @@ from schuler.ground_gyrocompass.identification import NorthEstimate, identify
 from schuler.ground_gyrocompass.monte_carlo import ARCSEC, monte_carlo, predicted_errors
 from schuler.ground_gyrocompass.observations import observe, sample_times
 from schuler.ground_gyrocompass.reproduction import reproduce
-from schuler.params import Parameter
+from schuler.params import Parameter, parse_parameters
 from schuler.registry import FigureRef, ReportSection, ReproductionRow, System
 from schuler.results import Result
 
@@ -186,17 +186,9 @@ def run(**values) -> NorthRun:
 
 def _with_defaults(parameters, values):
     """Fill missing keys with the parameters' defaults (SI); reject unknown keys."""
-    known = {p.name: p for p in parameters}
-    unknown = sorted(set(values) - set(known))
-    if unknown:
-        raise InvalidParameter(unknown[0], f"unknown parameter; allowed: {', '.join(sorted(known))}")
-    filled = {}
-    for name, spec in known.items():
-        value = values.get(name)
-        if value is None and spec.default is not None:
-            value = spec.parse(spec.default, name)
-        filled[name] = value
-    return filled
+    # parse_parameters names an unknown key and gives the defaults; the given values are SI already
+    defaults = parse_parameters(parameters, dict.fromkeys(values))
+    return defaults | {name: value for name, value in values.items() if value is not None}
 
 
 def write_figures(estimate: NorthEstimate, outdir, prefix="north", decay_rate=None, coefficient=None) -> list[Path]:

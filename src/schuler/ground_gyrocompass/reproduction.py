@@ -253,18 +253,42 @@ class SourceReproduction(Result):
         from rich.table import Table
 
         stages = Table(title="Source 004, Tables 1-3: grid stages, printed vs computed (relative coordinate)")
-        for column in ("unknowns", "stage", "cells", "printed best", "computed best", "printed F", "computed F"):
-            stages.add_column(column, justify="right")
+        for column in ("unknowns", "stage", "cells", "printed best", "computed best", "printed F", "computed F", "note"):
+            stages.add_column(column, justify="left" if column == "note" else "right")
+        four = self.four_unknowns_first_stage
+        misfit_note = (
+            "erratum: the printed F is not the sum of squares of alpha - alpha0 that is minimised here; no reading "
+            "of the misfit reproduces the source's Table 1 (see the table of readings below)"
+        )
+        first_stage_note = (
+            f"erratum: the printed best (4, 4, 2.2, 0.43) is not the grid's minimum: F there is "
+            f"{four['printed_best_misfit']:.4g}, the real best {tuple(four['first_stage_best'])} has "
+            f"F = {four['first_stage_misfit']:.4g}; refining around it ends at {tuple(four['refined_best'])} "
+            f"(alpha0 error {four['refined_alpha0_error_rad']:.3g} rad)"
+        )
+        # notes are long and some repeat: the table refers to them by number and lists each once below it
+        footnotes: dict[str, int] = {}
         for row in self.stages:
-            mark = "" if row["best_agrees"] else " ✗"
+            notes = []
+            if not row["best_agrees"]:
+                final = [r for r in self.stages if r["unknowns"] == row["unknowns"]][-1]
+                notes.append(first_stage_note if (row["unknowns"], row["stage"]) == (4, 1) else (
+                    "the printed cell is not the minimum of the sum of squares on this grid (the source minimises "
+                    f"another misfit: see the note on F); the final stage {'agrees' if final['best_agrees'] else 'differs'}"
+                ))
+            if not row["misfit_agrees"]:
+                notes.append(misfit_note)
+            references = " ".join(f"[{n}]" for n in sorted(footnotes.setdefault(note, len(footnotes) + 1)
+                                                            for note in notes))
             stages.add_row(
                 str(row["unknowns"]),
                 str(row["stage"]),
                 str(row["cells"]),
                 ", ".join(f"{v:g}" for v in row["printed_best"]),
-                ", ".join(f"{v:g}" for v in row["computed_best"]) + mark,
+                ", ".join(f"{v:g}" for v in row["computed_best"]) + ("" if row["best_agrees"] else " ✗"),
                 f"{row['printed_misfit']:.4g}",
                 f"{row['computed_misfit']:.4g}" + ("" if row["misfit_agrees"] else " ✗"),
+                references,
             )
         readings = Table(title="Table 1 against readings of the misfit (none reproduces it within 5 %)")
         for column in ("coordinate", "reading", "min cell", "at (4, 4)", "scale", "max deviation"):
@@ -278,14 +302,7 @@ class SourceReproduction(Result):
                 f"{row['best_scale']:.3g}",
                 f"{100 * row['max_deviation']:.0f} %",
             )
-        four = self.four_unknowns_first_stage
-        note = (
-            f"4 unknowns, first stage: printed best (4, 4, 2.2, 0.43) has F = {four['printed_best_misfit']:.4g}; "
-            f"the grid's real best is {tuple(four['first_stage_best'])} with F = {four['first_stage_misfit']:.4g}; "
-            f"refining around it ends at {tuple(four['refined_best'])} "
-            f"(alpha0 error {four['refined_alpha0_error_rad']:.3g} rad)."
-        )
-        return Group(self.estimate.render(), stages, readings, note)
+        return Group(self.estimate.render(), stages, *(f"[{n}] {note}" for note, n in footnotes.items()), readings)
 
 
 def reproduce(unknowns: int = 4, method: str = "lsq") -> SourceReproduction:

@@ -160,17 +160,23 @@ class VerticalReproduction(Result):
         ]
 
     def render(self):
+        from rich.console import Group
         from rich.table import Table
 
         table = Table(title=f"Gyro vertical: worked example of {SOURCE}")
         for column in ("quantity", "source", "computed", "unit", "agrees", "note"):
             table.add_column(column, overflow="fold")
+        # notes are long: the table refers to them by number and lists them below it
+        footnotes = []
         for row in self.rows():
             printed = row.printed if isinstance(row.printed, str) else f"{row.printed:.4g}"
+            reference = ""
+            if row.note:
+                footnotes.append(f"[{len(footnotes) + 1}] {row.note}")
+                reference = f"[{len(footnotes)}]"
             table.add_row(row.quantity, printed, f"{row.computed:.4g}", row.unit, "yes" if row.agrees else "NO",
-                          row.note)
-        table.caption = self.constants
-        return table
+                          reference)
+        return Group(table, *footnotes, f"Constants: {self.constants}")
 
 
 def mean_velocity_error(response) -> float:

@@ -46,15 +46,29 @@ class ReproductionResult(Result):
     notes: list = field(default_factory=list)
 
     def render(self):
+        from rich.console import Group
         from rich.table import Table
 
         table = Table(title="Gyrocompassing: source 003 reproduced", show_lines=False)
-        for column in ("quantity", "printed", "computed", "unit", "agrees"):
-            table.add_column(column, justify="left" if column == "quantity" else "right")
+        for column in ("quantity", "printed", "computed", "unit", "agrees", "note"):
+            table.add_column(column, justify="left" if column in ("quantity", "note") else "right")
+        # notes are long: the table refers to them by number and lists them below it
+        footnotes = []
         for row in self.rows:
             printed = f"{row.printed:.6g}" if isinstance(row.printed, float) else str(row.printed)
-            table.add_row(row.quantity, printed, f"{row.computed:.6g}", row.unit, "yes" if row.agrees else "NO")
-        return table
+            reference = ""
+            if row.note:
+                footnotes.append(f"[{len(footnotes) + 1}] {_marked(row)}")
+                reference = f"[{len(footnotes)}]"
+            table.add_row(row.quantity, printed, f"{row.computed:.6g}", row.unit, "yes" if row.agrees else "NO",
+                          reference)
+        return Group(table, *footnotes, "Errata in equations (no number to compare):",
+                     *(f"- {note}" for note in self.notes))
+
+
+def _marked(row: ReproductionRow) -> str:
+    """A disagreeing row's note is the source's erratum; say so."""
+    return row.note if row.agrees else f"erratum: {row.note}"
 
 
 def _printed_aperiodic_time(c_gamma: float, c_a: float, latitude: float) -> float:

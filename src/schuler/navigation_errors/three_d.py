@@ -44,15 +44,10 @@ from __future__ import annotations
 import numpy as np
 
 from schuler.core.lti import StateSpace
+from schuler.core.rotation import skew
 from schuler.exceptions import InvalidParameter
 
 _AXES = ("north", "east", "down")
-
-
-def _skew(vector) -> np.ndarray:
-    """[a x]: the matrix with [a x] b = a x b."""
-    a1, a2, a3 = vector
-    return np.array([[0.0, -a3, a2], [a3, 0.0, -a1], [-a2, a1, 0.0]])
 
 
 def psi_angle_model(
@@ -118,12 +113,12 @@ def psi_angle_model(
     omega_squared = g / R
 
     F = np.zeros((9, 9))
-    F[0:3, 0:3] = -_skew(transport)
+    F[0:3, 0:3] = -skew(transport)
     F[0:3, 3:6] = np.eye(3)
     F[3:6, 0:3] = -omega_squared * np.diag([1.0, 1.0, -2.0])
-    F[3:6, 3:6] = -_skew(2.0 * earth_rate + transport)
-    F[3:6, 6:9] = _skew(specific_force)
-    F[6:9, 6:9] = -_skew(earth_rate + transport)
+    F[3:6, 3:6] = -skew(2.0 * earth_rate + transport)
+    F[3:6, 6:9] = skew(specific_force)
+    F[6:9, 6:9] = -skew(earth_rate + transport)
     G = np.zeros((9, 6))
     G[3:6, 0:3] = np.eye(3)
     G[6:9, 3:6] = np.eye(3)
