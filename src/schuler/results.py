@@ -84,3 +84,28 @@ class Result:
         with console.capture() as capture:
             console.print(self.render())
         return capture.get()
+
+
+class Footnotes:
+    """Numbered notes for a table: the table shows ``[n]``, the notes go below it.
+
+    A note given twice keeps its first number.
+
+    >>> notes = Footnotes()
+    >>> notes.reference("3,650 ft is the amplitude"), notes.reference(""), notes.reference("3,650 ft is the amplitude")
+    ('[1]', '', '[1]')
+    >>> notes.lines()
+    ['[1] 3,650 ft is the amplitude']
+    """
+
+    def __init__(self):
+        self._numbers: dict[str, int] = {}
+
+    def reference(self, *notes: str) -> str:
+        """The ``[n]`` marks for the given notes (empty notes are skipped)."""
+        numbers = sorted({self._numbers.setdefault(note, len(self._numbers) + 1) for note in notes if note})
+        return " ".join(f"[{n}]" for n in numbers)
+
+    def lines(self) -> list[str]:
+        """Each note once, in order of first reference: ``"[n] note"``."""
+        return [f"[{n}] {note}" for note, n in self._numbers.items()]

@@ -40,7 +40,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from schuler.exceptions import IdentificationError, InvalidParameter
-from schuler.ground_gyrocompass.motion import basis, check_decay_rate, check_positive, directive_coefficient
+from schuler.ground_gyrocompass.motion import basis_columns, check_decay_rate, check_positive, directive_coefficient
 from schuler.results import Result
 
 UNKNOWN_SETS = {
@@ -91,23 +91,35 @@ def design(time, decay_rate, coefficient, unknowns: int, reading: str, derivativ
     """Columns of the linear parameters and their derivatives w.r.t. lambda and B.
 
     Returns ``(phi, d_decay_rate, d_coefficient, names)``, arrays (n, p) and the
-    linear parameters' names in column order.
+    linear parameters' names in column order (zeros for the derivatives without
+    ``derivatives``).
     """
-    torque = unknowns == 5
-    b = basis(time, decay_rate, coefficient, torque=torque, derivatives=derivatives)
-    first = b.angle[0] - 1.0 if reading == "relative" else b.angle[0]
-    keep = [0, 1, 2] if torque else [0, 1]
-    phi = np.column_stack([first] + [b.angle[k] for k in keep[1:]])
-    d_lam = np.column_stack([b.d_decay_rate[k] for k in keep])
-    d_b = np.column_stack([b.d_coefficient[k] for k in keep])
-    names = ["alpha0", "alpha0_dot"] + (["specific_torque"] if torque else [])
-    if reading == "absolute":
-        ones = np.ones((time.size, 1))
-        phi = np.hstack([phi, ones])
-        d_lam = np.hstack([d_lam, 0.0 * ones])
-        d_b = np.hstack([d_b, 0.0 * ones])
-        names.append("offset")
+    check_decay_rate(decay_rate)
+    check_positive(coefficient, "B", "1/s^2")
+    time = np.asarray(time, dtype=float)
+    phi, d_lam, d_b, names = _design(time, float(decay_rate), float(coefficient), unknowns, reading, derivatives)
+    if not derivatives:
+        d_lam = d_b = np.zeros_like(phi)
     return phi, d_lam, d_b, names
+
+
+def _design(time, decay_rate, coefficient, unknowns, reading, derivatives):
+    """:func:`design` for validated float parameters (d_lam, d_b are None without ``derivatives``)."""
+    torque = unknowns == 5
+    angle, d_lam, d_b = basis_columns(time, decay_rate, coefficient, torque, derivatives)
+    names = ["alpha0", "alpha0_dot"] + (["specific_torque"] if torque else [])
+    angle[0] = angle[0] - 1.0 if reading == "relative" else angle[0]
+    if reading == "absolute":
+        # the offset's column is 1 and does not depend on lambda or B
+        angle.append(np.ones(time.size))
+        if derivatives:
+            d_lam.append(np.zeros(time.size))
+            d_b.append(np.zeros(time.size))
+        names.append("offset")
+    phi = np.column_stack(angle)
+    if not derivatives:
+        return phi, None, None, names
+    return phi, np.column_stack(d_lam), np.column_stack(d_b), names
 
 
 def _cumulative_trapezoid(values, time):
@@ -193,12 +205,6 @@ class Fit:
     message: str
 
 
-def _linear_solve(phi, observed):
-    q, r = np.linalg.qr(phi)
-    coefficients = np.linalg.solve(r, q.T @ observed)  # r is at most 4x4: a plain solve is cheapest
-    return q, r, coefficients
-
-
 def covariance(jacobian, observed_residuals, unknowns):
     """cov = s^2 (J^T J)^-1 from the full Jacobian J (n, p) and the residuals (column-scaled SVD).
 
@@ -249,13 +255,21 @@ def parameter_order(unknowns: int, reading: str) -> tuple:
 
 
 class _Projected:
-    """Projected residual r(x) and its Golub-Pereyra Jacobian, x = ln of the nonlinear parameters."""
+    """Projected residual r(x) and its Golub-Pereyra Jacobian, x = ln of the nonlinear parameters.
+
+    The caller validates the record and the parameters once; lambda = exp(x) and
+    B = exp(x) stay positive, so the evaluations skip the checks (at a few hundred
+    samples they would cost as much as the Bessel functions).
+    """
 
     def __init__(self, time, observed, unknowns, reading, decay_rate, coefficient):
         self.time, self.observed, self.unknowns, self.reading = time, observed, unknowns, reading
-        self.known = {"decay_rate": decay_rate, "coefficient": coefficient}
+        self.known = {"decay_rate": float(decay_rate), "coefficient": float(coefficient)}
         self.free = [n for n in UNKNOWN_SETS[unknowns] if n in ("decay_rate", "coefficient")]
-        self._cache_key = None
+        # the last two points evaluated: scipy asks for the residual and then the
+        # Jacobian at the same x, and at the end for the Jacobian at the best point,
+        # which is the one before MINPACK's last (rejected or final) trial step
+        self._recent = []
         self.evaluations = 0
 
     def parameters(self, x):
@@ -264,34 +278,38 @@ class _Projected:
             values[name] = math.exp(value)
         return values
 
-    def _evaluate(self, x):
-        key = np.asarray(x).tobytes()
-        if key == self._cache_key:
-            return self._cache
+    def evaluate(self, x):
+        """(residual, Jacobian in x, linear coefficients, their names, parameters, (phi, d_lam, d_b)) at x."""
+        key = np.asarray(x, dtype=float).tobytes()
+        for recent_key, recent in self._recent:
+            if recent_key == key:
+                return recent
         values = self.parameters(x)
-        phi, d_lam, d_b, names = design(
-            self.time, values["decay_rate"], values["coefficient"], self.unknowns, self.reading
+        phi, d_lam, d_b, names = _design(
+            self.time, values["decay_rate"], values["coefficient"], self.unknowns, self.reading, True
         )
         self.evaluations += 1
-        q, r, coefficients = _linear_solve(phi, self.observed)
+        q, r = np.linalg.qr(phi)
+        coefficients = np.linalg.solve(r, q.T @ self.observed)  # r is at most 4x4: a plain solve is cheapest
         residual = self.observed - phi @ coefficients
-        jacobian = []
-        for name in self.free:
-            derivative = d_lam if name == "decay_rate" else d_b
-            a = derivative @ coefficients
-            a_perp = a - q @ (q.T @ a)
-            b = q @ np.linalg.solve(r.T, derivative.T @ residual)
-            jacobian.append(-(a_perp + b) * values[name])  # chain rule for the ln parameter
-        self._cache_key = key
-        self._cache = (residual, np.column_stack(jacobian) if jacobian else None, coefficients, names, values)
-        self.design = (phi, d_lam, d_b)
-        return self._cache
+        jacobian = None
+        if self.free:
+            derivatives = [d_lam if name == "decay_rate" else d_b for name in self.free]
+            # Golub-Pereyra: dr/dtheta = -(P_perp D c + Q R^-T D^T r), P_perp = I - Q Q^T;
+            # all free parameters in one pass (one triangular solve with several right sides)
+            a = np.column_stack([derivative @ coefficients for derivative in derivatives])
+            rhs = np.column_stack([derivative.T @ residual for derivative in derivatives])
+            scale = np.array([values[name] for name in self.free])  # chain rule for the ln parameters
+            jacobian = -(a + q @ (np.linalg.solve(r.T, rhs) - q.T @ a)) * scale
+        result = (residual, jacobian, coefficients, names, values, (phi, d_lam, d_b))
+        self._recent = [self._recent[-1], (key, result)] if self._recent else [(key, result)]
+        return result
 
     def residual(self, x):
-        return self._evaluate(x)[0]
+        return self.evaluate(x)[0]
 
     def jacobian(self, x):
-        return self._evaluate(x)[1]
+        return self.evaluate(x)[1]
 
 
 def _close(first, second, tolerance):
@@ -356,11 +374,11 @@ def fit_least_squares(time, observed, unknowns, decay_rate, coefficient, reading
         converged, message = bool(best[1].status > 0), str(best[1].message)
     else:
         x, converged, message = [], True, "linear least squares (2x2 normal equations, eq. (10))"
-    residual, _, coefficients, names, values = problem._evaluate(np.asarray(x, dtype=float))
+    residual, _, coefficients, names, values, columns = problem.evaluate(np.asarray(x, dtype=float))
     values = {"specific_torque": 0.0, "offset": 0.0, **values}
     values.update({name: float(value) for name, value in zip(names, coefficients)})
     order = parameter_order(unknowns, reading)
-    cov = covariance(jacobian_from_design(*problem.design, coefficients, unknowns), residual, unknowns)
+    cov = covariance(jacobian_from_design(*columns, coefficients, unknowns), residual, unknowns)
     return Fit(values, order, cov, float(residual @ residual), residual, problem.evaluations, converged, message)
 
 

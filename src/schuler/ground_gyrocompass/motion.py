@@ -188,26 +188,70 @@ def basis(time, decay_rate, coefficient, torque: bool = True, derivatives: bool 
     """
     check_decay_rate(decay_rate)
     check_positive(coefficient, "B", "1/s^2")
-    z, z0 = bessel_argument(np.asarray(time, dtype=float), decay_rate, coefficient)
-    lam = np.asarray(decay_rate, dtype=float)
+    time = np.asarray(time, dtype=float)
+    decay_rate = np.asarray(decay_rate, dtype=float)
+    coefficient = np.asarray(coefficient, dtype=float)
+    angle, d_lam, d_b = basis_columns(time, decay_rate, coefficient, torque, derivatives)
+    shape = np.broadcast(time, decay_rate, coefficient).shape
+    if not torque:
+        angle.append(np.zeros(shape))
+    angle = np.stack(np.broadcast_arrays(*angle))
+    if not derivatives:
+        zeros = np.zeros_like(angle)
+        return Basis(angle, zeros, zeros)
+    if not torque:
+        d_lam.append(np.zeros(shape))
+        d_b.append(np.zeros(shape))
+    return Basis(angle, np.stack(np.broadcast_arrays(*d_lam)), np.stack(np.broadcast_arrays(*d_b)))
+
+
+def basis_columns(time, decay_rate, coefficient, torque: bool, derivatives: bool):
+    """The arithmetic of :func:`basis`, without its checks: lists of columns.
+
+    For callers that evaluate the basis many times at parameters they have already
+    validated (the least-squares fit's inner loop), where the checks and the
+    stacking of :func:`basis` would cost more than the Bessel functions.
+
+    Parameters
+    ----------
+    time : ndarray
+        Time since release t, s (float array).
+    decay_rate, coefficient : float or ndarray
+        lambda (1/s) and B (1/s^2), both > 0 and finite (not checked).
+    torque, derivatives : bool
+        As in :func:`basis`.
+
+    Returns
+    -------
+    angle, d_decay_rate, d_coefficient : list of ndarray
+        [u1, u2] (+ [u3] with ``torque``) and their derivatives w.r.t. lambda and B
+        (empty lists without ``derivatives``); arrays broadcast from the inputs
+        (u1 and u2 always have the full broadcast shape).
+
+    Examples
+    --------
+    >>> angle, d_lam, d_b = basis_columns(np.array([0.0, 10.0]), SOURCE_LAMBDA, 0.0135849, False, True)
+    >>> len(angle), len(d_lam), float(np.round(angle[0][0], 12))
+    (2, 2, 1.0)
+    """
+    z, z0 = bessel_argument(time, decay_rate, coefficient)
+    lam = decay_rate
     j0z, y0z, j0a, y0a, j1a, y1a = j0(z), y0(z), j0(z0), y0(z0), j1(z0), y1(z0)
     c1 = j1a * y0z - j0z * y1a
     d = j0a * y0z - j0z * y0a
     u1 = 0.5 * math.pi * z0 * c1
     u2 = -math.pi / lam * d
-    shape = np.broadcast(z, lam).shape
-    u3 = np.zeros(shape)
+    angle = [u1, u2]
     if torque:
         a0_, cy0 = it2j0y0(z0)
         a_, cy = it2j0y0(z)
         # int_z^z0 J0(x)/x dx = ln(z0/z) - [A(z0) - A(z)], ln(z0/z) = lambda t / 2
-        p_j = 0.5 * lam * np.asarray(time, dtype=float) - (a0_ - a_)
+        p_j = 0.5 * lam * time - (a0_ - a_)
         p_y = cy - cy0  # int_z^z0 Y0(x)/x dx
         u3 = 2.0 * math.pi / lam**2 * (j0z * p_y - y0z * p_j)
-    angle = np.stack(np.broadcast_arrays(u1, u2, u3))
+        angle.append(u3)
     if not derivatives:
-        zeros = np.zeros_like(angle)
-        return Basis(angle, zeros, zeros)
+        return angle, [], []
 
     j1z, y1z = j1(z), y1(z)
     # partial derivatives in z0 (z held) and in z (z0 held)
@@ -217,9 +261,9 @@ def basis(time, decay_rate, coefficient, torque: bool = True, derivatives: bool 
     du2_dz = -math.pi / lam * (-j0a * y1z + j1z * y0a)
     du2_dlam = math.pi / lam**2 * d
     dz0_dlam = -z0 / lam
-    dz_dlam = -z * (1.0 / lam + 0.5 * np.asarray(time, dtype=float))
-    dz0_dB = z0 / (2.0 * np.asarray(coefficient, dtype=float))
-    dz_dB = z / (2.0 * np.asarray(coefficient, dtype=float))
+    dz_dlam = -z * (1.0 / lam + 0.5 * time)
+    dz0_dB = z0 / (2.0 * coefficient)
+    dz_dB = z / (2.0 * coefficient)
     d_lam = [
         du1_dz0 * dz0_dlam + du1_dz * dz_dlam,
         du2_dz0 * dz0_dlam + du2_dz * dz_dlam + du2_dlam,
@@ -233,10 +277,7 @@ def basis(time, decay_rate, coefficient, torque: bool = True, derivatives: bool 
         du3_dlam = -2.0 / lam * u3
         d_lam.append(du3_dz0 * dz0_dlam + du3_dz * dz_dlam + du3_dlam)
         d_b.append(du3_dz0 * dz0_dB + du3_dz * dz_dB)
-    else:
-        d_lam.append(np.zeros(shape))
-        d_b.append(np.zeros(shape))
-    return Basis(angle, np.stack(np.broadcast_arrays(*d_lam)), np.stack(np.broadcast_arrays(*d_b)))
+    return angle, d_lam, d_b
 
 
 def closed_form(time, alpha0, alpha0_dot, decay_rate, coefficient, specific_torque=0.0):

@@ -20,7 +20,7 @@ from schuler.ground_gyrocompass import motion
 from schuler.ground_gyrocompass.grid import STEP_ALPHA0, misfit_grid, refine, refine_around, source_boxes
 from schuler.ground_gyrocompass.identification import NorthEstimate, identify
 from schuler.ground_gyrocompass.observations import sample_times
-from schuler.results import Result
+from schuler.results import Footnotes, Result
 
 K_VALUES = np.arange(-9, 10)  # alpha0 = k pi/540
 M_VALUES = np.arange(-6, 7)  # alpha0_dot = m 1e-4 rad/s
@@ -267,7 +267,7 @@ class SourceReproduction(Result):
             f"(alpha0 error {four['refined_alpha0_error_rad']:.3g} rad)"
         )
         # notes are long and some repeat: the table refers to them by number and lists each once below it
-        footnotes: dict[str, int] = {}
+        footnotes = Footnotes()
         for row in self.stages:
             notes = []
             if not row["best_agrees"]:
@@ -278,8 +278,7 @@ class SourceReproduction(Result):
                 ))
             if not row["misfit_agrees"]:
                 notes.append(misfit_note)
-            references = " ".join(f"[{n}]" for n in sorted(footnotes.setdefault(note, len(footnotes) + 1)
-                                                            for note in notes))
+            references = footnotes.reference(*notes)
             stages.add_row(
                 str(row["unknowns"]),
                 str(row["stage"]),
@@ -302,7 +301,7 @@ class SourceReproduction(Result):
                 f"{row['best_scale']:.3g}",
                 f"{100 * row['max_deviation']:.0f} %",
             )
-        return Group(self.estimate.render(), stages, *(f"[{n}] {note}" for note, n in footnotes.items()), readings)
+        return Group(self.estimate.render(), stages, *footnotes.lines(), readings)
 
 
 def reproduce(unknowns: int = 4, method: str = "lsq") -> SourceReproduction:

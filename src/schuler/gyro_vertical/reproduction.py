@@ -26,7 +26,7 @@ from schuler.gyro_vertical.friction import friction_from_velocity_error
 from schuler.gyro_vertical.model import GreatCircleTrajectory, GyroVertical, transport_coriolis_acceleration
 from schuler.gyro_vertical.quasi_steady import Analysis, analyse, split_schuler_frequencies, steady_errors
 from schuler.registry import ReproductionRow
-from schuler.results import Result
+from schuler.results import Footnotes, Result
 
 SOURCE = "Drozdovich (1959), 'On an inertial method of measuring velocities', JPRS 2912 (source 000)"
 LATITUDE = math.radians(60.0)
@@ -167,16 +167,12 @@ class VerticalReproduction(Result):
         for column in ("quantity", "source", "computed", "unit", "agrees", "note"):
             table.add_column(column, overflow="fold")
         # notes are long: the table refers to them by number and lists them below it
-        footnotes = []
+        footnotes = Footnotes()
         for row in self.rows():
             printed = row.printed if isinstance(row.printed, str) else f"{row.printed:.4g}"
-            reference = ""
-            if row.note:
-                footnotes.append(f"[{len(footnotes) + 1}] {row.note}")
-                reference = f"[{len(footnotes)}]"
             table.add_row(row.quantity, printed, f"{row.computed:.4g}", row.unit, "yes" if row.agrees else "NO",
-                          reference)
-        return Group(table, *footnotes, f"Constants: {self.constants}")
+                          footnotes.reference(row.note))
+        return Group(table, *footnotes.lines(), f"Constants: {self.constants}")
 
 
 def mean_velocity_error(response) -> float:

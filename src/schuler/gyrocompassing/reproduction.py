@@ -17,7 +17,7 @@ from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.core.lti import simulate
 from schuler.gyrocompassing import analytic, models, plots, study
 from schuler.registry import FigureRef, ReportSection, ReproductionRow
-from schuler.results import Result
+from schuler.results import Footnotes, Result
 from schuler.units import from_unit, to_unit
 
 KYIV_LATITUDE = math.radians(50.45)
@@ -53,16 +53,13 @@ class ReproductionResult(Result):
         for column in ("quantity", "printed", "computed", "unit", "agrees", "note"):
             table.add_column(column, justify="left" if column in ("quantity", "note") else "right")
         # notes are long: the table refers to them by number and lists them below it
-        footnotes = []
+        footnotes = Footnotes()
         for row in self.rows:
             printed = f"{row.printed:.6g}" if isinstance(row.printed, float) else str(row.printed)
-            reference = ""
-            if row.note:
-                footnotes.append(f"[{len(footnotes) + 1}] {_marked(row)}")
-                reference = f"[{len(footnotes)}]"
+            reference = footnotes.reference(_marked(row) if row.note else "")
             table.add_row(row.quantity, printed, f"{row.computed:.6g}", row.unit, "yes" if row.agrees else "NO",
                           reference)
-        return Group(table, *footnotes, "Errata in equations (no number to compare):",
+        return Group(table, *footnotes.lines(), "Errata in equations (no number to compare):",
                      *(f"- {note}" for note in self.notes))
 
 

@@ -7,7 +7,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from schuler.results import Result
+from schuler.results import Footnotes, Result
 from schuler.units import to_unit
 
 DISPLAY_UNITS = ("ft", "m", "mi")
@@ -90,16 +90,13 @@ class ReproductionResult(Result):
         for column in ("source", "earth", "quantity", "printed", "computed", "agrees", "note"):
             table.add_column(column, justify="right" if column in ("printed", "computed") else "left")
         # notes are long: the table refers to them by number and lists them below it
-        footnotes = []
+        footnotes = Footnotes()
         for row in self.rows:
             computed_ft = 0.0 if abs(row.computed_ft) < 1e-6 else row.computed_ft  # rounding at omega t = 4 pi
-            reference = ""
-            if row.note:
-                footnotes.append(f"[{len(footnotes) + 1}] {row.source}, {row.earth}, {row.quantity}: {row.note}")
-                reference = f"[{len(footnotes)}]"
+            reference = footnotes.reference(f"{row.source}, {row.earth}, {row.quantity}: {row.note}" if row.note else "")
             table.add_row(row.source, row.earth, row.quantity, _length(row.printed_ft * 0.3048, unit),
                           _length(computed_ft * 0.3048, unit), "yes" if row.agrees else "NO", reference)
-        return Group(table, *footnotes, *self.notes)
+        return Group(table, *footnotes.lines(), *self.notes)
 
 
 @dataclass
