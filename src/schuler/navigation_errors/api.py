@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from schuler.core.earth import BOLLAY, FOOT, PRESETS
+from schuler.core.earth import BOLLAY, FOOT, PRESETS, STATUTE_MILE
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
 from schuler.io import save_figure_formats, write_dataframe_csv
@@ -389,16 +389,24 @@ def write_foucault_figure(outdir: Path, unit: str = "ft") -> list[Path]:
     return save_figure_formats(fig, Path(outdir) / "errors_foucault")
 
 
+def _report_row(row) -> ReproductionRow:
+    """A Problem 3 row as the report shows it: feet to 0.1 ft (zeros at omega t = 4 pi are
+    rounding), the hover error in miles as the source prints it."""
+    quantity = f"{row.source}, {row.earth}, {row.quantity}"
+    if row.source == "hover":
+        mile_ft = STATUTE_MILE / FOOT
+        return ReproductionRow(quantity, round(row.printed_ft / mile_ft, 1), round(row.computed_ft / mile_ft, 1), "mi",
+                               row.agrees, row.note)
+    return ReproductionRow(quantity, row.printed_ft, round(row.computed_ft, 1) + 0.0, "ft", row.agrees, row.note)
+
+
 def report(outdir: Path) -> ReportSection:
     """Write this system's figures into ``outdir`` and describe them with the reproduction table."""
     outdir = Path(outdir)
     write_problem3_figures(outdir)
     write_vertical_figure(outdir)
     write_foucault_figure(outdir)
-    rows = [
-        ReproductionRow(f"{r.source}, {r.earth}, {r.quantity}", r.printed_ft, r.computed_ft, "ft", r.agrees, r.note)
-        for r in problem3_rows()
-    ]
+    rows = [_report_row(r) for r in problem3_rows()]
     figures = [FigureRef(f"errors_{s}.png", f"Problem 3, {plots.SOURCE_TITLES[s]}: flat vs spherical Earth over "
                                             "0..10,120 s (markers: simulation of the error equations)")
                for s in SOURCES]

@@ -198,6 +198,8 @@ def _number(value) -> str:
     if isinstance(value, (int, float)):
         if isinstance(value, float) and not math.isfinite(value):
             return html.escape(str(value))
+        if 1e4 <= abs(value) < 1e9:
+            return html.escape(f"{value:,.6g}" if abs(value) < 1e6 else f"{value:,.0f}")  # 1,620,000 not 1.62e+06
         return html.escape(f"{value:.6g}")
     return html.escape(str(value))
 
