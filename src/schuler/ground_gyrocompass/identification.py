@@ -19,12 +19,12 @@ Sets of unknowns (the source's three plus one):
 
 The fit is nonlinear least squares by variable projection (Golub and Pereyra): for
 given (lambda, B) the linear parameters are solved exactly by QR, and
-Levenberg-Marquardt (scipy ``least_squares``) minimises the projected residual over
-ln(lambda) and ln(B), with the exact Golub-Pereyra Jacobian built from the
-closed-form derivatives of the Bessel basis. The start needs no grid: lambda and B
-come from a linear regression on the twice-integrated equation of motion
-(:func:`initial_estimate`); the instrument's nominal values are a second start,
-and the better of the two fits is kept.
+Levenberg-Marquardt (MINPACK's lmder, through scipy ``leastsq``) minimises the
+projected residual over ln(lambda) and ln(B), with the exact Golub-Pereyra Jacobian
+built from the closed-form derivatives of the Bessel basis. The start needs no
+grid: lambda and B come from a linear regression on the twice-integrated equation
+of motion (:func:`initial_estimate`); the instrument's nominal values are a second
+start, and the better of the two fits is kept.
 
 Standard errors come from the full Jacobian J at the optimum and the residual:
 cov = s^2 (J^T J)^-1 with s^2 = misfit / (n - p).
@@ -37,7 +37,8 @@ from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.linalg.lapack import dgeqrf, dorgqr, dtrtrs
+from scipy.optimize import leastsq
 
 from schuler.exceptions import IdentificationError, InvalidParameter
 from schuler.ground_gyrocompass.motion import basis_columns, check_decay_rate, check_positive, directive_coefficient
@@ -122,10 +123,32 @@ def _design(time, decay_rate, coefficient, unknowns, reading, derivatives):
     return phi, np.column_stack(d_lam), np.column_stack(d_b), names
 
 
-def _cumulative_trapezoid(values, time):
-    """Running trapezoid integral from time[0] of each column of ``values`` (n, k)."""
-    steps = 0.5 * (values[1:] + values[:-1]) * np.diff(time)[:, None]
-    return np.vstack([np.zeros((1, values.shape[1])), np.cumsum(steps, axis=0)])
+def _householder(matrix):
+    """Thin QR factors (Q (n, p), R (p, p) in its upper triangle) of a tall matrix.
+
+    LAPACK's Householder QR directly (what numpy.linalg.qr calls), without numpy's
+    per-call overhead, which at a few columns costs more than the arithmetic; the
+    triangular solves read only the upper triangle of R.
+    """
+    packed, tau, _, _ = dgeqrf(matrix)
+    q, _, _ = dorgqr(packed, tau)
+    return q, packed[: matrix.shape[1]]
+
+
+def _solve_triangular(r, rhs, transpose=False):
+    """Solve R x = rhs (or R^T x = rhs) with R the upper triangle of ``r`` (LAPACK dtrtrs)."""
+    solution, info = dtrtrs(r, rhs, lower=0, trans=int(transpose))
+    if info > 0:
+        raise IdentificationError("the record does not depend on every linear unknown: not identifiable")
+    return solution
+
+
+def _cumulative_trapezoid(values, time_steps):
+    """Running trapezoid integral from the first sample of each column of ``values`` (n, k)."""
+    integral = np.empty_like(values)
+    integral[0] = 0.0
+    np.cumsum(0.5 * (values[1:] + values[:-1]) * time_steps[:, None], axis=0, out=integral[1:])
+    return integral
 
 
 def initial_estimate(time, observed):
@@ -155,19 +178,31 @@ def initial_estimate(time, observed):
     if span <= 0.0 or time.size < 12:
         return None
     tau = time / span  # scaled time keeps the polynomial columns well conditioned
-    powers = tau[:, None] ** np.arange(6)
-    twice = _cumulative_trapezoid(_cumulative_trapezoid(powers[:, :4] * observed[:, None], time), time)
+    powers = np.vander(tau, 6, increasing=True)
+    steps = np.diff(time)
+    twice = _cumulative_trapezoid(_cumulative_trapezoid(powers[:, :4] * observed[:, None], steps), steps)
     matrix = np.hstack([powers[:, :2], twice, powers[:, 2:]])
     norms = np.linalg.norm(matrix, axis=0)
     if np.any(norms == 0.0):
         return None
-    solution = np.linalg.lstsq(matrix / norms, observed, rcond=None)[0] / norms
+    matrix /= norms
+    # QR is a third of the cost of lstsq's SVD; the two agree to round-off unless
+    # the columns are nearly dependent, where lstsq's minimum-norm answer is kept
+    q_factor, r_factor = _householder(matrix)
+    diagonal = np.abs(np.diag(r_factor))
+    if diagonal.min() > 1e-10 * diagonal.max():
+        solution = _solve_triangular(r_factor, q_factor.T @ observed) / norms
+    else:  # (nearly) dependent columns: the minimum-norm solution
+        solution = np.linalg.lstsq(matrix, observed, rcond=None)[0] / norms
     q = -(powers[:, :4] @ solution[2:6])
     usable = q > 0.0
-    if usable.sum() < 3:
+    if np.count_nonzero(usable) < 3:
         return None
-    line = np.column_stack([np.ones(usable.sum()), time[usable]])
-    intercept, slope = np.linalg.lstsq(line, np.log(q[usable]), rcond=None)[0]
+    # straight line ln q = intercept + slope t, by the centred normal equation (two unknowns)
+    line_time = time[usable] - time[usable].mean()
+    log_q = np.log(q[usable])
+    slope = (line_time @ log_q) / (line_time @ line_time)
+    intercept = log_q.mean() - slope * time[usable].mean()
     decay_rate, coefficient = -slope, math.exp(intercept)
     if not (0.0 < decay_rate < 10.0 / span and math.isfinite(coefficient) and coefficient > 0.0):
         return None
@@ -266,9 +301,9 @@ class _Projected:
         self.time, self.observed, self.unknowns, self.reading = time, observed, unknowns, reading
         self.known = {"decay_rate": float(decay_rate), "coefficient": float(coefficient)}
         self.free = [n for n in UNKNOWN_SETS[unknowns] if n in ("decay_rate", "coefficient")]
-        # the last two points evaluated: scipy asks for the residual and then the
-        # Jacobian at the same x, and at the end for the Jacobian at the best point,
-        # which is the one before MINPACK's last (rejected or final) trial step
+        # the last two points evaluated: MINPACK asks for the residual and then the
+        # Jacobian at the same x, and the fit ends with the covariance at the best
+        # point, usually the one before MINPACK's last (rejected or tiny) trial step
         self._recent = []
         self.evaluations = 0
 
@@ -289,8 +324,8 @@ class _Projected:
             self.time, values["decay_rate"], values["coefficient"], self.unknowns, self.reading, True
         )
         self.evaluations += 1
-        q, r = np.linalg.qr(phi)
-        coefficients = np.linalg.solve(r, q.T @ self.observed)  # r is at most 4x4: a plain solve is cheapest
+        q, r = _householder(phi)
+        coefficients = _solve_triangular(r, q.T @ self.observed)
         residual = self.observed - phi @ coefficients
         jacobian = None
         if self.free:
@@ -300,7 +335,7 @@ class _Projected:
             a = np.column_stack([derivative @ coefficients for derivative in derivatives])
             rhs = np.column_stack([derivative.T @ residual for derivative in derivatives])
             scale = np.array([values[name] for name in self.free])  # chain rule for the ln parameters
-            jacobian = -(a + q @ (np.linalg.solve(r.T, rhs) - q.T @ a)) * scale
+            jacobian = -(a + q @ (_solve_triangular(r, rhs, transpose=True) - q.T @ a)) * scale
         result = (residual, jacobian, coefficients, names, values, (phi, d_lam, d_b))
         self._recent = [self._recent[-1], (key, result)] if self._recent else [(key, result)]
         return result
@@ -310,6 +345,18 @@ class _Projected:
 
     def jacobian(self, x):
         return self.evaluate(x)[1]
+
+
+TERMINATION = {
+    1: "`ftol` termination condition is satisfied.",
+    2: "`xtol` termination condition is satisfied.",
+    3: "Both `ftol` and `xtol` termination conditions are satisfied.",
+    4: "`gtol` termination condition is satisfied.",
+}
+"""MINPACK lmder's successful exit codes. Its codes 6-8 (a tolerance below machine
+precision) cannot occur with tolerances >= 2.2e-16; 5 is the evaluation limit."""
+
+MAXIMUM_EVALUATIONS = "The maximum number of function evaluations is exceeded."
 
 
 def _close(first, second, tolerance):
@@ -351,6 +398,8 @@ def fit_least_squares(time, observed, unknowns, decay_rate, coefficient, reading
     best = None
     if problem.free:
         if start is not None:
+            check_decay_rate(start[0], "start lambda")
+            check_positive(start[1], "start B", "1/s^2")
             starts = [start]
         else:
             estimate = initial_estimate(time, observed)
@@ -360,18 +409,23 @@ def fit_least_squares(time, observed, unknowns, decay_rate, coefficient, reading
         for guess in starts:
             if guess is None:
                 continue
-            x0 = [math.log(guess[0] if name == "decay_rate" else guess[1]) for name in problem.free]
+            x0 = np.log([guess[0] if name == "decay_rate" else guess[1] for name in problem.free])
+            if not np.all(np.isfinite(problem.residual(x0))):
+                raise IdentificationError("the model is not finite at the start values (lambda t too large?)")
             # tight tolerances: a noise-free record is fitted to round-off (1e-9 relative
-            # is required); Levenberg-Marquardt converges quadratically near a zero residual
-            solution = least_squares(
-                problem.residual, x0, jac=problem.jacobian, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
-                max_nfev=200,
+            # is required); Levenberg-Marquardt converges quadratically near a zero residual.
+            # leastsq runs the same MINPACK lmder with the same defaults (diag from the
+            # Jacobian's column norms, factor 100) as least_squares(method="lm"), so the
+            # iterates are identical, at a fraction of least_squares' per-call overhead
+            solution, _, info, _, status = leastsq(
+                problem.residual, x0, Dfun=problem.jacobian, full_output=True, xtol=1e-15, ftol=1e-15,
+                gtol=1e-15, maxfev=200,
             )
-            cost = float(solution.fun @ solution.fun)
+            cost = float(info["fvec"] @ info["fvec"])
             if best is None or cost < best[0]:
-                best = (cost, solution)
-        x = best[1].x
-        converged, message = bool(best[1].status > 0), str(best[1].message)
+                best = (cost, solution, status)
+        x, status = best[1], best[2]
+        converged, message = status in TERMINATION, TERMINATION.get(status, MAXIMUM_EVALUATIONS)
     else:
         x, converged, message = [], True, "linear least squares (2x2 normal equations, eq. (10))"
     residual, _, coefficients, names, values, columns = problem.evaluate(np.asarray(x, dtype=float))

@@ -60,6 +60,8 @@ SOURCE_STEP = 1.0  # every 1 s
 
 def check_decay_rate(decay_rate, name: str = "lambda") -> None:
     """Raise InvalidParameter unless every decay rate lambda is finite and > 0."""
+    if isinstance(decay_rate, float) and 0.0 < decay_rate < math.inf:
+        return  # a valid scalar, without numpy's per-call cost (checked once per fit)
     values = np.asarray(decay_rate, dtype=float)
     if not np.all(np.isfinite(values)) or np.any(values <= 0.0):
         raise InvalidParameter(name, f"{values.ravel()[0]:g} 1/s: the rotor's decay rate must be > 0")
@@ -67,6 +69,8 @@ def check_decay_rate(decay_rate, name: str = "lambda") -> None:
 
 def check_positive(value, name: str, unit: str) -> None:
     """Raise InvalidParameter unless every value is finite and > 0."""
+    if isinstance(value, float) and 0.0 < value < math.inf:
+        return  # a valid scalar, without numpy's per-call cost
     values = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(values)) or np.any(values <= 0.0):
         bad = values.ravel()[~(np.isfinite(values.ravel()) & (values.ravel() > 0))][0]
@@ -254,29 +258,32 @@ def basis_columns(time, decay_rate, coefficient, torque: bool, derivatives: bool
         return angle, [], []
 
     j1z, y1z = j1(z), y1(z)
-    # partial derivatives in z0 (z held) and in z (z0 held)
-    du1_dz0 = 0.5 * math.pi * c1 + 0.5 * math.pi * z0 * ((j0a - j1a / z0) * y0z - j0z * (y0a - y1a / z0))
-    du1_dz = 0.5 * math.pi * z0 * (-j1a * y1z + j1z * y1a)
-    du2_dz0 = -math.pi / lam * (-j1a * y0z + j0z * y1a)
-    du2_dz = -math.pi / lam * (-j0a * y1z + j1z * y0a)
-    du2_dlam = math.pi / lam**2 * d
-    dz0_dlam = -z0 / lam
-    dz_dlam = -z * (1.0 / lam + 0.5 * time)
-    dz0_dB = z0 / (2.0 * coefficient)
-    dz_dB = z / (2.0 * coefficient)
+    # Partial derivatives in z0 (z held) and in z (z0 held), simplified with the
+    # recurrences so that c1 cancels:
+    #   du1/dz0 = (pi z0 / 2) d,            du1/dz = (pi z0 / 2) e,
+    #   du2/dz0 = (pi / lambda) c1,         du2/dz = -(pi / lambda) f,
+    # e = J1(z) Y1(z0) - J1(z0) Y1(z), f = J1(z) Y0(z0) - J0(z0) Y1(z); then the
+    # chain rule with dz0/dlambda = -z0/lambda, dz/dlambda = -g, dz0/dB = z0/(2B),
+    # dz/dB = z/(2B), and the explicit du2/dlambda = (pi / lambda^2) d.
+    e = j1z * y1a - j1a * y1z
+    f = j1z * y0a - j0a * y1z
+    g = z * (1.0 / lam + 0.5 * time)
+    z0_c1 = z0 * c1
     d_lam = [
-        du1_dz0 * dz0_dlam + du1_dz * dz_dlam,
-        du2_dz0 * dz0_dlam + du2_dz * dz_dlam + du2_dlam,
+        -0.5 * math.pi * z0 * (z0 / lam * d + e * g),
+        math.pi / lam**2 * (d - z0_c1) + math.pi / lam * (f * g),
     ]
-    d_b = [du1_dz0 * dz0_dB + du1_dz * dz_dB, du2_dz0 * dz0_dB + du2_dz * dz_dB]
+    d_b = [
+        0.25 * math.pi * z0 / coefficient * (z0 * d + z * e),
+        0.5 * math.pi / (lam * coefficient) * (z0_c1 - z * f),
+    ]
     if torque:
         k = 2.0 * math.pi / lam**2
-        # p_j = int_z^z0 J0/x: d/dz0 = J0(z0)/z0, d/dz = -J0(z)/z; same for p_y with Y0
-        du3_dz0 = k * (j0z * y0a / z0 - y0z * j0a / z0)
-        du3_dz = k * (-j1z * p_y + y1z * p_j)  # the J0 Y0 / z terms cancel
-        du3_dlam = -2.0 / lam * u3
-        d_lam.append(du3_dz0 * dz0_dlam + du3_dz * dz_dlam + du3_dlam)
-        d_b.append(du3_dz0 * dz0_dB + du3_dz * dz_dB)
+        # p_j = int_z^z0 J0/x: d/dz0 = J0(z0)/z0, d/dz = -J0(z)/z; same for p_y with Y0,
+        # so du3/dz0 = -k d / z0 and in du3/dz the J0 Y0 / z terms cancel
+        du3_dz = k * (y1z * p_j - j1z * p_y)
+        d_lam.append(k / lam * d - du3_dz * g - 2.0 / lam * u3)
+        d_b.append((z * du3_dz - k * d) / (2.0 * coefficient))
     return angle, d_lam, d_b
 
 
