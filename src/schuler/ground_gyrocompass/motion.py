@@ -353,6 +353,8 @@ def simulate(time, alpha0, alpha0_dot, decay_rate, coefficient, specific_torque=
         t_eval=time,
         rtol=1e-12,
         atol=1e-14,
+        # scipy's automatic first step divides by the state's size: 0/0 for a record at rest
+        first_step=min(1e-3, float(time[-1])) or None,
     )
     if not solution.success:
         raise SimulationError(f"integration of eq. (4) failed: {solution.message}")
