@@ -75,3 +75,11 @@ def test_emit_uses_120_columns_when_stdout_is_not_a_terminal(capsys):
     assert capsys.readouterr().out == line + "\n"
     emit(Wide(line + " overflow"), as_json=False)
     assert [row.rstrip() for row in capsys.readouterr().out.splitlines()] == [line, "overflow"]  # wraps at 120
+
+
+def test_unwritable_output_folder_is_one_line(run_cli, tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    out = run_cli("errors", "run", "--out", blocker / "figures")
+    assert out.code == 2
+    assert out.stderr.startswith("schuler: error: ") and out.stderr.count("\n") == 1

@@ -131,9 +131,10 @@ class Parameter:
 
     def help_text(self) -> str:
         parts = [self.help]
+        bounded = self.minimum is not None or self.maximum is not None
         if self.kind == "quantity":
-            parts.append(f"[{self.unit or 'number'}; range {self.range_text()}]")
-        elif self.kind == "integer" and (self.minimum is not None or self.maximum is not None):
+            parts.append(f"[{self.unit or 'number'}; range {self.range_text()}]" if bounded else f"[{self.unit or 'number'}]")
+        elif self.kind == "integer" and bounded:
             parts.append(f"[range {self.range_text()}]")
         if self.default is not None and self.kind != "flag":
             parts.append(f"(default {self.default})")

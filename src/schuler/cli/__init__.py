@@ -83,4 +83,8 @@ def main(argv=None) -> None:
     except SchulerError as error:
         print(f"schuler: error: {error}", file=sys.stderr)
         code = 2
+    except OSError as error:  # an output folder that cannot be written, a full disk
+        where = f": {error.filename}" if error.filename else ""
+        print(f"schuler: error: {error.strerror or error}{where}", file=sys.stderr)
+        code = 2
     sys.exit(code if isinstance(code, int) else 0)
