@@ -37,4 +37,4 @@ def test_figures_in_two_formats(tmp_path):
     paths = save_figure_formats(fig, tmp_path / "oscillator")
     assert [p.name for p in paths] == ["oscillator.png", "oscillator.svg"]
     assert paths[0].read_bytes()[:4] == b"\x89PNG" and b"<svg" in paths[1].read_bytes()[:500]
-    assert not plt.get_fignums()
+    assert fig.number not in plt.get_fignums()  # closed after saving
