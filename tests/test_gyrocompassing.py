@@ -14,7 +14,7 @@ from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter, NotObservable
 from schuler.gyrocompassing import analytic, models, study
-from schuler.gyrocompassing.api import SYSTEM, run, sweep
+from schuler.gyrocompassing.api import SYSTEM
 from schuler.gyrocompassing.reproduction import reproduce
 
 DEG_PER_H = math.radians(1.0) / 3600.0
@@ -286,16 +286,18 @@ def test_dense_outputs_exact_when_members_equal_engine_steps():
 
 
 def test_monte_carlo_spread_matches_analytic_sigma():
-    # std of N = 1500 samples is within 3 standard errors (sqrt(1/(2N)) = 1.8 %) of the analytic 1-sigma
-    case = study.AlignmentCase(drift_east=0.01 * DEG_PER_H)
+    # std of N = 1500 members is within 3 standard errors (sqrt(1/(2N)) = 1.8 %) of the analytic 1-sigma
     for model in ("simplified", "full"):
-        mc = study.monte_carlo(case, model, 1500, sigma_drift=0.01 * DEG_PER_H, sigma_drift_z=0.01 * DEG_PER_H,
-                               sigma_accel=100 * MICRO_G, seed=3, duration=1500)
-        assert mc.std == pytest.approx(mc.sigma_analytic, rel=0.055)
-        assert mc.mean == pytest.approx(0.01 * DEG_PER_H / (EARTH_RATE * math.cos(LAT50)), abs=4 * mc.std / math.sqrt(1500))
-    simplified = study.monte_carlo(case, "simplified", 10, sigma_drift=0.01 * DEG_PER_H, sigma_drift_z=0.02 * DEG_PER_H,
-                                   sigma_accel=100 * MICRO_G, duration=600)
-    assert simplified.sigma_analytic == pytest.approx(simplified.sigma_simplified, rel=1e-12)
+        result = SYSTEM.run(drift_east=0.01 * DEG_PER_H, model=model, sigma_drift=0.01 * DEG_PER_H,
+                            sigma_drift_z=0.01 * DEG_PER_H, sigma_accel=100 * MICRO_G, duration=1500.0,
+                            monte_carlo=1500, seed=3)
+        stats = result.monte_carlo.statistics["azimuth_error_rad"]
+        assert stats["std"] == pytest.approx(result.azimuth_error_sigma_rad, rel=0.055)
+        assert stats["mean"] == pytest.approx(0.01 * DEG_PER_H / (EARTH_RATE * math.cos(LAT50)),
+                                              abs=4 * stats["std"] / math.sqrt(1500))
+    simplified = SYSTEM.run(model="simplified", sigma_drift=0.01 * DEG_PER_H, sigma_drift_z=0.02 * DEG_PER_H,
+                            fidelity="closed")
+    assert simplified.azimuth_error_sigma_rad == pytest.approx(simplified.azimuth_error_sigma_simplified_rad, rel=1e-12)
 
 
 def test_near_the_pole():
@@ -336,35 +338,51 @@ def test_bad_library_input_raises():
 # --- SYSTEM ---------------------------------------------------------------------------------------
 
 
-def test_system_sweep_is_vectorised_and_matches_run():
+def test_system_evaluate_is_vectorised_and_matches_run():
     n = 100_000
     rng = np.random.default_rng(6)
     values = {"latitude": rng.uniform(-1.2, 1.2, n), "azimuth": rng.uniform(0, 2 * np.pi, n),
-              "drift_east": rng.normal(0, 0.01 * DEG_PER_H, n), "accel_error_x": rng.normal(0, 100 * MICRO_G, n),
+              "drift_east": rng.normal(0, 0.01 * DEG_PER_H, n), "accel_bias_x": rng.normal(0, 100 * MICRO_G, n),
               "c_gamma": np.where(np.arange(n) % 2 == 0, np.nan, 0.1)}
-    out = sweep(values)
+    out = SYSTEM.evaluate_values(values, fidelity="closed")
     assert out["azimuth_error_rad"].shape == (n,)
     for i in (0, 1, 77):
-        single = run(**{k: float(v[i]) if not np.isnan(v[i]) else None for k, v in values.items()}, duration=1500.0)
-        assert out["azimuth_error_rad"][i] / ARCMIN == pytest.approx(single.azimuth_error_closed_form_arcmin, rel=1e-12)
+        single = SYSTEM.run(**{k: float(v[i]) for k, v in values.items() if not np.isnan(v[i])}, duration=1500.0,
+                            fidelity="closed")
+        assert out["azimuth_error_rad"][i] == pytest.approx(single.azimuth_error_rad, rel=1e-12)
         assert out["settling_time_s"][i] == pytest.approx(single.settling_time_s, rel=1e-12)
         assert out["c_gamma"][i] == pytest.approx(single.c_gamma, rel=1e-15)
-    mixed = sweep({"latitude": np.radians([40.0, 40.0]), "accel_error_x": np.full(2, 100 * MICRO_G),
-                   "model": np.array(["simplified", "full"])})
+    mixed = SYSTEM.evaluate_values({"latitude": np.radians([40.0, 40.0]), "accel_bias_x": np.full(2, 100 * MICRO_G),
+                                    "model": np.array(["simplified", "full"])}, fidelity="closed")
     assert mixed["azimuth_error_rad"][0] == 0.0
     assert mixed["azimuth_error_rad"][1] / ARCSEC == pytest.approx(-100e-6 * math.tan(math.radians(40)) / ARCSEC, rel=3e-3)
-    assert SYSTEM.sweep is sweep and SYSTEM.name == "align"
+    assert SYSTEM.name == "align"
+
+
+def test_simulated_fidelity_honours_duration_per_case():
+    values = {"drift_east": np.full(3, 0.01 * DEG_PER_H), "duration": np.array([300.0, 1500.0, np.nan]),
+              "output_step": np.array([1.0, 2.0, 1.0])}
+    out = SYSTEM.evaluate_values(values)
+    np.testing.assert_array_equal(out["duration_s"], [300.0, 1500.0, 7200.0])
+    for i in range(3):
+        given = {k: float(v[i]) for k, v in values.items() if not np.isnan(v[i])}
+        single = SYSTEM.run(**given)
+        assert out["azimuth_error_rad"][i] == pytest.approx(single.azimuth_error_rad, rel=1e-12)
+        assert out["settling_time_simulated_s"][i] == single.settling_time_simulated_s
 
 
 def test_reproduction_flags_the_design_example():
-    rows = {row.quantity: row for row in reproduce().rows}
+    reproduction = reproduce()
+    rows = {row.quantity: row for row in reproduction.rows}
     c_gamma = rows["c_Gamma for T = 30 s, zeta = 0.8"]
-    assert (c_gamma.printed, round(c_gamma.computed, 4), c_gamma.agrees) == (0.08, 0.0533, False)
+    assert (c_gamma.printed, round(c_gamma.computed, 4), c_gamma.verdict) == ("0.08", 0.0533, "erratum")
     c_a = rows["c_a for T = 30 s at Kyiv (50.45 deg)"]
     assert c_a.computed == pytest.approx(23.93, abs=0.01) and "46.16 deg" in c_a.note
     aperiodic = rows["aperiodic settling time of the printed pair"]
-    assert aperiodic.printed < 0 < aperiodic.computed
-    assert rows["delta_y for 0.01 deg/h east drift at 50 deg"].agrees
+    assert aperiodic.verdict == "erratum" and aperiodic.computed > 0 and "negative" in aperiodic.note
+    assert rows["delta_y for 0.01 deg/h east drift at 50 deg"].verdict == "not printed in the source"
+    assert rows["delta_y for 0.01 deg/h east drift at 50 deg"].computed == pytest.approx(3.556, abs=5e-4)
+    assert not reproduction.failures
 
 
 @pytest.mark.slow
@@ -375,21 +393,18 @@ def test_report_writes_its_figures(tmp_path):
         assert (tmp_path / figure.path).stat().st_size > 10_000
 
 
-def test_system_sweep_accepts_every_parameter_as_an_array():
-    # as a generic sweep passes them: every run parameter, unset numbers as NaN, choices as strings
-    from schuler.gyrocompassing.api import PARAMETERS
-    from schuler.params import parse_parameters
+def test_system_evaluate_accepts_every_parameter_as_an_array():
+    # as a sweep passes them: every run parameter, unset numbers as NaN, choices as strings
+    from schuler.contract import Cases
 
     n = 4
-    defaults = parse_parameters(PARAMETERS, {})
-    values = {p.name: np.full(n, np.nan) if defaults[p.name] is None else np.full(n, defaults[p.name])
-              for p in PARAMETERS}
+    cases = Cases.from_case(SYSTEM.case(drift_east=0.01 * DEG_PER_H), n, fidelity="closed")
+    values = {name: cases[name] for name in cases.names}
     values["latitude"] = np.radians([0.0, 20.0, 40.0, 60.0])
-    values["drift_east"] = np.full(n, 0.01 * DEG_PER_H)
-    out = sweep(values)
+    out = SYSTEM.evaluate(Cases(values, fidelity="closed"))
     expected = 0.01 * DEG_PER_H / (EARTH_RATE * np.cos(values["latitude"]))
     np.testing.assert_allclose(out["azimuth_error_rad"], expected, rtol=1e-12)
     np.testing.assert_allclose(out["settling_time_s"], 187.5, rtol=1e-12)
     values["latitude"][-1] = math.radians(87.0)
     with pytest.raises(NotObservable):
-        sweep(values)
+        SYSTEM.evaluate(Cases(values))

@@ -20,18 +20,32 @@ schuler.exceptions.InvalidParameter: latitude: '95 deg' is outside [-90, 90] deg
 
 from __future__ import annotations
 
+import difflib
 import math
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from typing import Any, Literal
 
+import numpy as np
+
 from schuler.exceptions import InvalidParameter
-from schuler.units import parse_quantity, to_unit
+from schuler.units import parse_quantity, si_unit, to_unit
 
 Kind = Literal["quantity", "choice", "integer", "flag", "text"]
 
 
 def _fmt(x: float) -> str:
     return f"{x:g}"
+
+
+class _Shown:
+    """An SI value as the user should see it in a range message: ``114.6 deg``."""
+
+    def __init__(self, value: float, unit: str):
+        self.value, self.unit = value, unit
+
+    def __repr__(self) -> str:
+        return f"{self.value:.6g} {self.unit}".strip()
 
 
 @dataclass(frozen=True)
@@ -73,6 +87,46 @@ class Parameter:
     @property
     def option(self) -> str:
         return "--" + self.name.replace("_", "-")
+
+    @property
+    def si_unit(self) -> str:
+        """Unit of the SI value (``"rad/s"`` for deg/h); ``"1"`` for plain numbers and other kinds."""
+        return si_unit(self.unit) if self.kind == "quantity" else "1"
+
+    def check(self, value, label: str | None = None):
+        """Validate an SI value given directly (Python API): type, finiteness, range.
+
+        Returns the value as the kind's Python type (float, int, str or bool);
+        None is returned as is (the parameter's "not set" rule applies).
+        """
+        label = label or self.name
+        if value is None:
+            return None
+        if self.kind == "choice":
+            return self.parse(value, label)
+        if self.kind == "text":
+            if not isinstance(value, str):
+                raise InvalidParameter(label, f"{value!r} is not text")
+            return value
+        if self.kind == "flag":
+            if not isinstance(value, (bool, np.bool_)):
+                raise InvalidParameter(label, f"{value!r} is not true or false")
+            return bool(value)
+        if self.kind == "integer":
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+                if not (isinstance(value, (float, np.floating)) and float(value).is_integer()):
+                    raise InvalidParameter(label, f"{value!r} is not a whole number")
+            number = int(value)
+            self._check_range(number, number, number, label)
+            return number
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise InvalidParameter(label, f"{value!r} is not a number in SI ({self.si_unit})")
+        value = float(value)
+        if not math.isfinite(value):
+            raise InvalidParameter(label, f"{value!r} is not a finite number")
+        shown = float(to_unit(value, self.unit))
+        self._check_range(shown, value, _Shown(shown, self.unit), label)
+        return value
 
     def range_text(self) -> str:
         lo = "-inf" if self.minimum is None else _fmt(self.minimum)
@@ -139,6 +193,142 @@ class Parameter:
         if self.default is not None and self.kind != "flag":
             parts.append(f"(default {self.default})")
         return " ".join(parts)
+
+
+class Case(Mapping):
+    """One validated case: every parameter of a system in SI, and which of them were given.
+
+    A read-only mapping ``name -> SI value`` (None where a parameter's "not set"
+    rule applies). Build it with :meth:`ParameterSet.case` (SI values) or
+    :meth:`ParameterSet.parse` (values as users write them).
+    """
+
+    def __init__(self, values: dict[str, Any], given: Iterable[str] = ()):
+        self._values = dict(values)
+        self.given = frozenset(given)
+
+    def __getitem__(self, name: str):
+        return self._values[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._values)
+
+    def __len__(self) -> int:
+        return len(self._values)
+
+    def __repr__(self) -> str:
+        shown = ", ".join(f"{k}={v!r}" for k, v in self._values.items() if k in self.given)
+        return f"Case({shown})"
+
+
+class ParameterSet:
+    """The parameters of one system (or one command), declared once.
+
+    Every entry point builds its case here: unknown names are refused with a
+    suggestion, defaults are filled in one place, values are checked against
+    their range, and options that exclude each other are refused together.
+
+    Parameters
+    ----------
+    parameters : iterable of Parameter
+    owner : str
+        Who the parameters belong to (``"align"``), for messages.
+    exclusive : iterable of tuple of str
+        Groups of parameters of which at most one may be given.
+
+    Examples
+    --------
+    >>> ps = ParameterSet([Parameter("latitude", "deg", 50.0, "Latitude.", minimum=-90, maximum=90)], owner="demo")
+    >>> round(ps.case()["latitude"], 6)
+    0.872665
+    >>> ps.case(latitud=0.1)
+    Traceback (most recent call last):
+    ...
+    schuler.exceptions.InvalidParameter: latitud: unknown parameter of demo; did you mean 'latitude'? allowed: latitude
+    >>> ps.case(latitude=2.0)
+    Traceback (most recent call last):
+    ...
+    schuler.exceptions.InvalidParameter: latitude: 114.592 deg is outside [-90, 90] deg
+    """
+
+    def __init__(self, parameters: Iterable[Parameter], *, owner: str = "", exclusive: Iterable[tuple[str, ...]] = ()):
+        self.parameters = tuple(parameters)
+        self.owner = owner
+        self._by_name = {p.name: p for p in self.parameters}
+        if len(self._by_name) != len(self.parameters):
+            raise ValueError(f"{owner}: a parameter is declared twice")
+        self.exclusive = tuple(tuple(group) for group in exclusive)
+        for group in self.exclusive:
+            missing = set(group) - set(self._by_name)
+            if missing:
+                raise ValueError(f"{owner}: exclusive group names unknown parameters {sorted(missing)}")
+
+    def __iter__(self) -> Iterator[Parameter]:
+        return iter(self.parameters)
+
+    def __len__(self) -> int:
+        return len(self.parameters)
+
+    def __getitem__(self, name: str) -> Parameter:
+        return self._by_name[name]
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._by_name
+
+    def __add__(self, other: Iterable[Parameter]) -> ParameterSet:
+        extra = other.exclusive if isinstance(other, ParameterSet) else ()
+        return ParameterSet((*self.parameters, *other), owner=self.owner, exclusive=(*self.exclusive, *extra))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self._by_name)
+
+    def refuse_unknown(self, names: Iterable[str], label=lambda name: name) -> None:
+        """Raise :class:`InvalidParameter` for the first name that is not a parameter, suggesting the closest."""
+        for name in names:
+            if name not in self._by_name:
+                hint = difflib.get_close_matches(name, self.names, n=1, cutoff=0.6)
+                suggestion = f"did you mean {label(hint[0])!r}? " if hint else ""
+                of = f" of {self.owner}" if self.owner else ""
+                allowed = ", ".join(label(n) for n in self.names) or "(none)"
+                raise InvalidParameter(label(name), f"unknown parameter{of}; {suggestion}allowed: {allowed}")
+
+    def _refuse_conflicts(self, given: Iterable[str], label) -> None:
+        given = set(given)
+        for group in self.exclusive:
+            both = [name for name in group if name in given]
+            if len(both) > 1:
+                raise InvalidParameter(label(both[0]), f"cannot be combined with {label(both[1])}; give one of them")
+
+    def defaults(self) -> dict[str, Any]:
+        """Every parameter's default in SI (None where the "not set" rule applies)."""
+        return {p.name: None if p.default is None else p.parse(p.default) for p in self.parameters}
+
+    def case(self, values: Mapping[str, Any] | None = None, /, **si_values) -> Case:
+        """A validated :class:`Case` from SI values (Python API); missing or None values take the default."""
+        given = {**(values or {}), **si_values}
+        self.refuse_unknown(given)
+        given = {name: value for name, value in given.items() if value is not None}
+        self._refuse_conflicts(given, str)
+        checked = self.defaults()
+        for name, value in given.items():
+            checked[name] = self._by_name[name].check(value)
+        return Case(checked, given)
+
+    def parse(self, written: Mapping[str, Any], *, labels: str = "name") -> Case:
+        """A validated :class:`Case` from values as users write them (display units or unit strings).
+
+        ``labels="option"`` names problems by CLI option (``--drift-east``).
+        """
+        label = (lambda name: self._by_name[name].option if name in self._by_name else "--" + name.replace("_", "-")) \
+            if labels == "option" else (lambda name: name)
+        self.refuse_unknown(written, label)
+        given = {name: raw for name, raw in written.items() if raw is not None}
+        self._refuse_conflicts(given, label)
+        values = self.defaults()
+        for name, raw in given.items():
+            values[name] = self._by_name[name].parse(raw, label(name))
+        return Case(values, given)
 
 
 def parse_parameters(parameters, values: dict[str, Any], *, labels: str = "name") -> dict[str, Any]:

@@ -109,3 +109,87 @@ class Footnotes:
     def lines(self) -> list[str]:
         """Each note once, in order of first reference: ``"[n] note"``."""
         return [f"[{n}] {note}" for note, n in self._numbers.items()]
+
+
+@dataclasses.dataclass(kw_only=True)
+class RunResult(Result):
+    """Base of the results of ``System.run``: one case, and optionally its Monte Carlo.
+
+    ``monte_carlo`` holds the statistics of every output over the members (see
+    :class:`MonteCarloSummary`); None for the nominal case alone.
+    """
+
+    monte_carlo: MonteCarloSummary | None = None
+
+
+@dataclasses.dataclass
+class MonteCarloSummary(Result):
+    """Statistics of each output over the members of a Monte Carlo (SI, keyed by output name).
+
+    ``statistics[name]`` holds count (finite values), mean, std (sample, ddof = 1),
+    rms, min, max, p05, p50, p95 (percentiles exact up to 100,000 members, from a
+    uniform sample beyond). ``samples`` keeps the first 100,000 members' values.
+    """
+
+    members: int
+    seed: int
+    statistics: dict[str, dict[str, float | None]]
+    display_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
+    samples: dict[str, np.ndarray] = dataclasses.field(default_factory=dict, repr=False)
+
+    units: ClassVar[dict[str, str]] = {"members": "1", "seed": "1"}
+
+    @classmethod
+    def from_statistics(cls, members, seed, outputs, statistics, samples) -> MonteCarloSummary:
+        table = {}
+        for output in outputs:
+            stats = statistics[output.name]
+            empty = stats.count == 0
+            entry: dict[str, float | None] = {"count": int(stats.count)}
+            for key, value in (("mean", stats.mean), ("std", stats.std), ("min", stats.min), ("max", stats.max)):
+                entry[key] = None if empty else float(value[0])
+            entry["rms"] = None if empty else float(stats.rms[0])
+            for q in (5, 50, 95):
+                entry[f"p{q:02d}"] = None if empty else float(stats.percentile(q)[0])
+            table[output.name] = entry
+        shown = {o.name: o.display for o in outputs if o.display}
+        return cls(members=int(members), seed=int(seed), statistics=table, display_units=shown, samples=samples)
+
+    def render(self):
+        from rich.table import Table
+
+        from schuler.units import to_unit
+
+        constant = [name for name, stats in self.statistics.items() if stats["min"] == stats["max"]]
+        table = Table(title=f"Monte Carlo: {self.members} members (seed {self.seed})",
+                      caption=f"the same in every member: {', '.join(constant)}" if constant else None)
+        table.add_column("output")
+        for heading in ("mean", "std", "p05", "p95"):
+            table.add_column(heading, justify="right")
+        for name, stats in self.statistics.items():
+            if name in constant:
+                continue
+            unit = self.display_units.get(name, "")
+            cells = []
+            for key in ("mean", "std", "p05", "p95"):
+                value = stats[key]
+                cells.append("-" if value is None else f"{float(to_unit(value, unit)) if unit else value:.4g}")
+            table.add_row(display_label(name, unit), *cells)
+        return table
+
+
+_SI_SUFFIXES = ("_rad_s2", "_rad_s", "_m_s2", "_m_s", "_rad", "_s", "_m")
+
+
+def display_label(name: str, unit: str = "") -> str:
+    """A column label in a display unit: ``azimuth_error_rad`` in arcmin -> ``azimuth_error (arcmin)``.
+
+    >>> display_label("azimuth_error_rad", "arcmin"), display_label("settling_time_s")
+    ('azimuth_error (arcmin)', 'settling_time_s')
+    """
+    if not unit:
+        return name
+    for suffix in _SI_SUFFIXES:
+        if name.endswith(suffix):
+            return f"{name[: -len(suffix)]} ({unit})"
+    return f"{name} ({unit})"

@@ -188,3 +188,36 @@ def format_quantity(value_si: float, unit: str, digits: int = 4) -> str:
     '3.438 arcmin'
     """
     return f"{to_unit(value_si, unit):.{digits}g} {unit}".rstrip()
+
+
+_SI_SYMBOLS = {"radian": "rad", "meter": "m", "second": "s", "kilogram": "kg", "ampere": "A", "kelvin": "K"}
+
+
+@lru_cache(maxsize=256)
+def si_unit(unit: str) -> str:
+    """The SI unit (as written in ``units`` maps) of values whose display unit is ``unit``.
+
+    Angles are in rad; a plain number is ``"1"``.
+
+    >>> si_unit("deg/h"), si_unit("g"), si_unit("arcmin"), si_unit(""), si_unit("deg/h^0.5")
+    ('rad/s', 'm/s^2', 'rad', '1', 'rad/s^0.5')
+    """
+    base = ureg.Quantity(1.0, _display_unit(unit)).to_base_units().units
+    powers = {}
+    for name, exponent in base._units.items():
+        powers[_SI_SYMBOLS.get(name, name)] = exponent
+    if _angle_power(_display_unit(unit)) and "rad" not in powers:
+        powers = {"rad": _angle_power(_display_unit(unit)), **powers}
+
+    def term(symbol, exponent):
+        exponent = abs(exponent)
+        if exponent == 1:
+            return symbol
+        return f"{symbol}^{int(exponent) if float(exponent).is_integer() else exponent:g}"
+
+    top = [term(s, e) for s, e in powers.items() if e > 0]
+    bottom = [term(s, e) for s, e in powers.items() if e < 0]
+    text = "*".join(top) or "1"
+    if bottom:
+        text += "/" + ("/".join(bottom))
+    return text

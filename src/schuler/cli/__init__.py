@@ -22,15 +22,16 @@ from schuler import __version__
 from schuler.exceptions import SchulerError
 
 COMMANDS: dict[str, tuple[str, str]] = {
-    "errors": ("schuler.cli.errors:group", "Schuler-tuned INS error propagation (Bollay)."),
-    "vertical": ("schuler.cli.vertical:group", "Gyro vertical with integral correction (Drozdovich)."),
-    "calibrate": ("schuler.cli.calibrate:group", "Gyro drift calibration by alternating torque pulses."),
-    "align": ("schuler.cli.align:group", "Physical gyrocompassing of a platform INS."),
-    "north": ("schuler.cli.north:group", "Ground gyrocompass during rotor run-down."),
+    "errors": ("system", "Schuler-tuned INS error propagation (Bollay)."),
+    "vertical": ("system", "Gyro vertical with integral correction (Drozdovich)."),
+    "calibrate": ("system", "Gyro drift calibration by alternating torque pulses."),
+    "align": ("system", "Physical gyrocompassing of a platform INS."),
+    "north": ("system", "Ground gyrocompass during rotor run-down."),
     "run": ("schuler.cli.study:run_scenario", "Run a scenario file (TOML)."),
     "sweep": ("schuler.cli.study:sweep", "Sweep parameters or Monte Carlo over a scenario."),
     "report": ("schuler.cli.study:report", "Build the HTML report of all systems."),
 }
+"""Each command: where it comes from (``"system"``: generated from the registry's System) and its short help."""
 
 
 class LazyGroup(click.Group):
@@ -42,7 +43,13 @@ class LazyGroup(click.Group):
     def get_command(self, ctx, name):
         if name not in COMMANDS:
             return None
-        module_name, attribute = COMMANDS[name][0].split(":")
+        origin = COMMANDS[name][0]
+        if origin == "system":
+            from schuler.cli.systems import system_group
+            from schuler.registry import get_system
+
+            return system_group(get_system(name))
+        module_name, attribute = origin.split(":")
         return getattr(importlib.import_module(module_name), attribute)
 
     def format_commands(self, ctx, formatter):

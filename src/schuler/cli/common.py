@@ -1,7 +1,8 @@
 """What every command shares: options built from Parameters, output, and errors.
 
-Commands stay thin: parse options with :func:`parse_options`, call one public
-API function, hand its result to :func:`emit`.
+Commands stay thin: parse options with the system's
+:class:`~schuler.params.ParameterSet`, call one public function, hand its
+result to :func:`emit`.
 """
 
 from __future__ import annotations
@@ -15,14 +16,14 @@ import click
 
 from schuler import __version__
 from schuler.exceptions import InvalidParameter, SchulerError
-from schuler.params import Parameter, parse_parameters
+from schuler.params import Parameter
 from schuler.results import json_safe
 
 
 def parameter_options(parameters):
     """Decorator adding one click option per :class:`Parameter` (values stay strings).
 
-    Strings keep unit text ("0.01 deg/h") intact; :func:`parse_options` converts.
+    Strings keep unit text ("0.01 deg/h") intact; :meth:`ParameterSet.parse` converts.
     """
 
     def decorate(function):
@@ -42,12 +43,6 @@ def parameter_options(parameters):
         return function
 
     return decorate
-
-
-def parse_options(parameters, values: dict) -> dict:
-    """Parse the raw option values of ``parameters`` into SI (errors name the option)."""
-    names = {p.name for p in parameters}
-    return parse_parameters(parameters, {k: v for k, v in values.items() if k in names}, labels="option")
 
 
 @contextmanager
@@ -94,14 +89,26 @@ out_option = click.option(
 )
 
 
-def emit(result, as_json: bool, inputs: dict | None = None, files=()) -> None:
-    """Print a result: rich text by default, JSON (with version, SI inputs, units) with --json."""
+def json_document(result, inputs: dict | None = None, parameters=(), files=()) -> dict:
+    """What ``--json`` prints: version, SI inputs, the result, and a ``units`` map.
+
+    ``units`` covers the inputs (each parameter's SI unit) and the result's own
+    map; keys whose unit is in their name (``_rad``, ``_s``, ``_m_s``) need no entry.
+    """
+    data = {"schuler_version": __version__, "inputs": json_safe(inputs or {})}
+    data.update(result.to_dict())
+    units = {p.name: p.si_unit for p in parameters if inputs and p.name in inputs and p.kind in ("quantity", "integer")}
+    units.update(data.get("units", {}))
+    data["units"] = units
+    if files:
+        data["files"] = [str(f) for f in files]
+    return data
+
+
+def emit(result, as_json: bool, inputs: dict | None = None, parameters=(), files=()) -> None:
+    """Print a result: rich text by default, JSON (see :func:`json_document`) with --json."""
     if as_json:
-        data = {"schuler_version": __version__, "inputs": json_safe(inputs or {})}
-        data.update(result.to_dict())
-        if files:
-            data["files"] = [str(f) for f in files]
-        click.echo(json.dumps(data, indent=2))
+        click.echo(json.dumps(json_document(result, inputs, parameters, files), indent=2))
         return
     from rich.console import Console
 
@@ -113,10 +120,33 @@ def emit(result, as_json: bool, inputs: dict | None = None, files=()) -> None:
         console.print(f"wrote {len(files)} file(s) to {', '.join(folders)}")
 
 
+@contextmanager
+def progress_reporter(label: str, enabled: bool = True):
+    """A ``progress(done, total)`` callback drawing a bar on stderr (nothing when disabled or not a terminal)."""
+    if not enabled or not sys.stderr.isatty():
+        yield None
+        return
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    bar = Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                   console=Console(stderr=True), transient=True)
+    task = None
+
+    def progress(done: int, total: int) -> None:
+        nonlocal task
+        if task is None:
+            task = bar.add_task(label, total=total)
+        bar.update(task, completed=done)
+
+    with bar:
+        yield progress
+
+
 def warn(message: str) -> None:
     """One line on stderr, for conditions that degrade but do not stop a run."""
     print(f"schuler: warning: {message}", file=sys.stderr)
 
 
-__all__ = ["Parameter", "parameter_options", "parse_options", "options_named", "json_option", "out_option", "emit",
-           "warn"]
+__all__ = ["emit", "json_document", "json_option", "options_named", "out_option", "parameter_options",
+           "progress_reporter", "warn"]

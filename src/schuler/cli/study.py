@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import importlib
 import json
 from pathlib import Path
 
 import click
 
 from schuler import __version__
-from schuler.cli.common import emit, json_option, warn
+from schuler.cli.common import emit, json_option
 from schuler.registry import SYSTEM_MODULES
 
 _SCENARIO = click.argument("scenario", metavar="SCENARIO.toml", type=click.Path(dir_okay=False, path_type=Path))
@@ -26,41 +25,22 @@ _SCENARIO = click.argument("scenario", metavar="SCENARIO.toml", type=click.Path(
 )
 @json_option
 def run_scenario(scenario: Path, out_dir: Path | None, as_json: bool):
-    """Run a scenario file: print what `schuler SYSTEM run` prints for its parameters.
+    """Run a scenario file: what `schuler SYSTEM run` does for its parameters.
 
     The file names the system and sets its run options by name
-    (`latitude = "50 deg"`); see examples/*.toml. --out and --json override
-    the file's [outputs] table.
+    (`latitude = "50 deg"`); see examples/*.toml. With a [monte_carlo] table
+    and `cases = N`, N members draw its random parameters and the system's own
+    random terms. --out and --json override the file's [outputs] table.
     """
+    from schuler.cli.systems import execute_run
     from schuler.study.scenario import load_scenario
 
     loaded = load_scenario(scenario)
-    args = loaded.command_line()
-    out_dir = out_dir or loaded.out_dir
-    if out_dir is not None:
-        args += ["--out", str(out_dir)]
-    if as_json or loaded.as_json:
-        args.append("--json")
-    command = _system_run_command(loaded.system)
-    if command is None:
-        if out_dir is not None:
-            warn(f"--out: system {loaded.system!r} has no command of its own here, so no files are written")
-        result = loaded.run()
-        emit(result, as_json or loaded.as_json, inputs=loaded.values)
-        return
-    command.main(args=args[2:], prog_name=f"schuler {loaded.system} run", standalone_mode=False)
-
-
-def _system_run_command(name: str):
-    """The system's ``run`` click command, or None when it has no command-line module."""
-    module_name = f"schuler.cli.{name}"
-    try:
-        module = importlib.import_module(module_name)
-    except ModuleNotFoundError as error:
-        if error.name == module_name:
-            return None
-        raise
-    return module.group.commands.get("run")
+    table = loaded.monte_carlo
+    members = table.cases if table is not None and table.cases else 0
+    execute_run(loaded.definition(), loaded.values, monte_carlo=members, seed=table.seed if table else 0,
+                fidelity=loaded.fidelity, out_dir=out_dir or loaded.out_dir, as_json=as_json or loaded.as_json,
+                draw=loaded.draw if members else None)
 
 
 @click.command("sweep")
@@ -105,10 +85,14 @@ def _system_run_command(name: str):
     help="Local worker processes (without --scheduler), or LocalCluster workers (default 2).",
 )
 @click.option("--chunk-size", type=int, default=None, metavar="N", help="Cases per chunk (default 50000).")
+@click.option("--fidelity", default=None, metavar="NAME",
+              help="The system's evaluation fidelity, e.g. simulated or closed (default: the scenario's, else the "
+                   "system's first).")
 @click.option("--csv/--no-csv", "write_csv", default=True, help="Also write results.csv (large for huge sweeps).")
 @click.option("--progress/--no-progress", default=True, help="Show a progress bar on stderr.")
 @json_option
-def sweep(scenario, params, monte_carlo, out_dir, scheduler, workers, chunk_size, write_csv, progress, as_json):
+def sweep(scenario, params, monte_carlo, out_dir, scheduler, workers, chunk_size, fidelity, write_csv, progress,
+          as_json):
     """Sweep parameters of a scenario, or run a Monte Carlo, in vectorised chunks.
 
     One row per case in DIR/results.csv and DIR/results.parquet (a column per
@@ -130,6 +114,7 @@ def sweep(scenario, params, monte_carlo, out_dir, scheduler, workers, chunk_size
         workers=workers,
         progress=progress and not as_json,
         write_csv=write_csv,
+        fidelity=fidelity,
     )
     emit(summary, as_json, inputs={"scenario": str(scenario), "params": list(params), "monte_carlo": monte_carlo})
 

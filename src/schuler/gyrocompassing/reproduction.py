@@ -1,4 +1,7 @@
-"""The source's design example and statements, reproduced with their errata (source 003).
+"""The KPI manual's design example and statements, reproduced with their errata.
+
+Source: Meleshko, "Physical gyrocompassing of a semi-analytic INS", KPI lab
+manual (:data:`schuler.references.KPI_LAB_MANUAL`); equation numbers are the manual's.
 
 Constants: Earth rate U = 7.292115e-5 rad/s (the source does not state one),
 g = 9.80665 m/s^2, Kyiv (the source's university) at 50.45 deg for "the" latitude.
@@ -8,16 +11,17 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.core.lti import simulate
-from schuler.gyrocompassing import analytic, models, plots, study
-from schuler.registry import FigureRef, ReportSection, ReproductionRow
-from schuler.results import Footnotes, Result
+from schuler.gyrocompassing import analytic, evaluation, models, plots, study
+from schuler.contract import Cases, FigureRef, ReportSection, monte_carlo
+from schuler.core.random import RandomStreams
+from schuler.references import KPI_LAB_MANUAL
+from schuler.reproduction import Reproduction, Tolerance, compare
 from schuler.units import from_unit, to_unit
 
 KYIV_LATITUDE = math.radians(50.45)
@@ -36,38 +40,6 @@ RUN_DURATION = 1500.0
 """Simulated time of the worked cases, s: 40 decay times 1/h at T = 30 s, zeta = 0.8 (transient < 1e-17)."""
 
 
-@dataclass
-class ReproductionResult(Result):
-    """The source's numbers beside the computed ones."""
-
-    source: str
-    constants: dict
-    rows: list
-    notes: list = field(default_factory=list)
-
-    def render(self):
-        from rich.console import Group
-        from rich.table import Table
-
-        table = Table(title="Gyrocompassing: source 003 reproduced", show_lines=False)
-        for column in ("quantity", "printed", "computed", "unit", "agrees", "note"):
-            table.add_column(column, justify="left" if column in ("quantity", "note") else "right")
-        # notes are long: the table refers to them by number and lists them below it
-        footnotes = Footnotes()
-        for row in self.rows:
-            printed = f"{row.printed:.6g}" if isinstance(row.printed, float) else str(row.printed)
-            reference = footnotes.reference(_marked(row) if row.note else "")
-            table.add_row(row.quantity, printed, f"{row.computed:.6g}", row.unit, "yes" if row.agrees else "NO",
-                          reference)
-        return Group(table, *footnotes.lines(), "Errata in equations (no number to compare):",
-                     *(f"- {note}" for note in self.notes))
-
-
-def _marked(row: ReproductionRow) -> str:
-    """A disagreeing row's note is the source's erratum; say so."""
-    return row.note if row.agrees else f"erratum: {row.note}"
-
-
 def _printed_aperiodic_time(c_gamma: float, c_a: float, latitude: float) -> float:
     """The aperiodic settling time as printed: 5 / (-h + sqrt(h^2 - omega0^2)) (negative)."""
     h = c_gamma / 2
@@ -75,93 +47,92 @@ def _printed_aperiodic_time(c_gamma: float, c_a: float, latitude: float) -> floa
     return 5.0 / (-h + math.sqrt(h**2 - omega0_sq))
 
 
-def reproduce() -> ReproductionResult:
+def reproduce() -> Reproduction:
     """Reproduce the design example (T = 30 s) and check the source's statements and equations.
+
+    Every printed number is taken from Sec. 2 of the manual (after (1.25)) unless
+    the row says otherwise.
 
     Examples
     --------
     >>> r = reproduce()
-    >>> [row.quantity for row in r.rows][:2]
-    ['c_Gamma for T = 30 s, zeta = 0.8', 'c_a for T = 30 s at Kyiv (50.45 deg)']
+    >>> [row.quantity for row in r.rows][:2], r.failures
+    (['c_Gamma for T = 30 s, zeta = 0.8', 'c_a for T = 30 s at Kyiv (50.45 deg)'], [])
     """
+    where = "Sec. 2, after (1.25)"
     rows = []
     c_gamma, c_a_kyiv = (float(x) for x in analytic.gains_from_design(DESIGN_TIME_CONSTANT, DESIGN_DAMPING, KYIV_LATITUDE))
-    rows.append(ReproductionRow(
-        "c_Gamma for T = 30 s, zeta = 0.8", PRINTED_C_GAMMA, c_gamma, "1/s", False,
-        f"c_Gamma = 2 zeta / T; the printed 0.08 needs zeta = {PRINTED_C_GAMMA * DESIGN_TIME_CONSTANT / 2:.2f}",
-    ))
+    rows.append(compare(
+        "c_Gamma for T = 30 s, zeta = 0.8", c_gamma, "1/s", printed="0.08", where=where,
+        erratum=f"c_Gamma = 2 zeta / T; the printed 0.08 needs zeta = {PRINTED_C_GAMMA * DESIGN_TIME_CONSTANT / 2:.2f}"))
     latitude_for_22 = math.acos(1.0 / (DESIGN_TIME_CONSTANT**2 * EARTH_RATE * PRINTED_C_A))
-    rows.append(ReproductionRow(
-        "c_a for T = 30 s at Kyiv (50.45 deg)", PRINTED_C_A, c_a_kyiv, "1/s", False,
-        f"c_a = 1 / (T^2 U cos(latitude)); the printed 22 holds at {math.degrees(latitude_for_22):.2f} deg "
-        f"(U = {EARTH_RATE} rad/s)",
-    ))
+    rows.append(compare(
+        "c_a for T = 30 s at Kyiv (50.45 deg)", c_a_kyiv, "1/s", printed="22", where=where,
+        erratum=f"c_a = 1 / (T^2 U cos(latitude)); the printed 22 holds at {math.degrees(latitude_for_22):.2f} deg "
+                f"(U = {EARTH_RATE} rad/s)"))
     _, zeta_printed = analytic.design_from_gains(PRINTED_C_GAMMA, PRINTED_C_A, latitude_for_22)
-    rows.append(ReproductionRow(
-        "damping of the printed pair (0.08, 22)", DESIGN_DAMPING, float(zeta_printed), "", False,
-        "the printed gains give an aperiodic loop (zeta > 1), not zeta = 0.8",
-    ))
-    rows.append(ReproductionRow(
-        "aperiodic settling time of the printed pair", _printed_aperiodic_time(PRINTED_C_GAMMA, PRINTED_C_A, latitude_for_22),
-        float(analytic.settling_time(PRINTED_C_GAMMA, PRINTED_C_A, latitude_for_22)), "s", False,
-        "the printed formula 5/(-h + sqrt(h^2 - omega0^2)) is negative; corrected 5/(h - sqrt(h^2 - omega0^2))",
-    ))
+    rows.append(compare(
+        "damping of the printed pair (0.08, 22)", float(zeta_printed), "1", printed="0.8", where=where,
+        erratum="the printed gains give an aperiodic loop (zeta > 1), not the zeta = 0.8 they are meant for"))
+    printed_time = _printed_aperiodic_time(PRINTED_C_GAMMA, PRINTED_C_A, latitude_for_22)
+    rows.append(compare(
+        "aperiodic settling time of the printed pair", float(analytic.settling_time(PRINTED_C_GAMMA, PRINTED_C_A,
+                                                                                    latitude_for_22)), "s",
+        printed="5 / (-h + sqrt(h^2 - omega0^2))", value=printed_time, where="Sec. 2, before the T, zeta design",
+        erratum=f"the printed formula gives {printed_time:.4g} s (negative); corrected 5 / (h - sqrt(h^2 - omega0^2))"))
     design = study.AlignmentCase(latitude=KYIV_LATITUDE, drift_east=EXAMPLE_DRIFT, drift_z=EXAMPLE_DRIFT,
                                  latitude_error=from_unit(1.0, "arcmin"))
     run = study.run_case(design, "simplified", duration=RUN_DURATION)
-    settling_simulated = float(run.simulated.settling_time[0])
-    rows.append(ReproductionRow(
-        "settling time 5/h, T = 30 s, zeta = 0.8 (simulated 1 % band)", run.analytic["settling_time_s"],
-        settling_simulated, "s", abs(settling_simulated / run.analytic["settling_time_s"] - 1) < 0.05,
-        "5/h against the last exit of the simulated azimuth error from a 1 % band",
-    ))
-    rows.append(ReproductionRow(
+    rows.append(compare(
+        "settling time 5/h, T = 30 s, zeta = 0.8 (simulated 1 % band)", float(run.simulated.settling_time[0]), "s",
+        printed="t = 5/h", value=run.analytic["settling_time_s"], where="Sec. 2, before the T, zeta design",
+        tolerance=Tolerance(0.05),
+        note="5/h against the last exit of the simulated azimuth error from a 1 % band"))
+    rows.append(compare(
         "delta_y (1.21) vs simulated (1.19): 0.01 deg/h east and up, 1 arcmin latitude error",
-        float(to_unit(run.analytic["azimuth_error_analytic_rad"], "arcmin")),
         float(to_unit(run.simulated.azimuth_error[0], "arcmin")), "arcmin",
-        math.isclose(run.analytic["azimuth_error_analytic_rad"], run.simulated.azimuth_error[0], rel_tol=1e-9),
-        "closed form and exact simulation",
-    ))
+        printed="(1.21)", value=float(to_unit(run.analytic["azimuth_error_analytic_rad"], "arcmin")), where="(1.21)",
+        tolerance=Tolerance(1e-9), note="the formula (1.21) evaluated, against the exact simulation of (1.19)"))
     east_only = analytic.steady_state(math.radians(50.0), c_gamma, c_a_kyiv, drift_east=EXAMPLE_DRIFT)[0]
-    rows.append(ReproductionRow(
-        "delta_y for 0.01 deg/h east drift at 50 deg", 3.556, float(to_unit(east_only, "arcmin")), "arcmin",
-        abs(float(to_unit(east_only, "arcmin")) - 3.556) < 5e-4, "dominant term dw_dxi / (U cos(latitude))",
-    ))
+    rows.append(compare(
+        "delta_y for 0.01 deg/h east drift at 50 deg", float(to_unit(east_only, "arcmin")), "arcmin",
+        note="dominant term of (1.21), Delta omega_dxi / (U cos(latitude)); a worked value of this toolkit"))
     rate = {}
     for label, builder in (("printed", models.printed_mu_nu_model), ("corrected", models.full_mu_nu_model)):
         gains = analytic.gains_from_design(DESIGN_TIME_CONSTANT, DESIGN_DAMPING, KYIV_LATITUDE)
         rate[label] = float(np.max(builder(KYIV_LATITUDE, 0.0, *gains).eigenvalues().real))
-    rows.append(ReproductionRow(
-        "largest real part of the (1.17) eigenvalues at A = 0, as printed", "< 0 (stable)", rate["printed"], "1/s",
-        False, f"as printed the azimuth loop diverges (e-folding {1 / rate['printed'] / 3600:.1f} h); "
-               f"corrected: {rate['corrected']:.4f} 1/s",
-    ))
+    rows.append(compare(
+        "largest real part of the (1.17) eigenvalues at A = 0, as printed", rate["printed"], "1/s",
+        note=f"as printed the azimuth loop diverges (e-folding {1 / rate['printed'] / 3600:.1f} h); "
+             f"corrected: {rate['corrected']:.4f} 1/s"))
     accel = study.AlignmentCase(latitude=math.radians(50.0), accel_error_x=EXAMPLE_ACCEL_ERROR)
     shift = {m: study.run_case(accel, m, duration=RUN_DURATION).simulated.azimuth_error[0] for m in ("simplified", "full")}
-    rows.append(ReproductionRow(
-        "azimuth shift from 100 micro-g on x at 50 deg, A = 0 (full model)", 0.0,
-        float(to_unit(shift["full"], "arcsec")), "arcsec", False,
-        f"'does not depend on accelerometer errors' holds for (1.19) ({float(to_unit(shift['simplified'], 'arcsec')):.2g} "
-        "arcsec); in (1.17)/(1.18) alpha U_z adds about eps_alpha tan(latitude)",
-    ))
+    rows.append(compare(
+        "azimuth shift from 100 micro-g on x at 50 deg, A = 0 (full model)", float(to_unit(shift["full"], "arcsec")),
+        "arcsec", printed="does not depend on accelerometer errors", value=0.0, where=where,
+        tolerance=Tolerance(0.0, 1e-3),
+        erratum=f"holds for (1.19) ({float(to_unit(shift['simplified'], 'arcsec')):.2g} arcsec); in (1.17)/(1.18) "
+                "alpha U_z adds about eps_alpha tan(latitude)"))
     tilt = study.AlignmentCase(latitude=math.radians(50.0), azimuth=math.pi / 2, accel_error_x=EXAMPLE_ACCEL_ERROR)
     beta_full = study.run_case(tilt, "full", duration=RUN_DURATION).simulated.level_error_beta[0]
     eps_beta_printed = EXAMPLE_ACCEL_ERROR * math.sin(math.pi / 2) / STANDARD_GRAVITY
-    rows.append(ReproductionRow(
-        "beta_y for 100 micro-g on x at A = 90 deg", float(to_unit(-eps_beta_printed, "arcsec")),
-        float(to_unit(beta_full, "arcsec")), "arcsec", False,
-        "printed eps_beta = (Delta a_x sin A + Delta a_y cos A)/g; (1.8) gives eps_beta = (Delta a_y cos A - Delta a_x sin A)/g",
-    ))
-    return ReproductionResult(
-        source="source 003 (KPI lab manual, Meleshko), Sec. 2",
-        constants={"earth_rate_rad_per_s": EARTH_RATE, "gravity_m_per_s2": STANDARD_GRAVITY,
-                   "latitude_deg": math.degrees(KYIV_LATITUDE)},
+    rows.append(compare(
+        "beta_y for 100 micro-g on x at A = 90 deg", float(to_unit(beta_full, "arcsec")), "arcsec",
+        printed="eps_beta = (Delta a_x sin A + Delta a_y cos A)/g", value=float(to_unit(-eps_beta_printed, "arcsec")),
+        where=where,
+        erratum="(1.8) gives eps_beta = (Delta a_y cos A - Delta a_x sin A)/g: the printed sign of Delta a_x is wrong"))
+    return Reproduction(
+        system="align",
+        source=KPI_LAB_MANUAL.citation,
+        constants=f"U = {EARTH_RATE} rad/s (not stated in the source), g = {STANDARD_GRAVITY} m/s^2, "
+                  f"latitude {math.degrees(KYIV_LATITUDE)} deg (Kyiv)",
         rows=rows,
         notes=[
             "The third line of (1.17) pairs cos A with mu and sin A with nu; (1.10), (1.11) and (1.18) require "
             "(nu + eps_y) cos A + (mu - eps_x) sin A. The models use the corrected line.",
             "In (1.24) C1 has 'delta_2' for delta_y; the critical C2 is delta'0 + h (delta0 - delta_y).",
         ],
+        data={"simplified model (1.19), design example": run},
     )
 
 
@@ -169,7 +140,7 @@ def report(outdir: Path) -> ReportSection:
     """Write this system's figures into ``outdir`` and describe them (a few seconds).
 
     The Monte Carlo uses 400 members and the latitude sweep 9 simulated cases;
-    ``schuler align run --monte-carlo 10000`` and ``schuler align sweep`` scale them up.
+    ``schuler align run --monte-carlo 10000`` and ``schuler sweep`` scale them up.
     """
     outdir = Path(outdir)
     reproduction = reproduce()
@@ -186,8 +157,10 @@ def report(outdir: Path) -> ReportSection:
         # the sweep reaches 80 deg on purpose, to show the degradation the warning is about
         warnings.simplefilter("ignore", study.DegradedAccuracyWarning)
         swept = study.evaluate_cases(sweep_case, "full", simulate_runs=True)
-    mc = study.monte_carlo(base, "full", 400, sigma_drift=EXAMPLE_DRIFT, sigma_drift_z=EXAMPLE_DRIFT,
-                           sigma_accel=EXAMPLE_ACCEL_ERROR, duration=1200)
+    mc_case = evaluation.PARAMETERS.case(drift_east=EXAMPLE_DRIFT, sigma_drift=EXAMPLE_DRIFT,
+                                         sigma_drift_z=EXAMPLE_DRIFT, sigma_accel=EXAMPLE_ACCEL_ERROR, duration=1200.0)
+    mc = monte_carlo(evaluation.evaluate, evaluation.OUTPUTS, mc_case, 400, RandomStreams(0))
+    mc_sigma = float(evaluation.evaluate(Cases.from_case(mc_case))["azimuth_error_sigma_rad"][0])
     corrected = study.AlignmentCase(latitude=KYIV_LATITUDE)
     gains = corrected.gains()
     time = np.arange(0.0, 48 * 3600.0 + 1, 600.0)
@@ -204,8 +177,8 @@ def report(outdir: Path) -> ReportSection:
              "settling_time_s": swept["settling_time_s"],
              "settling_time_simulated_s": swept["settling_time_simulated_s"]}),
         "align_monte_carlo": plots.monte_carlo_histogram(
-            to_unit(mc.azimuth_errors, "arcmin"), float(to_unit(mc.sigma_analytic, "arcmin")),
-            float(to_unit(mc.mean, "arcmin")), "full"),
+            to_unit(mc.samples["azimuth_error_rad"], "arcmin"), float(to_unit(mc_sigma, "arcmin")),
+            float(to_unit(mc.statistics["azimuth_error_rad"]["mean"], "arcmin")), "full"),
         "align_printed_1_17": plots.printed_versus_corrected(time, printed, fixed),
     }
     plots.write_figures(figures, outdir, formats=("png",))
@@ -235,7 +208,7 @@ def report(outdir: Path) -> ReportSection:
         commands=[
             "schuler align reproduce",
             "schuler align run --latitude 50 --azimuth 30 --drift-east '0.01 deg/h' --out align",
-            "schuler align sweep latitude=0:80:10 --drift-east '0.01 deg/h' --out align",
+            "schuler sweep examples/align_gyrocompassing.toml --param latitude=0:80:10 --out align-sweep",
             "schuler align run --drift-east '0.01 deg/h' --monte-carlo 10000 --out align",
         ],
         notes=reproduction.notes,

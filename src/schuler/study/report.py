@@ -21,7 +21,8 @@ from pathlib import Path
 from schuler import __version__
 from schuler.exceptions import SchulerError
 from schuler.io import write_text
-from schuler.registry import SYSTEM_MODULES, ReportSection, System
+from schuler.contract import ReportSection, System
+from schuler.registry import SYSTEM_MODULES
 from schuler.study.systems import load_system
 
 FIGURES = "figures"
@@ -207,17 +208,19 @@ def _number(value) -> str:
 def _reproduction_table(section: ReportSection) -> str:
     rows = []
     for row in section.rows:
-        mark = '<td class="ok">agrees</td>' if row.agrees else '<td class="differs">differs</td>'
+        kind = "differs" if row.failed else "erratum" if row.verdict == "erratum" else "ok"
         rows.append(
-            f"<tr><td>{html.escape(row.quantity)}</td><td>{_number(row.printed)}</td>"
-            f"<td>{_number(row.computed)}</td><td>{html.escape(row.unit)}</td>{mark}"
-            f"<td>{html.escape(row.note)}</td></tr>"
+            f"<tr><td>{html.escape(row.quantity)}</td><td>{html.escape(row.printed or '-')}</td>"
+            f"<td>{html.escape(row.where)}</td><td>{_number(row.computed)}</td><td>{html.escape(row.unit)}</td>"
+            f'<td class="{kind}">{html.escape(row.verdict)}</td><td>{html.escape(row.note)}</td></tr>'
         )
-    agreeing = sum(row.agrees for row in section.rows)
+    counts = {verdict: sum(row.verdict.startswith(verdict) for row in section.rows)
+              for verdict in ("agrees", "tuned", "erratum", "not printed", "differs")}
+    summary = ", ".join(f"{n} {verdict}" for verdict, n in counts.items() if n)
     return (
-        f"<h3>Reproduction ({agreeing} of {len(section.rows)} agree)</h3>"
-        "<table class=\"reproduction\"><thead><tr><th>quantity</th><th>source</th><th>computed</th>"
-        "<th>unit</th><th>agreement</th><th>note</th></tr></thead><tbody>" + "".join(rows) + "</tbody></table>"
+        f"<h3>Reproduction ({summary})</h3>"
+        "<table class=\"reproduction\"><thead><tr><th>quantity</th><th>printed</th><th>where</th><th>computed</th>"
+        "<th>unit</th><th>verdict</th><th>note</th></tr></thead><tbody>" + "".join(rows) + "</tbody></table>"
     )
 
 
@@ -252,6 +255,7 @@ th, td { border: 1px solid #d0d7de; padding: 0.3rem 0.5rem; text-align: left; ve
 thead th { background: #eef1f4; }
 td.ok { color: #116329; font-weight: 600; }
 td.differs { color: #9a3412; font-weight: 600; }
+td.erratum { color: #7c4a03; font-weight: 600; }
 .figures { display: flex; flex-wrap: wrap; gap: 1rem; }
 figure { margin: 0; flex: 1 1 480px; background: #fff; border: 1px solid #d0d7de; padding: 0.5rem; }
 figure img { width: 100%; height: auto; }

@@ -11,16 +11,17 @@ as the command-line options (underscores instead of dashes)::
     latitude = "50 deg"
     drift_east = "0.01 deg/h"
 
-    [simulation]        # optional: the run's duration and step parameter (step may
-    duration = "6 h"    # stand for time_step or output_step); each may be set here or in
-    step = "1 s"        # [parameters], not both
+    [simulation]            # optional: the run's duration and output step (each may be
+    duration = "6 h"        # set here or in [parameters], not both) and the system's
+    output_step = "1 s"     # fidelity ("simulated" or "closed" where it offers both)
+    fidelity = "simulated"
 
     [outputs]           # optional
     directory = "out"   # like --out (relative to the current folder)
     json = false        # like --json
 
-    [monte_carlo]       # optional: what ``schuler sweep --monte-carlo N`` draws
-    seed = 1
+    [monte_carlo]       # optional: members of ``schuler run`` (cases) and what
+    seed = 1            # ``schuler sweep --monte-carlo N`` draws
     cases = 1000
     [monte_carlo.normal]    # standard deviation around the [parameters] value
     drift_east = "0.005 deg/h"
@@ -48,35 +49,32 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Union
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr, ValidationError
 from pydantic import create_model
+from scipy.special import ndtri
 
 from schuler.exceptions import InvalidParameter, ScenarioError
-from schuler.params import Parameter
-from schuler.registry import SYSTEM_MODULES, System, get_system
+from schuler.contract import System
+from schuler.core.random import RandomStreams
+from schuler.params import Case, Parameter
+from schuler.registry import SYSTEM_MODULES, get_system
+from schuler.units import to_unit
 from schuler.study.systems import load_system
 
-SIMULATION_KEYS: dict[str, tuple[str, ...]] = {
-    "duration": ("duration",),
-    "step": ("step", "time_step", "output_step"),
-}
-"""Keys of the ``[simulation]`` table and the run parameter each may stand for."""
+SIMULATION_KEYS = ("duration", "output_step")
+"""Parameters that may also be set in the ``[simulation]`` table (where the system has them)."""
 
 
 def simulation_keys(parameters) -> dict[str, str]:
-    """``[simulation]`` key -> run parameter name, for the keys a system supports.
+    """``[simulation]`` key -> run parameter name, for the keys a system has.
 
     >>> from schuler.params import Parameter
-    >>> simulation_keys([Parameter("time_step", "s", 1.0, "Output step.")])
-    {'step': 'time_step'}
+    >>> simulation_keys([Parameter("output_step", "s", 1.0, "Output step.")])
+    {'output_step': 'output_step'}
     """
     names = {spec.name for spec in parameters}
-    found = {}
-    for key, candidates in SIMULATION_KEYS.items():
-        match = next((name for name in candidates if name in names), None)
-        if match is not None:
-            found[key] = match
-    return found
+    return {key: key for key in SIMULATION_KEYS if key in names}
 
 Value = Union[StrictBool, StrictInt, StrictFloat, StrictStr]
 """What a TOML scalar can be; the Parameter decides what it means."""
@@ -100,6 +98,42 @@ class Distribution:
     first: float
     second: float = 0.0
 
+    def draw(self, spec: Parameter, base, seed: int, cases: np.ndarray) -> np.ndarray:
+        """The parameter's value for each case number (counter-based: independent of chunking).
+
+        Raises
+        ------
+        ScenarioError
+            A draw outside the parameter's range.
+        """
+        # parameter draws have stream names of their own, apart from the system's random terms
+        u = RandomStreams(seed).uniform(f"parameter/{spec.name}", cases)
+        if self.kind == "normal":
+            drawn = base + self.first * ndtri(u)
+        else:
+            drawn = self.first + (self.second - self.first) * u
+        if spec.kind == "integer":
+            drawn = np.rint(drawn).astype(np.int64)
+        _check_draws(spec, drawn, self.kind)
+        return drawn
+
+
+def _check_draws(spec: Parameter, drawn: np.ndarray, kind: str) -> None:
+    shown = to_unit(drawn, spec.unit) if spec.kind == "quantity" else drawn
+    low = shown.min()
+    high = shown.max()
+    too_low = spec.minimum is not None and (low < spec.minimum or (spec.exclusive_minimum and low <= spec.minimum))
+    too_high = spec.maximum is not None and (high > spec.maximum or (spec.exclusive_maximum and high >= spec.maximum))
+    if too_low or too_high:
+        bad = low if too_low else high
+        unit = f" {spec.unit}" if spec.kind == "quantity" and spec.unit else ""
+        raise ScenarioError(
+            f"[monte_carlo.{kind}] {spec.name}: a draw of {bad:g}{unit} is outside {spec.range_text()}; "
+            "narrow the distribution"
+        )
+
+
+
 
 @dataclass(frozen=True)
 class MonteCarlo:
@@ -118,8 +152,8 @@ class Scenario:
     ----------
     system : str
         CLI name of the system.
-    values : dict
-        Every ``run`` parameter in SI (defaults filled in), ready for ``System.run``.
+    values : Case
+        Every ``run`` parameter in SI (defaults filled in; ``values.given`` are the ones the file sets).
     written : dict
         The parameter values exactly as written in the file (strings or numbers),
         including the ``[simulation]`` ones, in the file's order.
@@ -129,39 +163,39 @@ class Scenario:
     as_json : bool
         The ``[outputs] json`` switch.
     monte_carlo : MonteCarlo or None
+    fidelity : str or None
+        The ``[simulation] fidelity`` (None: the system's default).
     source : str
         Where the scenario came from (file name), used in messages.
     """
 
     system: str
-    values: dict[str, Any]
+    values: Case
     written: dict[str, Any]
     title: str = ""
     description: str = ""
     out_dir: Path | None = None
     as_json: bool = False
     monte_carlo: MonteCarlo | None = None
+    fidelity: str | None = None
     source: str = "<scenario>"
 
     def definition(self) -> System:
         """The :class:`~schuler.registry.System` this scenario runs."""
         return get_system(self.system)
 
-    def run(self):
-        """Run the scenario with the system's API; returns its Result."""
-        return self.definition().run(**self.values)
+    def draw(self, cases: np.ndarray) -> dict[str, np.ndarray]:
+        """The values of the ``[monte_carlo]`` random parameters for the given case (member) numbers."""
+        table = self.monte_carlo
+        if table is None:
+            return {}
+        specs = {p.name: p for p in self.definition().parameters}
+        return {name: d.draw(specs[name], self.values[name], table.seed, cases)
+                for name, d in table.distributions.items()}
 
-    def command_line(self) -> list[str]:
-        """The equivalent ``schuler SYSTEM run`` arguments (values as written)."""
-        by_name = {p.name: p for p in self.definition().parameters}
-        args = [self.system, "run"]
-        for name, raw in self.written.items():
-            spec = by_name[name]
-            if spec.kind == "flag":
-                args.append(spec.option if spec.parse(raw, name) else f"--no-{spec.option[2:]}")
-            else:
-                args.extend([spec.option, str(raw)])
-        return args
+    def given(self) -> dict[str, Any]:
+        """The SI values the file sets (what ``System.run`` takes; the rest are defaults)."""
+        return {name: self.values[name] for name in self.values.given}
 
 
 def load_scenario(path) -> Scenario:
@@ -216,13 +250,12 @@ def scenario_model(system: System) -> type[BaseModel]:
         f"{system.name}_parameters", __config__=_STRICT, __validators__=_validators(parameters, fields), **fields
     )
     stands_for = simulation_keys(system.parameters)
-    sim_fields = {key: (Value | None, None) for key in stands_for}
+    sim_fields: dict[str, Any] = {key: (Value | None, None) for key in stands_for}
+    validators = _validators({key: parameters[name] for key, name in stands_for.items()}, dict(sim_fields))
+    if system.fidelities:
+        sim_fields["fidelity"] = (Literal[system.fidelities] | None, None)  # type: ignore[valid-type]
     simulation_table = create_model(
-        f"{system.name}_simulation",
-        __config__=_STRICT,
-        __validators__=_validators({key: parameters[name] for key, name in stands_for.items()}, sim_fields),
-        **sim_fields,
-    )
+        f"{system.name}_simulation", __config__=_STRICT, __validators__=validators, **sim_fields)
     random_fields = {name: (Value | None, None) for name in parameters}
     normal_table = create_model(f"{system.name}_normal", __config__=_STRICT, **random_fields)
     uniform_fields = {name: (tuple[Value, Value] | None, None) for name in parameters}
@@ -319,20 +352,24 @@ def _build(parsed: BaseModel, system: System, source: str) -> Scenario:
     written: dict[str, Any] = {}
     if parsed.parameters is not None:
         written.update({k: v for k, v in parsed.parameters.model_dump().items() if v is not None})
+    fidelity = None
     if parsed.simulation is not None:
         stands_for = simulation_keys(system.parameters)
         for key, value in parsed.simulation.model_dump().items():
             if value is None:
+                continue
+            if key == "fidelity":
+                fidelity = value
                 continue
             name = stands_for[key]
             if name in written:
                 raise ScenarioError(f"{source}: [simulation] {key}: also set as [parameters] {name}; set it once")
             written[name] = value
     specs = {p.name: p for p in system.parameters}
-    values = {}
-    for name, spec in specs.items():
-        raw = written.get(name, spec.default)
-        values[name] = None if raw is None else spec.parse(raw, name)
+    try:
+        values = system.parameters.parse(written)
+    except InvalidParameter as error:
+        raise ScenarioError(f"{source}: [parameters] {error}") from None
     outputs = parsed.outputs or OutputsTable()
     return Scenario(
         system=system.name,
@@ -343,6 +380,7 @@ def _build(parsed: BaseModel, system: System, source: str) -> Scenario:
         out_dir=Path(outputs.directory) if outputs.directory else None,
         as_json=outputs.json_,
         monte_carlo=_monte_carlo(parsed.monte_carlo, specs, source),
+        fidelity=fidelity,
         source=source,
     )
 

@@ -1,0 +1,136 @@
+"""The command line of every system, generated from its :class:`~schuler.contract.System`.
+
+``schuler NAME run`` (the system's parameters, ``--monte-carlo``, ``--seed``,
+``--fidelity`` where offered), ``schuler NAME reproduce`` and the system's own
+actions: each parses its options with the system's
+:class:`~schuler.params.ParameterSet`, calls one function of the system and
+hands the result to :func:`~schuler.cli.common.emit`. No numerics here.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from schuler.cli.common import (
+    emit,
+    json_option,
+    options_named,
+    out_option,
+    parameter_options,
+    progress_reporter,
+)
+from schuler.contract import RUN_OPTIONS, Action, System
+from schuler.params import Case, ParameterSet
+
+_CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
+
+
+def system_group(system: System) -> click.Group:
+    """The click group ``schuler NAME`` with ``run``, ``reproduce`` and the system's actions."""
+    group = click.Group(
+        name=system.name,
+        help=f"{system.title}.\n\nSource: {system.reference}." + (f"\n\nGuide: {system.guide}" if system.guide else ""),
+        short_help=system.title + ".",
+        context_settings=_CONTEXT,
+    )
+    group.add_command(_run_command(system))
+    group.add_command(_reproduce_command(system))
+    for action in system.actions:
+        group.add_command(_action_command(system, action))
+    return group
+
+
+def _given(case) -> dict:
+    """The values the user set (defaults stay to the system, so option conflicts are judged on what was typed)."""
+    return {name: case[name] for name in case.given}
+
+
+def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fidelity: str | None,
+                out_dir: Path | None, as_json: bool, draw=None) -> None:
+    """What ``schuler NAME run`` and ``schuler run SCENARIO`` do with a parsed case."""
+    with options_named(system.parameters), progress_reporter(f"{system.name} Monte Carlo", enabled=not as_json) \
+            as progress:
+        result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
+                            **_given(case))
+    files = system.write_files(result, out_dir) if out_dir is not None else []
+    inputs = dict(case)
+    if monte_carlo:
+        inputs.update(monte_carlo=monte_carlo, seed=seed)
+    if system.fidelities:
+        inputs["fidelity"] = system.check_fidelity(fidelity)
+    emit(result, as_json, inputs=inputs, parameters=system.parameters, files=files)
+
+
+def _run_command(system: System) -> click.Command:
+    run_options = ParameterSet(RUN_OPTIONS, owner=system.name)
+
+    def run(out_dir: Path | None, as_json: bool, fidelity: str | None = None, **raw):
+        options = run_options.parse({k: raw.pop(k) for k in run_options.names}, labels="option")
+        case = system.parameters.parse(raw, labels="option")
+        execute_run(system, case, monte_carlo=options["monte_carlo"], seed=options["seed"], fidelity=fidelity,
+                    out_dir=out_dir, as_json=as_json)
+
+    command = click.Command("run", callback=run, context_settings=_CONTEXT,
+                            help=f"One case: {system.title}. The headline numbers; figures and data with --out.\n\n"
+                                 "Bare numbers are in each option's display unit (shown below); values with "
+                                 "units are converted. --monte-carlo N adds N random members around the case.")
+    decorated = parameter_options(tuple(system.parameters) + RUN_OPTIONS)(command.callback)
+    for param in reversed(getattr(decorated, "__click_params__", [])):
+        command.params.append(param)
+    if system.fidelities:
+        command.params.append(click.Option(
+            ["--fidelity"], type=click.Choice(system.fidelities), default=None,
+            help=f"How outputs are computed: {', '.join(system.fidelities)} (default {system.fidelities[0]})."))
+    command.params.extend(_output_params())
+    return command
+
+
+def _output_params() -> list[click.Parameter]:
+    holder = out_option(json_option(lambda **kw: None))
+    return list(reversed(holder.__click_params__))
+
+
+def _reproduce_command(system: System) -> click.Command:
+    def reproduce(out_dir: Path | None, as_json: bool, **raw):
+        case = system.reproduce_parameters.parse(raw, labels="option")
+        with options_named(system.reproduce_parameters):
+            result = system.reproduce(**case)
+        files = system.write_files(result, out_dir) if out_dir is not None else []
+        emit(result, as_json, inputs=dict(case), parameters=system.reproduce_parameters, files=files)
+
+    return _command("reproduce", reproduce, system.reproduce_parameters,
+                    f"The source's published case, printed beside the computed values.\n\nSource: {system.reference}.")
+
+
+def _action_command(system: System, action: Action) -> click.Command:
+    paths = [argument.name for argument in action.arguments] + (["output"] if action.output_file else [])
+
+    def act(out_dir: Path | None, as_json: bool, **raw):
+        files_in = {name: raw.pop(name) for name in paths}
+        case = action.parameters.parse(raw, labels="option")
+        with options_named(action.parameters):
+            result = action.function(**files_in, **case)
+        files = system.write_files(result, out_dir) if out_dir is not None else []
+        written = getattr(result, "files", None) or []
+        emit(result, as_json, inputs={**{k: str(v) for k, v in files_in.items()}, **case},
+             parameters=action.parameters, files=[*written, *files])
+
+    command = _command(action.name, act, action.parameters, action.help)
+    for argument in reversed(action.arguments):
+        command.params.insert(0, click.Argument([argument.name], metavar=argument.metavar,
+                                                type=click.Path(dir_okay=False, path_type=Path)))
+    if action.output_file:
+        command.params.insert(len(action.arguments), click.Option(
+            ["--output", "-o", "output"], required=True, type=click.Path(dir_okay=False, path_type=Path),
+            help=action.output_file))
+    return command
+
+
+def _command(name: str, callback, parameters: ParameterSet, help_text: str) -> click.Command:
+    command = click.Command(name, callback=callback, help=help_text, context_settings=_CONTEXT)
+    decorated = parameter_options(tuple(parameters))(lambda **kw: None)
+    command.params.extend(reversed(getattr(decorated, "__click_params__", [])))
+    command.params.extend(_output_params())
+    return command

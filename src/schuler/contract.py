@@ -1,0 +1,461 @@
+"""The system contract: what every instrument system provides, in one place.
+
+A system (``schuler errors``, ``align``, ``imu`` ...) is one :class:`System`
+value in its subpackage's ``api`` module. Everything above it — the Python API
+(:meth:`System.run`), scenario files, sweeps, the report and the command line,
+which is generated from it — goes through the same few entries:
+
+1. **Parameters** (:class:`~schuler.params.ParameterSet`) declared once: names,
+   display units, defaults, ranges, help. Every entry point builds a validated
+   :class:`~schuler.params.Case` from them; nothing else fills defaults.
+2. ``evaluate(cases) -> {output: array}``: the vectorised evaluation of a batch
+   of cases (:class:`Cases`), each output an array of length ``len(cases)`` in
+   SI, declared in ``outputs`` (:class:`Output`). Sweeps and Monte Carlo call
+   only this.
+3. ``run_case(case, fidelity) -> Result``: one case in full (time histories for
+   figures and files). Its result's ``to_dict()`` holds every output of
+   ``evaluate`` with the same value (the contract tests check it to 1e-9).
+4. ``reproduce(**options) -> Reproduction``: the source's published case, rows
+   of printed and computed values with verdicts from stated tolerances.
+5. ``write_files(result, out_dir) -> [paths]``: the one entry that writes a
+   result's figures and data files.
+6. ``actions``: the system's own commands beyond ``run`` and ``reproduce``
+   (``north identify``), each a function of validated parameters returning a Result.
+
+Randomness belongs to the driver: a case's random terms (sensor noise,
+Monte Carlo perturbations) are drawn by ``evaluate`` from ``cases.random``
+(counter-based :class:`~schuler.core.random.RandomStreams`) addressed by
+``cases.members``, the global case or member numbers — so results never depend
+on chunking or executor. ``cases.random is None`` means the nominal case: every
+random term zero.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from schuler.core.random import RandomStreams
+from schuler.core.stats import StreamingStatistics
+from schuler.exceptions import InvalidParameter
+from schuler.params import Case, Parameter, ParameterSet
+from schuler.results import MonteCarloSummary, Result
+
+MONTE_CARLO_CHUNK = 2_000
+"""Members evaluated at once in :meth:`System.run` Monte Carlo (unless the system says otherwise)."""
+
+MONTE_CARLO_SAMPLES = 100_000
+"""Members whose outputs a Monte Carlo summary keeps for histograms."""
+
+
+@dataclass(frozen=True)
+class Output:
+    """One output of a system's ``evaluate``: its key, SI unit, display unit and meaning.
+
+    Parameters
+    ----------
+    name : str
+        Key in ``evaluate``'s dict and in the result's ``to_dict()`` (unit in
+        the name where it is not obvious: ``azimuth_error_rad``).
+    unit : str
+        SI unit of the values (``"rad"``, ``"s"``, ``"1"``).
+    display : str
+        Unit shown to people (``"arcmin"``); empty: the SI unit.
+    description : str
+        One line for tables, plots and documentation.
+    """
+
+    name: str
+    unit: str
+    display: str = ""
+    description: str = ""
+
+    @property
+    def shown_unit(self) -> str:
+        return self.display or ("" if self.unit == "1" else self.unit)
+
+
+class Cases:
+    """A batch of validated cases: every parameter an array of length ``n`` (SI).
+
+    Numbers are float arrays (NaN where a parameter is not set and its own rule
+    applies, see :meth:`value_or`), integers int64 arrays, choices and text
+    object arrays (None where not set), flags bool arrays.
+
+    Attributes
+    ----------
+    members : ndarray of int64
+        Global case or member numbers: the addresses of the random draws.
+    random : RandomStreams or None
+        Where random terms come from; None evaluates the nominal case (no noise).
+    fidelity : str or None
+        The system's evaluation fidelity (``"simulated"``, ``"closed"``) or None
+        for its default.
+    """
+
+    def __init__(self, values: Mapping[str, Any], *, members=None, random: RandomStreams | None = None,
+                 fidelity: str | None = None):
+        arrays = {name: np.asarray(value) for name, value in values.items()}
+        lengths = {a.shape[0] for a in arrays.values() if a.ndim == 1}
+        if any(a.ndim != 1 for a in arrays.values()) or len(lengths) > 1:
+            raise InvalidParameter("cases", "every parameter must be a 1-D array of the same length")
+        self.n = lengths.pop() if lengths else 0
+        self._values = arrays
+        self.members = np.arange(self.n, dtype=np.int64) if members is None else np.asarray(members, dtype=np.int64)
+        if self.members.shape != (self.n,):
+            raise InvalidParameter("members", f"expected {self.n} member numbers, got shape {self.members.shape}")
+        self.random = random
+        self.fidelity = fidelity
+
+    @classmethod
+    def from_case(cls, case: Case, n: int = 1, **kwargs) -> Cases:
+        """``n`` copies of one case (a Monte Carlo's members, or a single evaluation)."""
+        values = {}
+        for name, value in case.items():
+            if value is None:
+                values[name] = np.full(n, None, dtype=object)
+            elif isinstance(value, str):
+                values[name] = np.full(n, value, dtype=object)
+            else:
+                values[name] = np.full(n, value)
+        return cls(values, **kwargs)
+
+    def __len__(self) -> int:
+        return self.n
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self._values[name]
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._values
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self._values)
+
+    def float(self, name: str) -> np.ndarray:
+        """A numeric parameter as a float array (NaN where not set)."""
+        array = self._values[name]
+        if array.dtype == object:
+            return np.array([np.nan if v is None else float(v) for v in array])
+        return array.astype(float)
+
+    def value_or(self, name: str, fallback) -> np.ndarray:
+        """A numeric parameter with its "not set" entries replaced by ``fallback`` (scalar or array)."""
+        values = self.float(name)
+        return np.where(np.isnan(values), fallback, values)
+
+    def is_set(self, name: str) -> np.ndarray:
+        """Which cases set the parameter (bool array)."""
+        array = self._values[name]
+        if array.dtype == object:
+            return np.array([v is not None for v in array], dtype=bool)
+        if array.dtype.kind == "f":
+            return ~np.isnan(array)
+        return np.ones(self.n, dtype=bool)
+
+    def take(self, index) -> Cases:
+        """The cases at ``index`` (an index array or boolean mask), keeping their member numbers."""
+        return Cases({k: v[index] for k, v in self._values.items()}, members=self.members[index],
+                     random=self.random, fidelity=self.fidelity)
+
+    def groups(self, *names: str) -> Iterator[tuple[np.ndarray, Cases]]:
+        """Split the batch by the distinct values of ``names``: (indices, sub-batch) pairs.
+
+        For parameters that change the shape of a computation (a duration, an
+        output step, a model choice), so each group is evaluated at once.
+        """
+        if not names or self.n == 0:
+            yield np.arange(self.n), self
+            return
+        keys = [tuple(_key(self._values[name][i]) for name in names) for i in range(self.n)]
+        order: dict[tuple, list[int]] = {}
+        for i, key in enumerate(keys):
+            order.setdefault(key, []).append(i)
+        for indices in order.values():
+            index = np.asarray(indices, dtype=np.int64)
+            yield index, self.take(index)
+
+    def case(self, i: int) -> Case:
+        """Case ``i`` as a :class:`Case` (NaN and None become "not set")."""
+        values = {}
+        for name, array in self._values.items():
+            value = array[i]
+            value = value.item() if isinstance(value, np.generic) else value
+            values[name] = None if isinstance(value, float) and math.isnan(value) else value
+        return Case(values, [k for k, v in values.items() if v is not None])
+
+
+def _key(value):
+    value = value.item() if isinstance(value, np.generic) else value
+    return "nan" if isinstance(value, float) and math.isnan(value) else value
+
+
+@dataclass(frozen=True)
+class Argument:
+    """A positional argument of an action: a file it reads (``north identify RECORD``)."""
+
+    name: str
+    help: str
+    metavar: str = "FILE"
+
+
+@dataclass(frozen=True)
+class Action:
+    """A command of a system beyond ``run`` and ``reproduce``.
+
+    Parameters
+    ----------
+    name : str
+        Command name (``identify``).
+    help : str
+        Help text; its first line is the short help.
+    function : callable
+        ``function(**si_values, **arguments) -> Result``; ``arguments`` are the
+        positional files (Path) and, with ``output_file``, ``output`` (a Path).
+    parameters : ParameterSet
+        The command's options.
+    arguments : tuple of Argument
+        Positional file arguments.
+    output_file : str
+        Help of a required ``-o/--output FILE`` option; empty: no such option.
+    """
+
+    name: str
+    help: str
+    function: Callable[..., Result]
+    parameters: ParameterSet
+    arguments: tuple[Argument, ...] = ()
+    output_file: str = ""
+
+
+@dataclass(frozen=True)
+class System:
+    """An instrument system: the contract every subpackage's ``api.SYSTEM`` fulfils.
+
+    Attributes
+    ----------
+    name : str
+        Command name (``align``).
+    title : str
+        What it models, in a line.
+    reference : str
+        The source it follows, cited by author, title, venue and year.
+    parameters : ParameterSet
+        The parameters of ``run``, sweeps and scenarios.
+    outputs : tuple of Output
+        What ``evaluate`` returns.
+    evaluate : callable
+        ``evaluate(cases: Cases) -> dict[str, ndarray]`` (vectorised; see the module notes).
+    run_case : callable
+        ``run_case(case: Case, fidelity: str | None) -> Result``: one case in full.
+    reproduce : callable
+        ``reproduce(**options) -> Reproduction``: the source's published case.
+    reproduce_parameters : ParameterSet
+        Options of ``reproduce``.
+    write_files : callable
+        ``write_files(result, out_dir: Path) -> list[Path]`` for the results of
+        ``run``, ``reproduce`` and the actions.
+    report : callable
+        ``report(figures_dir: Path) -> ReportSection``.
+    fidelities : tuple of str
+        Named evaluation choices, the default first (empty: one way only).
+    actions : tuple of Action
+        Further commands.
+    random_terms : bool
+        Whether the model has random terms of its own (sensor noise, Monte
+        Carlo sigmas), so that ``--monte-carlo`` means something without a
+        scenario's parameter distributions.
+    member_bytes : callable or None
+        ``member_bytes(case) -> int``: memory one member of a Monte Carlo or
+        sweep chunk needs while evaluated (sizes the chunks).
+    guide : str
+        Name of the system's page in the user guide.
+    """
+
+    name: str
+    title: str
+    reference: str
+    parameters: ParameterSet
+    outputs: tuple[Output, ...]
+    evaluate: Callable[[Cases], dict[str, np.ndarray]]
+    run_case: Callable[[Case, str | None], Result]
+    reproduce: Callable[..., Result]
+    write_files: Callable[[Result, Path], list[Path]]
+    report: Callable[[Path], Any]
+    reproduce_parameters: ParameterSet = field(default_factory=lambda: ParameterSet(()))
+    fidelities: tuple[str, ...] = ()
+    actions: tuple[Action, ...] = ()
+    random_terms: bool = False
+    member_bytes: Callable[[Case], int] | None = None
+    guide: str = ""
+
+    def case(self, **si_values) -> Case:
+        """A validated case from SI values; unknown names raise :class:`InvalidParameter` with a suggestion."""
+        return self.parameters.case(si_values)
+
+    def check_fidelity(self, fidelity: str | None) -> str | None:
+        """The fidelity to use (the default when None); refuses one the system does not offer."""
+        if fidelity is None:
+            return self.fidelities[0] if self.fidelities else None
+        if fidelity not in self.fidelities:
+            offered = ", ".join(self.fidelities) or "none (this system has one way of evaluating)"
+            raise InvalidParameter("fidelity", f"{fidelity!r} is not offered; choose from {offered}")
+        return fidelity
+
+    def run(self, *, monte_carlo: int = 0, seed: int = 0, fidelity: str | None = None,
+            progress: Callable[[int, int], None] | None = None,
+            draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None, **si_values) -> Result:
+        """Run one case from SI values (every parameter not given takes its default).
+
+        Parameters
+        ----------
+        monte_carlo : int
+            Members of a Monte Carlo around the case (0: none). Each member draws
+            the system's random terms; statistics of every output are attached
+            to the result as ``monte_carlo``.
+        seed : int
+            Seed of the Monte Carlo's random streams.
+        fidelity : str, optional
+            One of :attr:`fidelities` (default: the first).
+        progress : callable, optional
+            ``progress(done, total)`` after each chunk of members.
+        draw : callable, optional
+            ``draw(member_numbers) -> {parameter: values}``: parameters drawn per
+            member (a scenario's ``[monte_carlo]`` distributions).
+        **si_values
+            Parameters in SI.
+
+        Raises
+        ------
+        InvalidParameter
+            An unknown name (with the closest known one suggested), a value out
+            of range, options that exclude each other.
+        """
+        case = self.case(**si_values)
+        fidelity = self.check_fidelity(fidelity)
+        members = _count(monte_carlo, "monte_carlo")
+        streams = RandomStreams(_count(seed, "seed"))
+        result = self.run_case(case, fidelity)
+        if members:
+            summary = self.monte_carlo(case, members, streams, fidelity, draw=draw, progress=progress)
+            result = _with_monte_carlo(result, summary)
+        return result
+
+    def monte_carlo(self, case: Case, members: int, streams: RandomStreams, fidelity: str | None = None, *,
+                    draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None,
+                    progress: Callable[[int, int], None] | None = None) -> MonteCarloSummary:
+        """Statistics of every output over ``members`` random members of ``case`` (see :func:`monte_carlo`)."""
+        return monte_carlo(self.evaluate, self.outputs, case, members, streams, fidelity,
+                           chunk=self._chunk_size(case), draw=draw, progress=progress)
+
+    def _chunk_size(self, case: Case) -> int:
+        if self.member_bytes is None:
+            return MONTE_CARLO_CHUNK
+        from schuler.memory import chunk_members
+
+        return chunk_members(self.member_bytes(case))
+
+    def evaluate_values(self, values: Mapping[str, Any], *, members=None, random: RandomStreams | None = None,
+                        fidelity: str | None = None) -> dict[str, np.ndarray]:
+        """``evaluate`` on parameter arrays in SI (unset parameters take their defaults)."""
+        self.parameters.refuse_unknown(values)
+        lengths = {np.size(v) for v in values.values() if np.ndim(v) > 0}
+        if len(lengths) > 1:
+            raise InvalidParameter("cases", f"parameter arrays have different lengths: {sorted(lengths)}")
+        n = lengths.pop() if lengths else 1
+        defaults = Cases.from_case(self.parameters.case(), n)
+        arrays = {name: defaults[name] for name in defaults.names}
+        for name, value in values.items():
+            array = np.broadcast_to(np.asarray(value), (n,))
+            arrays[name] = np.asarray(array, dtype=object) if array.dtype.kind in "USO" else np.array(array)
+        return self.evaluate(Cases(arrays, members=members, random=random, fidelity=self.check_fidelity(fidelity)))
+
+    def output(self, name: str) -> Output:
+        for output in self.outputs:
+            if output.name == name:
+                return output
+        raise KeyError(name)
+
+
+def monte_carlo(evaluate: Callable[[Cases], dict[str, np.ndarray]], outputs: tuple[Output, ...], case: Case,
+                members: int, streams: RandomStreams, fidelity: str | None = None, *, chunk: int = MONTE_CARLO_CHUNK,
+                draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None,
+                progress: Callable[[int, int], None] | None = None) -> MonteCarloSummary:
+    """Statistics of every output over ``members`` random members of ``case``, streamed in chunks.
+
+    Member ``i`` draws its random terms from ``streams`` at address ``i``, so the
+    statistics do not depend on ``chunk``. ``draw(member_numbers) -> {parameter:
+    values}`` optionally replaces parameters per member (a scenario's distributions).
+    """
+    statistics = {output.name: StreamingStatistics((1,), reservoir_size=MONTE_CARLO_SAMPLES) for output in outputs}
+    samples: dict[str, list[np.ndarray]] = {output.name: [] for output in outputs}
+    kept = 0
+    for start in range(0, members, chunk):
+        numbers = np.arange(start, min(start + chunk, members), dtype=np.int64)
+        batch = Cases.from_case(case, numbers.size, members=numbers, random=streams, fidelity=fidelity)
+        if draw is not None:
+            values = {name: batch[name] for name in batch.names}
+            values.update(draw(numbers))
+            batch = Cases(values, members=numbers, random=streams, fidelity=fidelity)
+        results = evaluate(batch)
+        for name, stats in statistics.items():
+            values = np.asarray(results[name], dtype=float)
+            stats.update(values[np.isfinite(values)][:, None])
+            if kept < MONTE_CARLO_SAMPLES:
+                samples[name].append(values[:MONTE_CARLO_SAMPLES - kept])
+        kept = min(MONTE_CARLO_SAMPLES, kept + numbers.size)
+        if progress is not None:
+            progress(int(numbers[-1]) + 1, members)
+    return MonteCarloSummary.from_statistics(members, streams.seed, outputs, statistics,
+                                             {k: np.concatenate(v) if v else np.empty(0) for k, v in samples.items()})
+
+
+def _count(value, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise InvalidParameter(name, f"{value!r} must be a whole number >= 0")
+    return int(value)
+
+
+def _with_monte_carlo(result: Result, summary: MonteCarloSummary) -> Result:
+    import dataclasses
+
+    if not any(f.name == "monte_carlo" for f in dataclasses.fields(result)):
+        raise TypeError(f"{type(result).__name__} has no monte_carlo field; derive it from RunResult")
+    return dataclasses.replace(result, monte_carlo=summary)
+
+
+RUN_OPTIONS = (
+    Parameter("monte_carlo", "", 0, "Monte Carlo members around the case (0: the nominal case only).",
+              minimum=0, kind="integer"),
+    Parameter("seed", "", 0, "Seed of the random streams (a member's draws depend only on seed and member).",
+              minimum=0, kind="integer"),
+)
+"""Options every ``run`` has besides the system's parameters."""
+
+
+@dataclass(frozen=True)
+class FigureRef:
+    """A figure file (relative to the report folder) and its caption."""
+
+    path: str
+    caption: str
+
+
+@dataclass
+class ReportSection:
+    """What one system contributes to the HTML report."""
+
+    system: str
+    title: str
+    source: str
+    summary: str
+    rows: list = field(default_factory=list)
+    figures: list[FigureRef] = field(default_factory=list)
+    commands: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)

@@ -1,0 +1,233 @@
+"""What the gyrocompassing system evaluates: its parameters, outputs, ``evaluate`` and ``run_case``.
+
+Parameters are declared once in :data:`PARAMETERS`; :func:`evaluate` is the
+vectorised evaluation of many cases (sweeps, Monte Carlo), :func:`run_case` one
+case in full (its outputs equal :func:`evaluate`'s, plus the time histories of
+the chosen model and of (1.19) beside it for the figures).
+
+Fidelities: ``simulated`` (default) takes the azimuth and level errors, the
+settling time in the 1 % band and the constraint check from the exact
+simulation of the chosen model over ``duration``; ``closed`` takes the errors
+from the model's closed-form steady state and leaves the simulated-only outputs
+NaN. Monte Carlo members draw the residual drifts about the platform x, y axes
+(``sigma_drift``), about z (``sigma_drift_z``) and the accelerometer biases
+(``sigma_accel``) independently around the case's values.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from schuler.contract import Cases, Output
+from schuler.gyrocompassing import analytic, models, study
+from schuler.gyrocompassing.results import AlignmentResult, write_files
+from schuler.params import Case, Parameter, ParameterSet
+
+_ERROR_RANGE = {"minimum": -600.0, "maximum": 600.0}
+
+PARAMETERS = ParameterSet((
+    Parameter("latitude", "deg", 50.0, "Latitude of the site.", minimum=-90, maximum=90,
+              exclusive_minimum=True, exclusive_maximum=True),
+    Parameter("azimuth", "deg", 0.0, "Azimuth A of the platform's x_g axis.", minimum=-360, maximum=360),
+    Parameter("drift_east", "deg/h", 0.0, "Residual drift about east, Delta omega_dxi (estimate - true)."),
+    Parameter("drift_north", "deg/h", 0.0, "Residual drift about north, Delta omega_deta."),
+    Parameter("drift_x", "deg/h", 0.0, "Residual drift about the platform x axis (adds to east/north)."),
+    Parameter("drift_y", "deg/h", 0.0, "Residual drift about the platform y axis (adds to east/north)."),
+    Parameter("drift_z", "deg/h", 0.0, "Residual drift about the platform z axis (up)."),
+    Parameter("latitude_error", "arcmin", 0.0, "Error Delta phi of the latitude entered.", **_ERROR_RANGE),
+    Parameter("accel_bias_x", "g", 0.0, "Bias Delta a_x of the x accelerometer (measured - true).",
+              minimum=-0.1, maximum=0.1),
+    Parameter("accel_bias_y", "g", 0.0, "Bias Delta a_y of the y accelerometer (measured - true).",
+              minimum=-0.1, maximum=0.1),
+    Parameter("time_constant", "s", study.DEFAULT_TIME_CONSTANT,
+              "Time constant T of the azimuth loop (gains not given follow from T and zeta).",
+              minimum=0, exclusive_minimum=True),
+    Parameter("damping", "", study.DEFAULT_DAMPING, "Damping ratio zeta of the azimuth loop.",
+              minimum=0, exclusive_minimum=True),
+    Parameter("c_gamma", "1/s", None, "Level correction gain c_Gamma (not set: 2 zeta / T).",
+              minimum=0, exclusive_minimum=True),
+    Parameter("c_a", "1/s", None, "Azimuth correction gain c_a (not set: 1 / (T^2 U cos(latitude))).",
+              minimum=0, exclusive_minimum=True),
+    Parameter("initial_azimuth_error", "deg", math.degrees(study.DEFAULT_INITIAL_AZIMUTH_ERROR),
+              "Initial azimuth misalignment delta0.", minimum=-90, maximum=90),
+    Parameter("initial_beta", "arcmin", 0.0, "Initial level error beta0 (0: levelled).", **_ERROR_RANGE),
+    Parameter("initial_alpha", "arcmin", 0.0, "Initial level error alpha0 (0: levelled).", **_ERROR_RANGE),
+    Parameter("model", "", "full", "Model: full (mu, nu) (1.17), full-ab (beta, alpha) (1.18) or simplified (1.19).",
+              choices=models.MODELS, kind="choice"),
+    Parameter("duration", "s", None,
+              "Simulated time (not set: 2 h, or 3 settling times if longer, at most 48 h).",
+              minimum=0, exclusive_minimum=True, maximum=study.MAX_DURATION),
+    Parameter("output_step", "s", 1.0, "Output step (the simulation is exact between outputs).",
+              minimum=0, exclusive_minimum=True),
+    Parameter("max_latitude", "deg", math.degrees(study.DEFAULT_MAX_LATITUDE),
+              "Latitude above which azimuth is reported not observable.", minimum=0, maximum=90,
+              exclusive_minimum=True, exclusive_maximum=True),
+    Parameter("sigma_drift", "deg/h", 0.01, "Monte Carlo: 1-sigma of the x and y residual drifts.", minimum=0),
+    Parameter("sigma_drift_z", "deg/h", 0.01, "Monte Carlo: 1-sigma of the z residual drift.", minimum=0),
+    Parameter("sigma_accel", "g", 1e-4, "Monte Carlo: 1-sigma of each accelerometer bias.", minimum=0),
+), owner="align")
+"""Every option of ``schuler align run`` (and key of an ``align`` scenario)."""
+
+OUTPUTS = (
+    Output("azimuth_error_rad", "rad", "arcmin", "azimuth error delta of the model at the end (steady state)"),
+    Output("azimuth_error_analytic_rad", "rad", "arcmin", "steady state delta_y of (1.21)"),
+    Output("full_minus_simplified_rad", "rad", "arcsec",
+           "closed-form steady state of the full model minus (1.21): what alpha U_z adds"),
+    Output("level_error_beta_rad", "rad", "arcmin", "level error beta of the model at the end"),
+    Output("level_error_beta_analytic_rad", "rad", "arcmin", "steady state beta_y of (1.25)"),
+    Output("azimuth_error_sigma_rad", "rad", "arcmin",
+           "1-sigma of the model's steady azimuth error for the Monte Carlo sigmas"),
+    Output("azimuth_error_sigma_simplified_rad", "rad", "arcmin", "the same from (1.21), drifts only"),
+    Output("settling_time_s", "s", "", "settling time 5/h (or the corrected aperiodic formula)"),
+    Output("settling_time_simulated_s", "s", "", "last exit from the 1 % band (simulated; inf: not settled)"),
+    Output("c_gamma", "1/s", "", "level correction gain used"),
+    Output("c_a", "1/s", "", "azimuth correction gain used"),
+    Output("time_constant_s", "s", "", "time constant T of the gains used"),
+    Output("damping", "1", "", "damping ratio zeta of the gains used"),
+    Output("max_abs_delta_rad", "rad", "", "largest |delta| over the run (simulated)"),
+    Output("max_abs_beta_rad", "rad", "", "largest |beta| over the run (simulated)"),
+    Output("max_abs_delta_rate_rad_s", "rad/s", "", "largest |delta'| over the run (simulated)"),
+    Output("constraints_ok", "1", "", "1 when |delta| < 0.4 rad, |beta| < 0.01 rad, |delta'| < 0.2 rad/s throughout"),
+    Output("duration_s", "s", "", "simulated time"),
+)
+
+FIDELITIES = ("simulated", "closed")
+
+_CASE_FIELDS = ("latitude", "azimuth", "drift_east", "drift_north", "drift_x", "drift_y", "drift_z",
+                "latitude_error", "time_constant", "damping", "c_gamma", "c_a", "initial_azimuth_error",
+                "initial_beta", "initial_alpha")
+
+
+def alignment_case(cases: Cases) -> study.AlignmentCase:
+    """The :class:`~schuler.gyrocompassing.study.AlignmentCase` of a batch, random terms drawn for members."""
+    arrays = {name: cases.float(name) for name in _CASE_FIELDS}
+    arrays["accel_error_x"] = cases.float("accel_bias_x")
+    arrays["accel_error_y"] = cases.float("accel_bias_y")
+    if cases.random is not None:
+        draw = cases.random.normal
+        for name, sigma in (("drift_x", "sigma_drift"), ("drift_y", "sigma_drift"), ("drift_z", "sigma_drift_z"),
+                            ("accel_error_x", "sigma_accel"), ("accel_error_y", "sigma_accel")):
+            arrays[name] = arrays[name] + cases.float(sigma) * draw(name, cases.members)
+    max_latitude = cases.float("max_latitude")
+    return study.AlignmentCase(**arrays, max_latitude=float(max_latitude.max()) if max_latitude.size else
+                               study.DEFAULT_MAX_LATITUDE)
+
+
+def evaluate(cases: Cases) -> dict[str, np.ndarray]:
+    """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
+
+    Cases are grouped by model, duration and output step (each group is one
+    batched simulation on the engine), so swept durations and steps hold per case.
+    """
+    n = len(cases)
+    out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
+    fidelity = cases.fidelity or FIDELITIES[0]
+    # a duration not set is the case's own automatic one, so a batch gives what each case alone gives
+    settling = study.analytic_results(alignment_case(cases), "simplified")["settling_time_s"]
+    automatic = np.array([study.automatic_duration(t) for t in np.broadcast_to(settling, (n,))])
+    resolved = Cases({**{name: cases[name] for name in cases.names}, "duration": cases.value_or("duration", automatic)},
+                     members=cases.members, random=cases.random, fidelity=cases.fidelity)
+    for index, group in resolved.groups("model", "duration", "output_step", "max_latitude"):
+        part = _evaluate_group(group, fidelity)
+        for name, values in part.items():
+            out[name][index] = values
+    return out
+
+
+def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
+    model = str(cases["model"][0])
+    case = alignment_case(cases)
+    duration = float(cases.float("duration")[0])
+    simulate = fidelity == "simulated"
+    result = study.evaluate_cases(case, model, simulate_runs=simulate, duration=duration,
+                                  time_step=float(cases.float("output_step")[0]))
+    full = study.analytic_results(case, "full-ab")["azimuth_error_rad"]
+    c_gamma, c_a = result["c_gamma"], result["c_a"]
+    system = case.model(model)
+    gains = analytic.steady_state_gain_matrix(system.A, system.B)[..., list(system.states).index("delta"), :]
+    sigmas = np.stack([cases.float("sigma_drift"), cases.float("sigma_drift"), cases.float("sigma_drift_z"),
+                       np.zeros(len(cases)), cases.float("sigma_accel"), cases.float("sigma_accel")], axis=-1)
+    out = {
+        "azimuth_error_rad": result["azimuth_error_simulated_rad" if simulate else "azimuth_error_rad"],
+        "azimuth_error_analytic_rad": result["azimuth_error_analytic_rad"],
+        "full_minus_simplified_rad": full - result["azimuth_error_analytic_rad"],
+        "level_error_beta_rad": result["level_error_beta_simulated_rad" if simulate else "level_error_beta_rad"],
+        "level_error_beta_analytic_rad": result["level_error_beta_analytic_rad"],
+        "azimuth_error_sigma_rad": np.sqrt(np.sum((gains * sigmas) ** 2, axis=-1)),
+        "azimuth_error_sigma_simplified_rad": analytic.azimuth_error_sigma(
+            case.latitude, c_gamma, c_a, cases.float("sigma_drift"), cases.float("sigma_drift_z"), 0.0,
+            case.earth_rate),
+        "settling_time_s": result["settling_time_s"],
+        "c_gamma": c_gamma,
+        "c_a": c_a,
+        "time_constant_s": result["time_constant_s"],
+        "damping": result["damping"],
+    }
+    if simulate:
+        out.update({
+            "settling_time_simulated_s": result["settling_time_simulated_s"],
+            "max_abs_delta_rad": result["max_abs_delta_rad"],
+            "max_abs_beta_rad": result["max_abs_beta_rad"],
+            "max_abs_delta_rate_rad_s": result["max_abs_delta_rate_rad_per_s"],
+            "constraints_ok": np.asarray(result["constraints_ok"], dtype=float),
+            "duration_s": np.full(len(cases), duration),
+        })
+    return out
+
+
+def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
+    """One case in full: the outputs of :func:`evaluate` and the histories of the model and of (1.19).
+
+    Examples
+    --------
+    >>> r = run_case(PARAMETERS.case(drift_east=np.radians(0.01) / 3600, model="simplified"))
+    >>> round(float(np.degrees(r.azimuth_error_rad) * 60), 3), r.constraints_ok
+    (3.556, True)
+    """
+    fidelity = fidelity or FIDELITIES[0]
+    cases = Cases.from_case(case, fidelity=fidelity)
+    outputs = {name: float(values[0]) for name, values in evaluate(cases).items()}
+    aligned = alignment_case(cases)
+    single = study.AlignmentCase(**{f: (v[0] if isinstance(v, np.ndarray) else v)
+                                    for f, v in vars(aligned).items()})
+    model = case["model"]
+    histories = simplified = None
+    if fidelity == "simulated":
+        with warnings.catch_warnings():
+            # evaluate has warned about the latitude already; the histories are the same case
+            warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")
+            histories = study.run_case(single, model, duration=outputs["duration_s"], time_step=case["output_step"])
+            simplified = histories
+            if model != "simplified":
+                # (1.19) beside the model for the comparison figures; the model's own run has warned already
+                warnings.simplefilter("ignore", study.DegradedAccuracyWarning)
+                simplified = study.run_case(single, "simplified", duration=outputs["duration_s"],
+                                            time_step=case["output_step"])
+    violations = [] if histories is None else list(histories.violations)
+    return AlignmentResult(
+        model=model, fidelity=fidelity,
+        regime=_regime(outputs["c_gamma"], outputs["c_a"], case["latitude"]),
+        constraint_violations=violations, run=histories, simplified_run=simplified,
+        **{name: (None if math.isnan(value) else bool(value)) if name == "constraints_ok" else value
+           for name, value in outputs.items()},
+    )
+
+
+def _regime(c_gamma: float, c_a: float, latitude: float) -> str:
+    h_sq = (c_gamma / 2) ** 2
+    omega0_sq = c_a * math.cos(latitude) * study.EARTH_RATE
+    if math.isclose(h_sq, omega0_sq, rel_tol=1e-9):
+        return "critical"
+    return "oscillatory" if omega0_sq > h_sq else "aperiodic"
+
+
+def member_bytes(case: Case) -> int:
+    """Memory one member holds while simulated: its history of 3 states and 3 outputs, 8 bytes each."""
+    duration = case["duration"] or study.MAX_DURATION
+    return int(6 * 8 * (duration / case["output_step"] + 2))
+
+
+__all__ = ["FIDELITIES", "OUTPUTS", "PARAMETERS", "alignment_case", "evaluate", "member_bytes", "run_case"]

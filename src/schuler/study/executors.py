@@ -1,0 +1,127 @@
+"""Where sweep chunks are evaluated: in this process, a pool of local processes, or a Dask cluster.
+
+Each executor maps a function over chunk tasks and yields results as they
+complete, with only a few chunks in flight at once (bounded memory). The
+workers of an existing Dask cluster need the same version of schuler installed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+from schuler.exceptions import ScenarioError
+
+class InProcess:
+    """Evaluate chunks one after another in this process (vectorised within each)."""
+
+    name = "in-process"
+
+    def map(self, function, tasks: Iterable) -> Iterator:
+        for task in tasks:
+            yield function(task)
+
+    def close(self) -> None:
+        """Nothing to release."""
+
+
+class LocalProcesses:
+    """A pool of local worker processes (spawned: safe beside threads)."""
+
+    name = "processes"
+
+    def __init__(self, workers: int):
+        import multiprocessing
+
+        self.workers = workers
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+
+    def map(self, function, tasks: Iterable) -> Iterator:
+        yield from _windowed(lambda task: self.pool.submit(function, task), tasks, 2 * self.workers, _wait_futures)
+
+    def close(self) -> None:
+        self.pool.shutdown(wait=True, cancel_futures=True)
+
+
+class DaskCluster:
+    """A Dask cluster: a LocalCluster started here (``"local"``) or an existing scheduler."""
+
+    name = "dask"
+
+    def __init__(self, scheduler: str, workers: int | None = None):
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:
+            raise ScenarioError("--scheduler: Dask is not installed; install schuler[dask]") from None
+        self.cluster = None
+        if scheduler == "local":
+            self.cluster = LocalCluster(
+                n_workers=workers or 2,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # any free port: never clashes with another cluster
+                silence_logs=50,
+            )
+            self.client = Client(self.cluster)
+        elif scheduler.startswith(("tcp://", "tls://", "inproc://", "ws://", "wss://")):
+            try:
+                self.client = Client(scheduler, timeout="20s")
+            except OSError as error:
+                raise ScenarioError(f"--scheduler: cannot reach {scheduler}: {error}") from None
+        else:
+            raise ScenarioError(f"--scheduler: {scheduler!r} is neither 'local' nor an address like tcp://HOST:8786")
+
+    def map(self, function, tasks: Iterable) -> Iterator:
+        from distributed import as_completed
+
+        threads = max(1, sum(self.client.nthreads().values()))
+        completed = as_completed()
+
+        def submit(task):
+            future = self.client.submit(function, task, pure=False)
+            completed.add(future)
+            return future
+
+        def next_done(pending):
+            future = next(completed)
+            pending.discard(future)
+            result = future.result()
+            future.release()
+            return [result]
+
+        yield from _windowed(submit, tasks, 2 * threads, next_done)
+
+    def close(self) -> None:
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def _wait_futures(pending: set) -> list:
+    done, _ = wait(pending, return_when=FIRST_COMPLETED)
+    pending -= done
+    return [future.result() for future in done]
+
+
+def _windowed(submit, tasks: Iterable, window: int, next_done) -> Iterator:
+    """Keep at most ``window`` tasks in flight; yield results as they complete."""
+    pending: set = set()
+    for task in tasks:
+        pending.add(submit(task))
+        if len(pending) >= window:
+            yield from next_done(pending)
+    while pending:
+        yield from next_done(pending)
+
+
+def make_executor(scheduler: str | None = None, workers: int | None = None):
+    """In-process (default), local processes (``workers`` > 1) or Dask (``scheduler``)."""
+    if workers is not None and workers < 1:
+        raise ScenarioError(f"--workers: {workers} must be at least 1")
+    if scheduler:
+        return DaskCluster(scheduler, workers)
+    if workers and workers > 1:
+        return LocalProcesses(workers)
+    return InProcess()
+
+
