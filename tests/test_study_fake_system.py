@@ -15,24 +15,32 @@ from typing import ClassVar
 import numpy as np
 import pytest
 
-from schuler.params import Parameter
-from schuler.registry import SYSTEM_MODULES, FigureRef, ReportSection, ReproductionRow, System
-from schuler.results import Result
+from schuler.contract import Cases, FigureRef, Output, ReportSection, System
+from schuler.params import Parameter, ParameterSet
+from schuler.registry import SYSTEM_MODULES
+from schuler.reproduction import Reproduction, compare
+from schuler.results import RunResult
 
 EARTH_RATE = 7.292115e-5
 
-PARAMETERS = (
+PARAMETERS = ParameterSet((
     Parameter("latitude", "deg", 50.0, "Latitude of the site.", minimum=-89.0, maximum=89.0),
     Parameter("drift_east", "deg/h", 0.01, "East gyro drift rate.", minimum=0.0),
     Parameter("gain", "", 1.0, "Loop gain.", minimum=0.0, exclusive_minimum=True),
     Parameter("method", "", "closed", "How to evaluate.", choices=("closed", "table"), kind="choice"),
     Parameter("members", "", 1, "Members.", minimum=1, kind="integer"),
     Parameter("duration", "s", 3600.0, "Simulated time.", minimum=0.0, exclusive_minimum=True),
-    Parameter("step", "s", 1.0, "Time step.", minimum=0.0, exclusive_minimum=True),
+    Parameter("output_step", "s", 1.0, "Time step.", minimum=0.0, exclusive_minimum=True),
+    Parameter("sigma_drift", "deg/h", 0.0, "Monte Carlo 1-sigma of the drift.", minimum=0.0),
+), owner="fake")
+
+OUTPUTS = (
+    Output("azimuth_error_rad", "rad", "arcmin", "steady azimuth error"),
+    Output("settling_time_s", "s", "", "settling time"),
 )
 
 CALLS = {"sweep": 0}
-"""Evaluations of fake_sweep in this process (resume tests count them)."""
+"""Evaluations of fake_evaluate in this process (resume tests count them)."""
 
 KILL_ABOVE = "SCHULER_FAKE_KILL_ABOVE"
 """Environment: a worker process evaluating a chunk with latitude above this (rad) dies, once."""
@@ -41,7 +49,7 @@ KILL_MARKER = "SCHULER_FAKE_KILL_MARKER"
 
 
 @dataclass
-class FakeResult(Result):
+class FakeResult(RunResult):
     azimuth_error_rad: float
     settling_time_s: float
     method: str
@@ -49,34 +57,41 @@ class FakeResult(Result):
     units: ClassVar[dict[str, str]] = {}
 
 
-def fake_sweep(values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def fake_evaluate(cases: Cases) -> dict[str, np.ndarray]:
     CALLS["sweep"] += 1
-    latitude = np.asarray(values["latitude"], dtype=float)
+    latitude = cases.float("latitude")
     threshold = os.environ.get(KILL_ABOVE)
     marker = os.environ.get(KILL_MARKER)
     if threshold and marker and latitude.min() > float(threshold) and not Path(marker).exists():
         Path(marker).write_text(str(os.getpid()))
         os._exit(1)
-    azimuth = np.asarray(values["drift_east"], dtype=float) / (EARTH_RATE * np.cos(latitude))
-    settling = np.asarray(values["duration"], dtype=float) / np.asarray(values["gain"], dtype=float)
-    return {"azimuth_error_rad": azimuth, "settling_time_s": settling * np.asarray(values["members"])}
+    drift = cases.float("drift_east")
+    if cases.random is not None:
+        drift = drift + cases.float("sigma_drift") * cases.random.normal("drift_east", cases.members)
+    azimuth = drift / (EARTH_RATE * np.cos(latitude))
+    settling = cases.float("duration") / cases.float("gain")
+    return {"azimuth_error_rad": azimuth, "settling_time_s": settling * cases["members"]}
 
 
-def fake_run(latitude, drift_east, gain, method, members, duration, step) -> FakeResult:
-    out = fake_sweep(
-        {
-            "latitude": np.array([latitude]),
-            "drift_east": np.array([drift_east]),
-            "gain": np.array([gain]),
-            "members": np.array([members]),
-            "duration": np.array([duration]),
-        }
-    )
-    return FakeResult(float(out["azimuth_error_rad"][0]), float(out["settling_time_s"][0]), method)
+def fake_run_case(case, fidelity=None) -> FakeResult:
+    out = fake_evaluate(Cases.from_case(case))
+    return FakeResult(azimuth_error_rad=float(out["azimuth_error_rad"][0]),
+                      settling_time_s=float(out["settling_time_s"][0]), method=case["method"])
 
 
-def fake_reproduce() -> FakeResult:
-    return fake_run(np.radians(50.0), np.radians(0.01) / 3600, 1.0, "closed", 1, 3600.0, 1.0)
+def fake_reproduce() -> Reproduction:
+    result = fake_run_case(PARAMETERS.case(latitude=np.radians(50.0), drift_east=np.radians(0.01) / 3600))
+    computed = float(np.degrees(result.azimuth_error_rad) * 60)
+    return Reproduction(
+        system="fake", source="Test fixture <not a real source> & co", constants="Omega = 7.292115e-5 rad/s",
+        rows=[compare("azimuth error", computed, "arcmin", printed="3.556", where="p. 1", note="closed form"),
+              compare("printed typo", computed, "arcmin", printed="4.0", where="p. 2",
+                      erratum="the source drops a factor")],
+        notes=["An erratum, explained."], data=result)
+
+
+def fake_write_files(result, out_dir) -> list:
+    return []
 
 
 def fake_report(outdir: Path) -> ReportSection:
@@ -91,16 +106,13 @@ def fake_report(outdir: Path) -> ReportSection:
     ax.set_ylabel("azimuth error [arcmin]")
     ax.set_title("Steady-state azimuth error")
     save_figure_formats(fig, Path(outdir) / "fake_azimuth", ("png", "svg"))
-    computed = fake_reproduce().azimuth_error_rad
+    reproduction = fake_reproduce()
     return ReportSection(
         system="fake",
         title="A fake gyrocompass",
         source="Test fixture <not a real source> & co",
         summary="Steady-state azimuth error of a gyrocompass.",
-        rows=[
-            ReproductionRow("azimuth error", 3.6, float(np.degrees(computed) * 60), "arcmin", True, "closed form"),
-            ReproductionRow("printed typo", "4.0", 3.6, "arcmin", False, "the source drops a factor"),
-        ],
+        rows=reproduction.rows,
         figures=[
             FigureRef("fake_azimuth.png", "Azimuth error against latitude (PNG)."),
             FigureRef("fake_azimuth.svg", "Azimuth error against latitude (SVG)."),
@@ -113,24 +125,17 @@ def fake_report(outdir: Path) -> ReportSection:
 FAKE = System(
     name="fake",
     title="Fake gyrocompass",
-    source="Test fixture",
+    reference="Test fixture",
     parameters=PARAMETERS,
-    run=fake_run,
+    outputs=OUTPUTS,
+    evaluate=fake_evaluate,
+    run_case=fake_run_case,
     reproduce=fake_reproduce,
+    write_files=fake_write_files,
     report=fake_report,
-    sweep=fake_sweep,
+    random_terms=True,
 )
 SYSTEM = FAKE
-
-FAKE_WITHOUT_SWEEP = System(
-    name="fakerun",
-    title="Fake gyrocompass without a vectorised sweep",
-    source="Test fixture",
-    parameters=PARAMETERS,
-    run=fake_run,
-    reproduce=fake_reproduce,
-    report=fake_report,
-)
 
 
 def register(monkeypatch) -> None:
@@ -153,7 +158,7 @@ def only_systems(request, modules: dict[str, str]) -> None:
 
 def test_fake_run_matches_its_closed_form():
     # psi = drift / (Omega cos(lat)): 0.01 deg/h at 50 deg N: 0.01 / (15.04107 * cos 50) rad = 3.5557 arcmin
-    result = fake_reproduce()
+    result = fake_reproduce().data
     expected = np.radians(0.01) / 3600 / (EARTH_RATE * np.cos(np.radians(50.0)))
     assert result.azimuth_error_rad == pytest.approx(expected, rel=1e-12)
     assert np.degrees(result.azimuth_error_rad) * 60 == pytest.approx(3.5557, abs=1e-4)

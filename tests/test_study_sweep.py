@@ -14,15 +14,10 @@ from hypothesis import strategies as st
 
 from schuler.exceptions import ScenarioError
 from schuler.study.scenario import parse_scenario
-from schuler.study.sweep import (
-    RunLoop,
-    chunk_path,
-    grid_values,
-    histograms,
-    parse_axis,
-    plan_sweep,
-    run_sweep,
-)
+from schuler.study.plan import grid_values, parse_axis, plan_sweep
+from schuler.study.store import chunk_path
+from schuler.study.summary import histograms
+from schuler.study.sweep import run_sweep
 
 SCENARIO = """\
 system = "fake"
@@ -123,7 +118,7 @@ def test_sweep_results_are_the_closed_form_per_case(scenario, tmp_path):
     assert summary.cases == len(frame) == 70 and summary.chunks == 5
     assert list(frame.columns) == [
         "case", "latitude_deg", "drift_east_deg_per_h", "gain", "method", "members",
-        "duration_s", "step_s", "azimuth_error_rad", "settling_time_s",
+        "duration_s", "output_step_s", "sigma_drift_deg_per_h", "azimuth_error_rad", "settling_time_s",
     ]  # fmt: skip
     assert frame["case"].tolist() == list(range(70))
     # grid: case = (latitude index * 2 + members index) * 5 + draw
@@ -159,13 +154,20 @@ def test_draws_do_not_depend_on_chunking(scenario, tmp_path):
     assert not np.allclose(results(tmp_path / "a")["gain"], results(tmp_path / "c")["gain"])
 
 
-def test_a_system_without_sweep_is_run_case_by_case(scenario, tmp_path):
-    values = plan_sweep(scenario, fake.FAKE, GRID, monte_carlo=2).case_values(0, 28)
-    looped = RunLoop(fake.fake_run)(values)
-    vectorised = fake.fake_sweep(values)
-    assert looped.keys() == vectorised.keys()
-    for name in vectorised:
-        assert np.allclose(looped[name], vectorised[name], rtol=1e-14)
+def test_system_random_terms_are_drawn_only_in_a_monte_carlo(scenario, tmp_path):
+    # sigma_drift is a random term of the system itself: a plain grid is nominal, a Monte Carlo draws it
+    noisy = parse_scenario(SCENARIO.replace('drift_east = "0.01 deg/h"', 'drift_east = "0.01 deg/h"\nsigma_drift = "0.005 deg/h"'))
+    plain = run_sweep(noisy, tmp_path / "grid", ("latitude=0,30",), progress=False, plots=False)
+    assert plain.statistics["azimuth_error_rad"]["std"] > 0  # two latitudes
+    grid = results(tmp_path / "grid")
+    expected = np.radians(0.01) / 3600 / (fake.EARTH_RATE * np.cos(np.radians(grid["latitude_deg"])))
+    assert np.allclose(grid["azimuth_error_rad"], expected, rtol=1e-12)
+    run_sweep(noisy, tmp_path / "mc7", ("latitude=0,30",), monte_carlo=25, chunk_size=7, progress=False, plots=False)
+    run_sweep(noisy, tmp_path / "mc50", ("latitude=0,30",), monte_carlo=25, chunk_size=50, progress=False, plots=False)
+    pd.testing.assert_frame_equal(results(tmp_path / "mc7"), results(tmp_path / "mc50"), check_exact=True)
+    drawn = results(tmp_path / "mc7")
+    nominal = np.radians(drawn["drift_east_deg_per_h"]) / 3600 / (fake.EARTH_RATE * np.cos(np.radians(drawn["latitude_deg"])))
+    assert not np.allclose(drawn["azimuth_error_rad"], nominal)
 
 
 def test_monte_carlo_draws_outside_the_range_are_refused(tmp_path):
@@ -253,5 +255,7 @@ def test_sweep_command_line(tmp_path, run_cli):
     assert text.code == 0 and "1 resumed" in text.stdout
     bad = run_cli("sweep", path, "--param", "latitude=0:95:5", "--out", tmp_path / "p")
     assert bad.code == 2 and bad.stderr.strip() == "schuler: error: --param latitude: 95.0 is outside [-89, 89] deg"
+    bad = run_cli("sweep", path, "--fidelity", "rough", "--out", tmp_path / "r")
+    assert bad.code == 2 and "--fidelity" in bad.stderr
     bad = run_cli("sweep", path, "--scheduler", "udp:x", "--out", tmp_path / "q")
     assert bad.code == 2 and "--scheduler: 'udp:x' is neither 'local' nor an address" in bad.stderr
