@@ -23,7 +23,7 @@ members = 2
 
 [simulation]
 duration = "2 h"
-step = "0.5 s"
+output_step = "0.5 s"
 
 [outputs]
 json = false
@@ -54,17 +54,14 @@ def test_a_scenario_gives_si_values_defaults_and_monte_carlo(tmp_path):
     assert scenario.system == "fake" and scenario.title == "A study"
     assert scenario.values["latitude"] == pytest.approx(math.radians(45))
     assert scenario.values["drift_east"] == pytest.approx(math.radians(0.02) / 3600)
-    assert scenario.values["duration"] == 7200.0 and scenario.values["step"] == 0.5
+    assert scenario.values["duration"] == 7200.0 and scenario.values["output_step"] == 0.5
     assert scenario.values["gain"] == 1.0  # default
     assert scenario.values["members"] == 2 and scenario.values["method"] == "table"
     mc = scenario.monte_carlo
     assert (mc.seed, mc.cases) == (7, 10)
     assert mc.distributions["drift_east"].first == pytest.approx(math.radians(0.005) / 3600)
     assert (mc.distributions["gain"].first, mc.distributions["gain"].second) == (0.5, 2.0)
-    assert scenario.command_line() == [
-        "fake", "run", "--latitude", "45 deg", "--drift-east", "0.02", "--method", "table",
-        "--members", "2", "--duration", "2 h", "--step", "0.5 s",
-    ]  # fmt: skip
+    assert scenario.values.given == {"latitude", "drift_east", "method", "members", "duration", "output_step"}
 
 
 def test_run_prints_what_the_api_returns(tmp_path, run_cli):
@@ -72,7 +69,7 @@ def test_run_prints_what_the_api_returns(tmp_path, run_cli):
     out = run_cli("run", path, "--json")
     assert out.code == 0, out.stderr
     data = out.json()
-    expected = fake.fake_run(**load_scenario(path).values)
+    expected = fake.FAKE.run(**load_scenario(path).given())
     assert data["azimuth_error_rad"] == pytest.approx(expected.azimuth_error_rad, rel=1e-12)
     assert data["settling_time_s"] == 2 * 7200.0
     assert data["inputs"]["latitude"] == pytest.approx(math.radians(45))
@@ -86,7 +83,7 @@ def test_run_prints_what_the_api_returns(tmp_path, run_cli):
         # unknown key, with a suggestion and the allowed keys
         ('system = "fake"\n[parameters]\nlattitude = 50\n', "[parameters] lattitude: unknown key; did you mean 'latitude'?"),
         ('system = "fake"\ncolour = "red"\n', "colour: unknown key"),
-        ('system = "fake"\n[simulation]\ntime = "1 h"\n', "[simulation] time: unknown key; allowed: duration, step"),
+        ('system = "fake"\n[simulation]\ntime = "1 h"\n', "[simulation] time: unknown key; allowed: duration, output_step"),
         ('system = "fake"\n[outputs]\nfolder = "x"\n', "[outputs] folder: unknown key"),
         ('system = "fake"\n[parameters]\nduration = "1 h"\n[simulation]\nduration = "2 h"\n',
          "[simulation] duration: also set as [parameters] duration; set it once"),
@@ -159,7 +156,7 @@ def test_every_parameter_value_is_checked_by_its_parameter(tmp_path):
     scenario = parse_scenario('system = "fake"\n[parameters]\nlatitude = "-89 deg"\ndrift_east = "0 deg/h"\n')
     assert scenario.values["latitude"] == pytest.approx(-math.radians(89))
     assert scenario.values["drift_east"] == 0.0
-    assert np.isfinite(scenario.run().azimuth_error_rad)
+    assert np.isfinite(scenario.definition().run(**scenario.given()).azimuth_error_rad)
 
 
 @pytest.mark.parametrize("name", ["errors", "vertical", "calibrate", "align", "north"])
