@@ -1,21 +1,58 @@
-"""Atomic file output: a crash never leaves a half-written result.
+"""File output that never leaves a half-written result, a wrong mode or a replaced link.
 
-Every file is written to a temporary file in the destination folder and moved
-into place with :func:`os.replace`, which is atomic on POSIX and Windows.
+Every regular file is written to a temporary file in the destination folder
+and moved into place with :func:`os.replace` (atomic on POSIX and Windows), so
+an interrupted run leaves either the old file or the new one. The new file gets
+the mode a plain ``open()`` would give it (``0o666`` masked by the umask, or the
+mode of the file it replaces). A symbolic link is followed: the file it points
+to is replaced, the link stays. A FIFO, a character device (``/dev/stdout``) or
+``-`` (standard output) is written directly, never replaced. Errors name the
+path the user gave, never the temporary file.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
+import stat
 import tempfile
 from pathlib import Path
+
+PART_SUFFIX = ".part"
+"""Suffix of the temporary files (``.NAME.XXXXXXXX.part``) beside a target."""
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _streamed(target: Path) -> bool:
+    """True for targets that must be written in place: FIFOs, character and block devices."""
+    try:
+        mode = os.stat(target).st_mode
+    except OSError:
+        return False
+    return stat.S_ISFIFO(mode) or stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+
+
+@contextlib.contextmanager
+def _naming(tmp: Path | None, shown):
+    """Re-raise an OSError about the temporary file as one about the user's path."""
+    try:
+        yield
+    except OSError as error:
+        if tmp is None or error.filename in (None, str(tmp), tmp):
+            raise OSError(error.errno or errno.EIO, error.strerror or str(error), str(shown)) from None
+        raise
 
 
 @contextlib.contextmanager
 def atomic_path(path):
-    """Yield a temporary path beside ``path``; on success move it into place.
+    """Yield a path to write; on success it becomes ``path`` (see the module notes).
 
     >>> import tempfile, pathlib
     >>> target = pathlib.Path(tempfile.mkdtemp()) / "a.txt"
@@ -24,17 +61,42 @@ def atomic_path(path):
     >>> target.read_text()
     'done'
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
-    tmp = Path(tmp)
+    shown = path
+    if str(path) == "-":
+        yield Path("/dev/stdout")
+        return
+    target = Path(os.path.realpath(path))
+    if _streamed(target):
+        with _naming(None, shown):
+            yield target
+        return
+    with _naming(None, shown):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=PART_SUFFIX, dir=target.parent)
+        os.close(fd)
+    tmp = Path(name)
     try:
-        yield tmp
-        os.replace(tmp, path)
+        with _naming(tmp, shown):
+            yield tmp
+            try:
+                mode = stat.S_IMODE(os.stat(target).st_mode)
+            except FileNotFoundError:
+                mode = 0o666 & ~_umask()
+            os.chmod(tmp, mode)
+            os.replace(tmp, target)
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def remove_stale_parts(folder) -> list[Path]:
+    """Delete temporary files (``.*.part``) an interrupted run left in ``folder`` and its subfolders."""
+    removed = []
+    for part in Path(folder).rglob(f".*{PART_SUFFIX}"):
+        if part.is_file():
+            part.unlink()
+            removed.append(part)
+    return removed
 
 
 def write_text(path, text: str) -> Path:

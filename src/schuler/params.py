@@ -183,15 +183,28 @@ class Parameter:
         if low_bad or high_bad:
             raise InvalidParameter(label, f"{raw!r} is outside {self.range_text()}")
 
+    def default_text(self) -> str:
+        """The default as ``--help`` shows it: ``50 deg``, ``off``, ``full``, ``not set``."""
+        if self.default is None:
+            return "not set"
+        if self.kind == "flag":
+            return "on" if self.parse(self.default) else "off"
+        if isinstance(self.default, float):
+            shown = f"{self.default:.6g}"
+        else:
+            shown = str(self.default)
+        if self.kind == "quantity" and self.unit and not isinstance(self.default, str):
+            shown += f" {self.unit}"
+        return shown
+
     def help_text(self) -> str:
         parts = [self.help]
         bounded = self.minimum is not None or self.maximum is not None
-        if self.kind == "quantity":
-            parts.append(f"[{self.unit or 'number'}; range {self.range_text()}]" if bounded else f"[{self.unit or 'number'}]")
+        if self.kind == "quantity" and bounded:
+            parts.append(f"Range {self.range_text()}.")
         elif self.kind == "integer" and bounded:
-            parts.append(f"[range {self.range_text()}]")
-        if self.default is not None and self.kind != "flag":
-            parts.append(f"(default {self.default})")
+            parts.append(f"Range {self.range_text()}.")
+        parts.append(f"[default: {self.default_text()}]")
         return " ".join(parts)
 
 

@@ -18,10 +18,11 @@ import numpy as np
 def json_safe(value: Any) -> Any:
     """Convert numpy arrays and scalars, tuples and nested results to JSON-safe data.
 
-    Non-finite floats become None (JSON has no NaN).
+    Non-finite floats become None (JSON has no NaN); floats keep 15 significant
+    digits, so rounding noise (29.999999999999993) does not reach the user.
 
-    >>> json_safe({"a": np.array([1.0, np.nan]), "b": (np.int64(2),)})
-    {'a': [1.0, None], 'b': [2]}
+    >>> json_safe({"a": np.array([1.0, np.nan]), "b": (np.int64(2),), "c": 29.999999999999993})
+    {'a': [1.0, None], 'b': [2], 'c': 30.0}
     """
     if isinstance(value, Result):
         return value.to_dict()
@@ -39,7 +40,7 @@ def json_safe(value: Any) -> Any:
         return int(value)
     if isinstance(value, (float, np.floating)):
         value = float(value)
-        return value if math.isfinite(value) else None
+        return float(f"{value:.15g}") if math.isfinite(value) else None
     if hasattr(value, "__fspath__"):
         return str(value)
     return value

@@ -13,7 +13,9 @@ line on stderr and exit with code 2.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
+import threading
 import warnings
 
 import click
@@ -74,16 +76,29 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
     print(f"schuler: warning: {message}", file=sys.stderr)
 
 
+_SIGNALLED: list[int] = []
+
+
+def _terminate(signum, frame):
+    """SIGTERM ends a run like Ctrl-C: files being written are removed, one line, exit 128 + 15."""
+    _SIGNALLED.append(signum)
+    raise KeyboardInterrupt
+
+
 def main(argv=None) -> None:
     """Entry point: run the CLI, turning errors into one line and exit code 2."""
     warnings.showwarning = _show_warning
+    handled = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if handled else None
     try:
         code = cli.main(args=argv, prog_name="schuler", standalone_mode=False)
     except click.exceptions.Exit as exit_:
         code = exit_.exit_code
-    except click.exceptions.Abort:
-        print("schuler: error: aborted", file=sys.stderr)
-        code = 130
+    except (click.exceptions.Abort, KeyboardInterrupt):
+        terminated = bool(_SIGNALLED)
+        print(f"schuler: error: {'terminated (SIGTERM)' if terminated else 'interrupted'}; "
+              "partial files were removed", file=sys.stderr)
+        code = 128 + (signal.SIGTERM if terminated else signal.SIGINT)
     except click.ClickException as error:
         print(f"schuler: error: {error.format_message()}", file=sys.stderr)
         code = 2
@@ -94,4 +109,8 @@ def main(argv=None) -> None:
         where = f": {error.filename}" if error.filename else ""
         print(f"schuler: error: {error.strerror or error}{where}", file=sys.stderr)
         code = 2
+    finally:
+        if handled:
+            signal.signal(signal.SIGTERM, previous)
+        _SIGNALLED.clear()
     sys.exit(code if isinstance(code, int) else 0)

@@ -82,7 +82,7 @@ def _run_command(system: System) -> click.Command:
     if system.fidelities:
         command.params.append(click.Option(
             ["--fidelity"], type=click.Choice(system.fidelities), default=None,
-            help=f"How outputs are computed: {', '.join(system.fidelities)} (default {system.fidelities[0]})."))
+            help=f"How outputs are computed: {', '.join(system.fidelities)}. [default: {system.fidelities[0]}]"))
     command.params.extend(_output_params())
     return command
 

@@ -47,7 +47,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from schuler.results import json_safe
-from schuler.io import write_json
+from schuler.io import remove_stale_parts, write_json
 from schuler.study.executors import InProcess, make_executor
 from schuler.study.plan import DEFAULT_CHUNK_SIZE, SweepPlan, plan_sweep
 from schuler.study.scenario import Scenario
@@ -106,6 +106,7 @@ def run_sweep(
     plan = plan_sweep(scenario, system, params, monte_carlo, chunk_size, fidelity)
     out_dir = Path(out_dir)
     _prepare(out_dir, plan)
+    remove_stale_parts(out_dir)  # what an interrupted run was writing (a resumed run starts those files anew)
     done = {i for i in range(plan.chunks) if chunk_path(out_dir, i).exists()}
     todo = [i for i in range(plan.chunks) if i not in done]
     tasks = (ChunkTask(plan, index, system.evaluate) for index in todo)
