@@ -15,6 +15,9 @@ from test_study_report import full_report, landed_systems
 
 from schuler.study.report import build_report
 
+MIN_FONT_PX = 9.0
+"""Smallest legible figure text as displayed in a 1280-px wide window, px."""
+
 CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 CHROMIUM_ARGS = [
     "--headless",
@@ -57,6 +60,11 @@ def open_in_browser(index: Path, screenshot: Path) -> dict:
                 "Array.from(document.images).filter(img => img.naturalWidth === 0).map(img => img.src)"
             )
             problems["image_count"] = page.evaluate("document.images.length")
+            # the smallest text of each figure as shown: its size in the image times the displayed scale
+            problems["fonts"] = page.evaluate(
+                "Array.from(document.images).map(img => [img.src.split('/').pop(), "
+                "parseFloat(img.dataset.minFontPx || 'NaN') * img.clientWidth / img.naturalWidth])"
+            )
             problems["title"] = page.title()
             page.screenshot(path=str(screenshot), full_page=True)
         finally:
@@ -71,6 +79,8 @@ def assert_clean(problems: dict, screenshot: Path) -> None:
     assert problems["requests"] == []
     assert problems["images"] == [], "broken images"
     assert problems["image_count"] > 0
+    small = [(name, round(px, 1)) for name, px in problems["fonts"] if not px >= MIN_FONT_PX]
+    assert not small, f"figure text smaller than {MIN_FONT_PX} px as displayed: {small}"
     assert problems["title"].startswith("schuler")
     assert screenshot.stat().st_size > 10_000
 

@@ -114,8 +114,7 @@ def fake_report(outdir: Path) -> ReportSection:
         summary="Steady-state azimuth error of a gyrocompass.",
         rows=reproduction.rows,
         figures=[
-            FigureRef("fake_azimuth.png", "Azimuth error against latitude (PNG)."),
-            FigureRef("fake_azimuth.svg", "Azimuth error against latitude (SVG)."),
+            FigureRef("fake_azimuth.png", "Azimuth error against latitude."),
         ],
         commands=["schuler fake run --latitude 50"],
         notes=["An erratum, explained."],

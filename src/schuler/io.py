@@ -111,11 +111,32 @@ def write_json(path, data) -> Path:
     return write_text(path, json.dumps(data, indent=2) + "\n")
 
 
+MIN_FONT_KEY = "schuler-min-font-px"
+"""PNG text chunk holding the smallest font size of the figure, in pixels of the image."""
+
+
+def smallest_font_px(fig, dpi: float) -> float:
+    """The smallest font size among the figure's visible texts, in pixels at ``dpi``."""
+    from matplotlib.text import Text
+
+    sizes = [t.get_fontsize() for t in fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
+    return min(sizes) * dpi / 72.0 if sizes else 0.0
+
+
 def save_figure(fig, path, **kwargs) -> Path:
-    """Save a matplotlib figure atomically; the format follows the file suffix."""
+    """Save a matplotlib figure atomically; the format follows the file suffix.
+
+    A PNG records its smallest font size in pixels (:data:`MIN_FONT_KEY`), so a
+    page showing it can check that its text stays legible at the displayed size.
+    """
     path = Path(path)
+    fmt = path.suffix.lstrip(".") or "png"
+    if fmt == "png":
+        dpi = kwargs.get("dpi", "figure")
+        dpi = fig.dpi if dpi == "figure" else dpi
+        kwargs.setdefault("metadata", {})[MIN_FONT_KEY] = f"{smallest_font_px(fig, dpi):.2f}"
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", **kwargs)
+        fig.savefig(tmp, format=fmt, **kwargs)
     return path
 
 

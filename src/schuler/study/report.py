@@ -20,7 +20,7 @@ from pathlib import Path
 
 from schuler import __version__
 from schuler.exceptions import SchulerError
-from schuler.io import write_text
+from schuler.io import MIN_FONT_KEY, write_text
 from schuler.contract import ReportSection, System
 from schuler.registry import SYSTEM_MODULES
 from schuler.study.systems import load_system
@@ -75,7 +75,7 @@ def build_report(out_dir, systems=None, jobs: int = 1) -> Path:
         SystemEntry(name, loaded[name], *built[name]) if name in built else SystemEntry(name, None, None)
         for name in names
     ]
-    return write_text(out_dir / "index.html", render_html(entries, time.perf_counter() - began))
+    return write_text(out_dir / "index.html", render_html(entries, time.perf_counter() - began, figures))
 
 
 def build_section(module: str, figures: Path) -> tuple[ReportSection, float]:
@@ -89,10 +89,11 @@ def build_section(module: str, figures: Path) -> tuple[ReportSection, float]:
     return section, time.perf_counter() - began
 
 
-def render_html(entries: list[SystemEntry], seconds: float) -> str:
+def render_html(entries: list[SystemEntry], seconds: float, figures_dir: Path | None = None) -> str:
     """The report page for the given entries (figure paths relative to ``figures/``).
 
-    ``seconds`` is the time the whole report took, shown in the footer.
+    ``seconds`` is the time the whole report took, shown in the footer;
+    ``figures_dir`` holds the figures (their sizes and fonts set how they are shown).
     """
     available = [e for e in entries if e.section is not None]
     parts = [
@@ -109,7 +110,7 @@ def render_html(entries: list[SystemEntry], seconds: float) -> str:
         _intro(entries),
         _contents(entries),
     ]
-    parts.extend(_section(entry) for entry in entries)
+    parts.extend(_section(entry, figures_dir) for entry in entries)
     parts.append(
         f"<footer><p>schuler {html.escape(__version__)}: {len(available)} of {len(entries)} systems, "
         f"built in {seconds:.1f} s. Rebuild with <code>schuler report --out DIR</code>.</p></footer>"
@@ -151,7 +152,34 @@ def _anchor(name: str) -> str:
     return f"system-{name}"
 
 
-def _section(entry: SystemEntry) -> str:
+WIDE_PIXELS = 700
+"""A figure wider than this (natural size) spans the whole column, so its text stays legible."""
+
+
+def _figure(figure, figures_dir: Path | None) -> str:
+    """One figure: the image at (at most) its natural size, its SVG beside it, the caption."""
+    src = html.escape(f"{FIGURES}/{figure.path}", quote=True)
+    caption = html.escape(figure.caption)
+    attributes, wide, links = "", False, ""
+    if figures_dir is not None:
+        path = figures_dir / figure.path
+        if path.suffix == ".png" and path.exists():
+            from PIL import Image
+
+            with Image.open(path) as image:
+                width = image.width
+                font = image.info.get(MIN_FONT_KEY)
+            wide = width > WIDE_PIXELS
+            attributes = f' width="{width}"' + (f' data-min-font-px="{html.escape(font)}"' if font else "")
+        svg = path.with_suffix(".svg")
+        if path.suffix == ".png" and svg.exists():
+            links = f' (<a href="{html.escape(f"{FIGURES}/{svg.name}", quote=True)}">SVG</a>)'
+    return (f'<figure class="{"wide" if wide else "narrow"}"><a href="{src}"><img src="{src}" '
+            f'alt="{html.escape(figure.caption, quote=True)}"{attributes} loading="lazy"></a>'
+            f"<figcaption>{caption}{links}</figcaption></figure>")
+
+
+def _section(entry: SystemEntry, figures_dir: Path | None = None) -> str:
     name = html.escape(entry.name)
     if entry.section is None:
         return (
@@ -174,13 +202,7 @@ def _section(entry: SystemEntry) -> str:
         parts.append("</ul>")
     if section.figures:
         parts.append('<div class="figures">')
-        for figure in section.figures:
-            src = html.escape(f"{FIGURES}/{figure.path}", quote=True)
-            caption = html.escape(figure.caption)
-            parts.append(
-                f'<figure><a href="{src}"><img src="{src}" alt="{html.escape(figure.caption, quote=True)}" '
-                f'loading="lazy"></a><figcaption>{caption}</figcaption></figure>'
-            )
+        parts.extend(_figure(figure, figures_dir) for figure in section.figures)
         parts.append("</div>")
     parts.append(_parameters_table(system))
     if section.commands:
@@ -256,9 +278,10 @@ thead th { background: #eef1f4; }
 td.ok { color: #116329; font-weight: 600; }
 td.differs { color: #9a3412; font-weight: 600; }
 td.erratum { color: #7c4a03; font-weight: 600; }
-.figures { display: flex; flex-wrap: wrap; gap: 1rem; }
-figure { margin: 0; flex: 1 1 480px; background: #fff; border: 1px solid #d0d7de; padding: 0.5rem; }
-figure img { width: 100%; height: auto; }
+.figures { display: grid; grid-template-columns: repeat(auto-fill, minmax(500px, 1fr)); gap: 1rem; }
+figure { margin: 0; background: #fff; border: 1px solid #d0d7de; padding: 0.5rem; }
+figure.wide { grid-column: 1 / -1; }
+figure img { max-width: 100%; height: auto; display: block; margin: 0 auto; }
 figcaption { font-size: 0.85rem; color: #57606a; }
 pre { background: #f3f4f6; padding: 0.8rem; overflow-x: auto; }
 code { font-family: ui-monospace, "SFMono-Regular", Menlo, monospace; font-size: 0.9em; }
