@@ -24,6 +24,7 @@ import numpy as np
 from schuler.contract import Cases, Output
 from schuler.gyrocompassing import analytic, models, study
 from schuler.gyrocompassing.results import AlignmentResult, write_files
+from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
 
 _ERROR_RANGE = {"minimum": -600.0, "maximum": 600.0}
@@ -44,13 +45,13 @@ PARAMETERS = ParameterSet((
               minimum=-0.1, maximum=0.1),
     Parameter("time_constant", "s", study.DEFAULT_TIME_CONSTANT,
               "Time constant T of the azimuth loop (gains not given follow from T and zeta).",
-              minimum=0, exclusive_minimum=True),
+              minimum=0.1, maximum=1e5),
     Parameter("damping", "", study.DEFAULT_DAMPING, "Damping ratio zeta of the azimuth loop.",
-              minimum=0, exclusive_minimum=True),
+              minimum=0.01, maximum=100),
     Parameter("c_gamma", "1/s", None, "Level correction gain c_Gamma (not set: 2 zeta / T).",
-              minimum=0, exclusive_minimum=True),
+              minimum=1e-6, maximum=100),
     Parameter("c_a", "1/s", None, "Azimuth correction gain c_a (not set: 1 / (T^2 U cos(latitude))).",
-              minimum=0, exclusive_minimum=True),
+              minimum=1e-6, maximum=1e8),
     Parameter("initial_azimuth_error", "deg", math.degrees(study.DEFAULT_INITIAL_AZIMUTH_ERROR),
               "Initial azimuth misalignment delta0.", minimum=-90, maximum=90),
     Parameter("initial_beta", "arcmin", 0.0, "Initial level error beta0 (0: levelled).", **_ERROR_RANGE),
@@ -61,7 +62,7 @@ PARAMETERS = ParameterSet((
               "Simulated time (not set: 2 h, or 3 settling times if longer, at most 48 h).",
               minimum=0, exclusive_minimum=True, maximum=study.MAX_DURATION),
     Parameter("output_step", "s", 1.0, "Output step (the simulation is exact between outputs).",
-              minimum=0, exclusive_minimum=True),
+              minimum=1e-3, maximum=3600),
     Parameter("max_latitude", "deg", math.degrees(study.DEFAULT_MAX_LATITUDE),
               "Latitude above which azimuth is reported not observable.", minimum=0, maximum=90,
               exclusive_minimum=True, exclusive_maximum=True),
@@ -95,6 +96,9 @@ OUTPUTS = (
 )
 
 FIDELITIES = ("simulated", "closed")
+
+_CHUNK_MEMBERS = 2_000
+"""Members the engine simulates at once (it streams longer batches chunk by chunk)."""
 
 _CASE_FIELDS = ("latitude", "azimuth", "drift_east", "drift_north", "drift_x", "drift_y", "drift_z",
                 "latitude_error", "time_constant", "damping", "c_gamma", "c_a", "initial_azimuth_error",
@@ -142,6 +146,10 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
     case = alignment_case(cases)
     duration = float(cases.float("duration")[0])
     simulate = fidelity == "simulated"
+    if simulate:
+        points = duration / float(cases.float("output_step")[0]) + 2
+        require(points * 8 * 6 * min(len(cases), _CHUNK_MEMBERS), "this simulation",
+                "--duration or --output-step (or --fidelity closed)")
     result = study.evaluate_cases(case, model, simulate_runs=simulate, duration=duration,
                                   time_step=float(cases.float("output_step")[0]))
     full = study.analytic_results(case, "full-ab")["azimuth_error_rad"]
@@ -196,6 +204,7 @@ def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
     model = case["model"]
     histories = simplified = None
     if fidelity == "simulated":
+        require(member_bytes(case) * 3, "this run's histories", "--duration or --output-step")
         with warnings.catch_warnings():
             # evaluate has warned about the latitude already; the histories are the same case
             warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")

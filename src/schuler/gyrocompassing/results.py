@@ -60,7 +60,7 @@ class AlignmentResult(RunResult):
         def seconds(value):
             if value is None or math.isnan(value):
                 return "-"
-            return "not settled" if math.isinf(value) else f"{value:.1f} s"
+            return "not settled" if math.isinf(value) else f"{value:.5g} s"
 
         table = Table(title=f"Gyrocompassing, {self.model} model ({self.fidelity})", show_header=True)
         table.add_column("quantity")
