@@ -289,3 +289,14 @@ def test_run_with_monte_carlo_attaches_statistics():
     again = dataclasses.replace(r, monte_carlo=None)
     assert again.azimuth_rad == r.azimuth_rad
     assert r.monte_carlo.statistics["cycle_time_s"]["std"] == 0.0
+
+
+@pytest.mark.slow
+def test_report_writes_its_figures(tmp_path):
+    section = SYSTEM.report(tmp_path)
+    assert section.system == "calibrate" and len(section.rows) == 8 and len(section.figures) == 3
+    assert not [row for row in section.rows if row.verdict.startswith("differs")]
+    for figure in section.figures:
+        assert (tmp_path / figure.path).stat().st_size > 10_000
+        assert (tmp_path / figure.path).with_suffix(".svg").exists()
+    assert any("--drift-x" in command for command in section.commands)
