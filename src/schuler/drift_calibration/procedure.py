@@ -78,7 +78,7 @@ def rate_from_reading(reading, k1: float, tau: float):
     Parameters
     ----------
     reading : float or ndarray
-        Integrator output Delta U, V.
+        Integrator output Delta U, V s.
     k1 : float
         Command-sensor gain K1, V/rad.
     tau : float

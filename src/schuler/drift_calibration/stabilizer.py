@@ -147,12 +147,12 @@ class CycleOutcome:
     Attributes
     ----------
     reading : ndarray, shape (N,)
-        Integrator output Delta U at the end of the cycle, V.
+        Integrator output Delta U at the end of the cycle, V s (the integral of U over the cycle).
     sensor_samples : ndarray, shape (N, 3)
         Command-sensor signal U at t0, t0 + tau and the end of the cycle, V
         (used by the loop-lag compensation).
     time, platform_angle, sensor_signal, integrator_output : ndarray
-        Histories (time (n,) in s; the others (N, n) in rad, V, V), empty unless requested.
+        Histories (time (n,) in s; the others (N, n) in rad, V, V s), empty unless requested.
     """
 
     reading: np.ndarray
@@ -377,7 +377,7 @@ def reading_closed_form(
     sway_angle=0.0,
     sway_rate=0.0,
 ):
-    """Delta U in closed form for an ideal loop and a leak-free integrator, V.
+    """Delta U in closed form for an ideal loop and a leak-free integrator, V s.
 
     Generalises the source's (11) to unequal pulses (phase 2 of length
     tau_2 = tau + L, L = delta tau, amplitude (1 + epsilon)), a tilted pulse top, an
@@ -420,7 +420,7 @@ def reading_closed_form(
 
 
 def loop_lag_error_rectangular(stabilizer: Stabilizer, rate):
-    """Extra Delta U of a first-order stabilization loop, rectangular pulses, V.
+    """Extra Delta U of a first-order stabilization loop, rectangular pulses, V s.
 
     From int_a^b alpha = int_a^b beta - T_s (alpha(b) - alpha(a)) for alpha' = (beta - alpha)/T_s,
     the lag adds -K1 T_s [2 alpha(tau) - alpha(0) - alpha(2 tau)], which for a
@@ -445,7 +445,7 @@ def loop_lag_error_rectangular(stabilizer: Stabilizer, rate):
 
 
 def leak_error_initial_angle(stabilizer: Stabilizer, initial_angle):
-    """Delta U from a constant sensor signal U0 = K1 alpha0 through a leaky integrator, V.
+    """Delta U from a constant sensor signal U0 = K1 alpha0 through a leaky integrator, V s.
 
     int_0^{2 tau} s(t) U0 exp(-(2 tau - t)/T_L) dt = -U0 T_L (1 - exp(-tau/T_L))^2;
     an ideal integrator (T_L = inf) cancels U0 exactly.
