@@ -131,7 +131,7 @@ def plant_reading(
         start = phase * tau
         for j, (a, b) in enumerate(zip(shape.knots[:-1], shape.knots[1:])):
             # the segment's own linear law, so a jump at a knot is never straddled or sampled
-            def current(t, j=j, a=a):
+            def current(t, j=j, a=a, sign=sign, start=start):
                 return sign * (shape.start_values[j] + shape.slopes[j] * ((t - start) / tau - a))
 
             solution = solve_ivp(derivative, (start + a * tau, start + b * tau), state, method="DOP853",

@@ -42,16 +42,13 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE
-from schuler.drift_calibration.stabilizer import Stabilizer, simulate_cycle
+from schuler.drift_calibration.draws import ProcedureErrors
+from schuler.drift_calibration.stabilizer import NOISE_STEPS, Stabilizer, simulate_cycle
 from schuler.exceptions import InvalidParameter, NotObservable
-
-if TYPE_CHECKING:
-    from schuler.drift_calibration.error_budget import ErrorBudget
 
 MODES = ("three-axis", "single-axis")
 
@@ -81,7 +78,7 @@ def rate_from_reading(reading, k1: float, tau: float):
     Parameters
     ----------
     reading : float or ndarray
-        Integrator output Delta U, V.
+        Integrator output Delta U, V s.
     k1 : float
         Command-sensor gain K1, V/rad.
     tau : float
@@ -201,7 +198,8 @@ def fit_positions(rates_x, rates_y=None, mode: str = "three-axis"):
     positions = rates_x.shape[1]
     design = position_design(positions, mode)
     data = rates_x if mode == "single-axis" else np.hstack([rates_x, np.atleast_2d(rates_y)])
-    solution = data @ np.linalg.pinv(design).T
+    # einsum, not a BLAS product: each member's numbers then do not depend on how many are fitted at once
+    solution = np.einsum("mk,jk->mj", data, np.linalg.pinv(design))
     if mode == "single-axis":
         return {"drift_x": solution[:, 0], "drift_y": np.full(len(data), np.nan), "c": solution[:, 1], "s": solution[:, 2]}
     return {"drift_x": solution[:, 0], "drift_y": solution[:, 1], "c": solution[:, 2], "s": solution[:, 3]}
@@ -270,20 +268,20 @@ def run_procedure(
     mode: str = "three-axis",
     positions: int = 2,
     cycles: int = 1,
-    budget: "ErrorBudget | None" = None,
-    members: int | None = None,
-    rng: np.random.Generator | None = None,
+    errors: ProcedureErrors | None = None,
     earth_rate: float = EARTH_RATE,
-    steps: int = 40,
+    steps: int = NOISE_STEPS,
 ) -> ProcedureOutcome:
     """Simulate the whole procedure and recover drifts and azimuth, vectorised over members.
 
     Each position k (turn 2 pi k / N about the vertical) runs ``cycles``
     measurement cycles of the X channel and, in three-axis mode, then of the Y
     channel; the readings are turned into rates by (13) (after the loop-lag
-    compensation when the budget has one), averaged over the cycles, and
-    separated by (15)/(16) (N = 2) or least squares (N >= 3). The azimuth comes
-    from atan2 (three-axis, or any mode with N >= 3) or asin (single-axis, N = 2).
+    compensation), averaged over the cycles, and separated by (15)/(16)
+    (N = 2) or least squares (N >= 3). The azimuth comes from atan2
+    (three-axis, or any mode with N >= 3) or asin (single-axis, N = 2). Every
+    cycle of every member is independent given its errors, so all of them are
+    simulated in one batch.
 
     Parameters
     ----------
@@ -296,16 +294,13 @@ def run_procedure(
     mode : {"three-axis", "single-axis"}
     positions, cycles : int
         Number of equally spaced platform positions (>= 2) and cycles averaged at each.
-    budget : ErrorBudget, optional
-        Random instrument errors (standard deviations); None = error-free.
-    members : int, optional
-        Monte Carlo members (default: the length of the array arguments, or 1).
-    rng : numpy.random.Generator, optional
-        Needed when ``budget`` is given.
+    errors : ProcedureErrors, optional
+        The drawn instrument and procedure errors of each member
+        (:func:`~schuler.drift_calibration.draws.draw_errors`); None = error-free.
     earth_rate : float
         Omega, rad/s.
     steps : int
-        Grid steps per pulse for the noise inputs.
+        Grid steps per pulse for the noise inputs (the ``samples`` of the errors follow from it).
 
     Returns
     -------
@@ -322,52 +317,49 @@ def run_procedure(
     _validate_site(latitude, azimuth, mode, positions, cycles)
     drift_y = drift_x if drift_y is None else drift_y
     sizes = {np.size(v) for v in (latitude, azimuth, drift_x, drift_y)} - {1}
-    if len(sizes) > 1:
-        raise InvalidParameter("latitude", f"array arguments disagree in length: {sorted(sizes)}")
-    count = members or (sizes.pop() if sizes else 1)
-    shape = (count,)
-    latitude, azimuth, drift_x, drift_y = (np.broadcast_to(np.asarray(v, dtype=float), shape) for v in
+    count = errors.members if errors is not None else max(sizes, default=1)
+    if sizes - {count}:
+        raise InvalidParameter("latitude", f"array arguments disagree in length: {sorted(sizes | {count})}")
+    latitude, azimuth, drift_x, drift_y = (np.broadcast_to(np.asarray(v, dtype=float), (count,)) for v in
                                            (latitude, azimuth, drift_x, drift_y))
-    if budget is not None and rng is None:
-        raise InvalidParameter("rng", "a random generator is needed with an error budget")
-    channels = ("x",) if mode == "single-axis" else ("x", "y")
-    draw = budget.draw if budget is not None else None
-    systematic = draw("procedure", count, rng, channels=len(channels)) if draw else {}
-    turns = turn_angles(positions)
-    rates = np.empty((count, len(channels), positions))
-    readings = np.empty((count, len(channels), positions, cycles))
-    lag_known = stabilizer.loop_time_constant * (1.0 + systematic.get("lag_compensation_error", 0.0))
-    for k, turn in enumerate(turns):
-        position = draw("position", count, rng) if draw else {}
-        actual = azimuth + turn + (position.get("turn_error", 0.0) if k > 0 else 0.0)
-        omega_x0, omega_y0, omega_z0 = apparent_drift(latitude, actual, earth_rate)
-        for c, channel in enumerate(channels):
-            own, apparent = (drift_x, omega_x0) if channel == "x" else (drift_y, omega_y0)
-            # a levelling residual e (elevation of the channel's axis) adds -Omega sin(phi) e by (2)
-            rate = own + apparent + omega_z0 * position.get(f"elevation_{channel}", 0.0)
-            per_channel = {key: value[:, c] for key, value in systematic.items() if np.ndim(value) == 2}
-            for m in range(cycles):
-                cycle = draw("cycle", count, rng) if draw else {}
-                outcome = simulate_cycle(
-                    stabilizer, rate,
-                    initial_angle=cycle.get("initial_angle", 0.0),
-                    sensor_scale_error=per_channel.get("sensor_scale_error", 0.0),
-                    amplitude_mismatch=systematic.get("amplitude_mismatch", 0.0),
-                    duration_mismatch=systematic.get("duration_mismatch", 0.0),
-                    tilt=systematic.get("tilt", 0.0),
-                    integrator_offset=per_channel.get("integrator_offset", 0.0),
-                    sway_angle=cycle.get("sway_angle", 0.0),
-                    sway_rate=cycle.get("sway_rate", 0.0),
-                    sensor_noise_density=budget.sensor_noise_density if budget else 0.0,
-                    angle_random_walk=budget.angle_random_walk if budget else 0.0,
-                    steps=steps, rng=rng,
-                )
-                samples = outcome.sensor_samples
-                # first-order loop lag: int alpha = int beta - T (alpha(b) - alpha(a)) on each phase
-                compensated = outcome.reading + lag_known * (2.0 * samples[:, 1] - samples[:, 0] - samples[:, 2])
-                readings[:, c, k, m] = compensated
-            rates[:, c, k] = rate_from_reading(readings[:, c, k, :].mean(axis=-1), stabilizer.k1, stabilizer.tau)
-    assumed_latitude = latitude + systematic.get("latitude_error", 0.0)
+    n_channels = 1 if mode == "single-axis" else 2
+    shape = (count, n_channels, positions, cycles)
+    if errors is None:
+        errors = ProcedureErrors.zero(count, n_channels, positions, cycles)
+    actual = azimuth[:, None] + turn_angles(positions)[None, :] + errors.turn_error
+    omega_x0, omega_y0, omega_z0 = apparent_drift(latitude[:, None], actual, earth_rate)
+    own = np.stack([drift_x, drift_y][:n_channels], axis=1)
+    apparent = np.stack([omega_x0, omega_y0][:n_channels], axis=1)
+    # a levelling residual e (elevation of the channel's axis) adds -Omega sin(phi) e by (2)
+    rate = own[:, :, None] + apparent + omega_z0[:, None, :] * errors.elevation
+
+    def per_cycle(values: np.ndarray) -> np.ndarray:
+        """Member, channel or position values spread over every cycle, flattened."""
+        values = np.asarray(values)
+        return np.broadcast_to(values.reshape(values.shape + (1,) * (4 - values.ndim)), shape).reshape(-1)
+
+    noise = None if errors.noise is None else errors.noise.reshape(-1, *errors.noise.shape[-3:])
+    outcome = simulate_cycle(
+        stabilizer, per_cycle(rate),
+        initial_angle=errors.initial_angle.reshape(-1),
+        sensor_scale_error=per_cycle(errors.sensor_scale_error),
+        amplitude_mismatch=per_cycle(errors.amplitude_mismatch),
+        duration_mismatch=per_cycle(errors.duration_mismatch),
+        tilt=per_cycle(errors.tilt),
+        integrator_offset=per_cycle(errors.integrator_offset),
+        sway_angle=errors.sway_angle.reshape(-1),
+        sway_rate=errors.sway_rate.reshape(-1),
+        sensor_noise_density=per_cycle(errors.sensor_noise_density),
+        angle_random_walk=per_cycle(errors.angle_random_walk),
+        noise=noise, steps=steps,
+    )
+    samples = outcome.sensor_samples.reshape(*shape, 3)
+    # first-order loop lag: int alpha = int beta - T (alpha(b) - alpha(a)) on each phase
+    lag_known = stabilizer.loop_time_constant * (1.0 + errors.lag_compensation_error)[:, None, None, None]
+    readings = outcome.reading.reshape(shape) + lag_known * (
+        2.0 * samples[..., 1] - samples[..., 0] - samples[..., 2])
+    rates = rate_from_reading(readings.mean(axis=-1), stabilizer.k1, stabilizer.tau)
+    assumed_latitude = latitude + errors.latitude_error
     return _recover(rates, mode, positions, azimuth, assumed_latitude, earth_rate, readings)
 
 

@@ -125,7 +125,7 @@ class PulseShape:
         return bool(mirrored_knots and np.allclose(left[1:-1], right[1:-1], atol=tolerance * scale)
                     and abs(self.symmetry_bracket()) <= tolerance * scale)
 
-    def with_tilt(self, tilt: float) -> "PulseShape":
+    def with_tilt(self, tilt: float) -> PulseShape:
         """This shape plus the zero-mean ramp ``tilt * (2u - 1)`` (a sloping pulse top).
 
         A tilt leaves the area unchanged and adds ``-tilt / 3`` to

@@ -70,6 +70,9 @@ from schuler.core.lti import StateSpace, simulate
 from schuler.drift_calibration.pulses import PulseShape
 from schuler.exceptions import InvalidParameter
 
+NOISE_STEPS = 40
+"""Grid steps per pulse when noise is on: white noise held over each step (its integral's variance is exact)."""
+
 
 def _positive(name: str, value: float, allow_zero: bool = False) -> float:
     value = float(value)
@@ -144,12 +147,12 @@ class CycleOutcome:
     Attributes
     ----------
     reading : ndarray, shape (N,)
-        Integrator output Delta U at the end of the cycle, V.
+        Integrator output Delta U at the end of the cycle, V s (the integral of U over the cycle).
     sensor_samples : ndarray, shape (N, 3)
         Command-sensor signal U at t0, t0 + tau and the end of the cycle, V
         (used by the loop-lag compensation).
     time, platform_angle, sensor_signal, integrator_output : ndarray
-        Histories (time (n,) in s; the others (N, n) in rad, V, V), empty unless requested.
+        Histories (time (n,) in s; the others (N, n) in rad, V, V s), empty unless requested.
     """
 
     reading: np.ndarray
@@ -160,7 +163,7 @@ class CycleOutcome:
     integrator_output: np.ndarray = field(default_factory=lambda: np.empty((0, 0)), repr=False)
 
 
-def _phase_model(duration: np.ndarray, switch: float, lag: float, leak: float, sway_omega: float, ideal: bool):
+def _phase_model(duration: float | np.ndarray, switch: float, lag: float, leak: float, sway_omega: float, ideal: bool):
     """Normalised-time state-space model of one phase; duration (N,) or scalar."""
     # state order: q, beta, [alpha], theta_b, thetadot_b, W ; inputs: slope, level, rate, noise, offset
     n = 5 if ideal else 6
@@ -202,27 +205,39 @@ def _pulse_inputs(shape: PulseShape, grid: np.ndarray, amplitude: np.ndarray, ti
 
 
 def _short_step(model: StateSpace, state: np.ndarray, inputs: np.ndarray, length: np.ndarray) -> np.ndarray:
-    """Exact step of per-member length (|length| tiny) with held inputs: expm by its Taylor series.
+    """Exact step of per-member length with held inputs: expm by its Taylor series, scaled and squared.
 
     A per-member step would cost one matrix exponential per member; for the
     microsecond tails of a duration mismatch the series sum_k (L M)^k / k! of
     the augmented matrix M = [[A, B], [0, 0]] reaches rounding in a few terms.
+    A longer tail is cut into 2^s equal parts whose transition is squared s times.
     """
     n, m = model.n_states, model.n_inputs
     augmented = np.zeros((n + m, n + m))
     augmented[:n, :n] = model.A
     augmented[:n, n:] = model.B
     size = np.max(np.abs(length)) * np.linalg.norm(augmented, 1)
-    if size > 0.05:
-        raise InvalidParameter("duration_mismatch", "too large for a tail step: keep |delta| * tau below 0.05 T_s")
+    squarings = max(0, math.ceil(math.log2(size / 0.05))) if size > 0.05 else 0
     terms = 10  # (0.05)^11 / 11! < 1e-22: the series has converged to rounding
     powers = [np.eye(n + m)]
     for k in range(1, terms):
         powers.append(powers[-1] @ augmented / k)
-    coefficients = np.asarray(length, dtype=float)[:, None] ** np.arange(terms)[None, :]
-    transition = np.einsum("nk,kij->nij", coefficients, np.stack(powers))
+    part = np.asarray(length, dtype=float) / 2.0**squarings
+    transition = np.einsum("nk,kij->nij", part[:, None] ** np.arange(terms)[None, :], np.stack(powers))
+    for _ in range(squarings):
+        transition = transition @ transition
     extended = np.concatenate([state, inputs], axis=1)
     return np.einsum("nij,nj->ni", transition[:, :n, :], extended)
+
+
+def cycle_grid(shape: PulseShape, steps: int = NOISE_STEPS) -> np.ndarray:
+    """Normalised time grid of one phase when noise is on: the pulse knots and ``steps`` equal steps.
+
+    >>> from schuler.drift_calibration.pulses import triangular
+    >>> cycle_grid(triangular(), 4)
+    array([0.  , 0.25, 0.5 , 0.75, 1.  ])
+    """
+    return np.union1d(shape.knots, np.linspace(0.0, 1.0, steps + 1))
 
 
 def simulate_cycle(
@@ -239,8 +254,8 @@ def simulate_cycle(
     sway_rate=0.0,
     sensor_noise_density=0.0,
     angle_random_walk=0.0,
-    steps: int = 40,
-    rng: np.random.Generator | None = None,
+    noise: np.ndarray | None = None,
+    steps: int = NOISE_STEPS,
     keep_history: bool = False,
 ) -> CycleOutcome:
     """Simulate one measurement cycle (two pulses, switch, integrator) for N members at once.
@@ -264,14 +279,17 @@ def simulate_cycle(
         Input offset of the integrator, as an angle of the command sensor, rad.
     sway_angle, sway_rate : array_like
         Base sway angle (rad) and rate (rad/s) about X at t0.
-    sensor_noise_density : float
-        White noise of the command sensor, rad/sqrt(Hz).
-    angle_random_walk : float
-        Gyro angle random walk, rad/sqrt(s).
+    sensor_noise_density : array_like
+        White noise of the command sensor, rad/sqrt(Hz) (scalar or per member).
+    angle_random_walk : array_like
+        Gyro angle random walk, rad/sqrt(s) (scalar or per member).
+    noise : ndarray, shape (N, 2, 2, S), optional
+        Standard normal samples held over the S steps of each phase: ``noise[:, p, 0]``
+        drives the angle random walk and ``noise[:, p, 1]`` the sensor noise of phase p;
+        S = ``cycle_grid(stabilizer.shape, steps).size - 1``. Required when a noise
+        density is nonzero (the caller draws them, so that they are addressed per member).
     steps : int
         Grid steps per phase when noise is on (noise-free cycles need only the pulse knots).
-    rng : numpy.random.Generator, optional
-        Source of the noise (required when a noise density is nonzero).
     keep_history : bool
         Also return the time histories (for plots).
 
@@ -288,12 +306,13 @@ def simulate_cycle(
     members = rate.size
     if np.any(1.0 + delta <= 0.0):
         raise InvalidParameter("duration_mismatch", "the second pulse must last a positive time")
-    noisy = sensor_noise_density > 0.0 or angle_random_walk > 0.0
-    if noisy and rng is None:
-        raise InvalidParameter("rng", "a random generator is needed when noise is on")
-    grid = stabilizer.shape.knots
-    if noisy or keep_history:
-        grid = np.union1d(grid, np.linspace(0.0, 1.0, steps + 1))
+    densities = np.broadcast_to(np.asarray(angle_random_walk, dtype=float), (members,)), \
+        np.broadcast_to(np.asarray(sensor_noise_density, dtype=float), (members,))
+    noisy = bool(np.any(densities[0] > 0.0) or np.any(densities[1] > 0.0))
+    grid = cycle_grid(stabilizer.shape, steps) if noisy or keep_history else stabilizer.shape.knots
+    if noisy and (noise is None or noise.shape != (members, 2, 2, grid.size - 1)):
+        raise InvalidParameter("noise", f"need standard normal samples of shape ({members}, 2, 2, {grid.size - 1}) "
+                                        "when a noise density is nonzero")
     ideal = stabilizer.loop_time_constant == 0.0
     omega_sway = 2.0 * math.pi * stabilizer.sway_frequency
     amplitude = np.full(members, stabilizer.pulse_rate)
@@ -316,11 +335,10 @@ def simulate_cycle(
         inputs[:, :, 1] = level
         inputs[:, :, 2] = rate[:, None]
         inputs[:, :, 4] = offset[:, None]
-        if noisy:
+        if noise is not None and noisy:
             step = np.diff(grid) * stabilizer.tau
-            white = rng.standard_normal((2, members, grid.size - 1))
-            inputs[:, :-1, 2] += angle_random_walk * white[0] / np.sqrt(step)
-            inputs[:, :-1, 3] = sensor_noise_density * white[1] / np.sqrt(step)
+            inputs[:, :-1, 2] += densities[0][:, None] * noise[:, phase, 0] / np.sqrt(step)
+            inputs[:, :-1, 3] = densities[1][:, None] * noise[:, phase, 1] / np.sqrt(step)
         state[:, 0] = 0.0  # each pulse's ramp part starts from zero
         states = simulate(model, grid, state, inputs).states
         measured = states[:, :, i_alpha] - states[:, :, i_theta] + inputs[:, :, 3]
@@ -359,7 +377,7 @@ def reading_closed_form(
     sway_angle=0.0,
     sway_rate=0.0,
 ):
-    """Delta U in closed form for an ideal loop and a leak-free integrator, V.
+    """Delta U in closed form for an ideal loop and a leak-free integrator, V s.
 
     Generalises the source's (11) to unequal pulses (phase 2 of length
     tau_2 = tau + L, L = delta tau, amplitude (1 + epsilon)), a tilted pulse top, an
@@ -402,7 +420,7 @@ def reading_closed_form(
 
 
 def loop_lag_error_rectangular(stabilizer: Stabilizer, rate):
-    """Extra Delta U of a first-order stabilization loop, rectangular pulses, V.
+    """Extra Delta U of a first-order stabilization loop, rectangular pulses, V s.
 
     From int_a^b alpha = int_a^b beta - T_s (alpha(b) - alpha(a)) for alpha' = (beta - alpha)/T_s,
     the lag adds -K1 T_s [2 alpha(tau) - alpha(0) - alpha(2 tau)], which for a
@@ -427,7 +445,7 @@ def loop_lag_error_rectangular(stabilizer: Stabilizer, rate):
 
 
 def leak_error_initial_angle(stabilizer: Stabilizer, initial_angle):
-    """Delta U from a constant sensor signal U0 = K1 alpha0 through a leaky integrator, V.
+    """Delta U from a constant sensor signal U0 = K1 alpha0 through a leaky integrator, V s.
 
     int_0^{2 tau} s(t) U0 exp(-(2 tau - t)/T_L) dt = -U0 T_L (1 - exp(-tau/T_L))^2;
     an ideal integrator (T_L = inf) cancels U0 exactly.
