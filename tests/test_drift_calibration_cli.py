@@ -103,7 +103,7 @@ def test_reproduce(run_cli, tmp_path):
     assert data["inputs"] == {"monte_carlo": 300, "seed": 0} and data["units"]["computed"] == "the row's unit"
     assert (tmp_path / "calibrate_reproduction_monte_carlo.svg").stat().st_size > 1000
     summary = pd.read_csv(tmp_path / "calibrate_reproduction_summary.csv")
-    assert summary["rms_azimuth_error_arcmin"].iloc[1] == pytest.approx(2.0, rel=1e-3)
+    assert summary["rms_azimuth_error_rad"].iloc[1] == pytest.approx(math.radians(2.0 / 60), rel=1e-3)
     human = run_cli("calibrate", "reproduce", "--monte-carlo", "200")
     assert human.code == 0 and "tuned to match" in human.stdout and "deg/h chosen to give it" in human.stdout
 

@@ -168,7 +168,9 @@ class Reproduction(Result):
     notes : list of str
         What the reader should know beyond the rows.
     details : dict
-        Further results (SI, unit in the key or in ``units``).
+        Further results (SI, unit in the key or in ``details_units``).
+    details_units : dict
+        Units of the keys of ``details`` whose unit is not in their name.
     data : object
         What ``write_files`` needs for figures (not in ``to_dict``).
     """
@@ -179,9 +181,15 @@ class Reproduction(Result):
     rows: list[ReproductionRow]
     notes: list[str] = field(default_factory=list)
     details: dict[str, Any] = field(default_factory=dict)
+    details_units: dict[str, str] = field(default_factory=dict, repr=False)
     data: Any = field(default=None, repr=False)
 
     units: ClassVar[dict[str, str]] = {"computed": "the row's unit"}
+
+    def to_dict(self) -> dict[str, Any]:
+        data = super().to_dict()
+        data["units"] = {**self.units, **self.details_units}
+        return data
 
     @property
     def failures(self) -> list[ReproductionRow]:

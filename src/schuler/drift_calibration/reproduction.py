@@ -72,11 +72,12 @@ def _monte_carlo(case, members: int, seed: int) -> MonteCarloSummary:
 
 
 def _row(label: str, mode: str, drift: float, summary: MonteCarloSummary) -> dict:
+    """One budget's Monte Carlo in SI (the relative drift error is a plain ratio)."""
     stats = summary.statistics
-    return {"budget": label, "mode": mode, "drift_deg_h": float(to_unit(drift, "deg/h")),
-            "mean_relative_drift_error_percent": float(to_unit(stats["relative_drift_error"]["mean"], "%")),
-            "rms_drift_error_x_deg_h": float(to_unit(stats["drift_x_error_rad_s"]["rms"], "deg/h")),
-            "rms_azimuth_error_arcmin": float(to_unit(stats["azimuth_error_rad"]["rms"], "arcmin"))}
+    return {"budget": label, "mode": mode, "drift_rad_s": float(drift),
+            "mean_relative_drift_error": float(stats["relative_drift_error"]["mean"]),
+            "rms_drift_error_x_rad_s": float(stats["drift_x_error_rad_s"]["rms"]),
+            "rms_azimuth_error_rad": float(stats["azimuth_error_rad"]["rms"])}
 
 
 def reproduce(monte_carlo: int = 2000, seed: int = 0) -> Reproduction:
@@ -149,6 +150,7 @@ def reproduce(monte_carlo: int = 2000, seed: int = 0) -> Reproduction:
         ],
         details={"budget_scale": scale, "drift_rad_s": drift, "members": monte_carlo, "seed": seed,
                  "summary": summary},
+        details_units={"budget_scale": "1", "members": "1", "seed": "1", "mean_relative_drift_error": "1"},
         data={"samples": {name: scaled["three-axis"].samples[name] for name in
                           ("drift_x_error_rad_s", "drift_y_error_rad_s", "azimuth_error_rad")},
               "title": f"Source's case, typical budget x {scale:.3g}, three-axis ({monte_carlo} members)",
