@@ -12,7 +12,6 @@ from hypothesis import strategies as st
 from schuler.core.earth import BOLLAY, FOOT, MEAN_RADIUS, STANDARD_GRAVITY, STATUTE_MILE
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
-from schuler.reproduction import printed_value
 from schuler.navigation_errors.actions import VERTICAL_PARAMETERS, vertical
 from schuler.navigation_errors.effective_period import (
     effective_schuler_period,
@@ -21,7 +20,13 @@ from schuler.navigation_errors.effective_period import (
     thrust_gravity,
 )
 from schuler.navigation_errors.inputs import FLIGHT_TIME
-from schuler.navigation_errors.reproduction import MAGNITUDES, SPEED, problem3_rows, report, reproduce
+from schuler.navigation_errors.reproduction import (
+    MAGNITUDES,
+    SPEED,
+    problem3_rows,
+    report,
+    reproduce,
+)
 from schuler.navigation_errors.single_channel import (
     SOURCES,
     channel_model,
@@ -41,6 +46,7 @@ from schuler.navigation_errors.vertical_channel import (
     printed_hover_expression,
     unaided_model,
 )
+from schuler.reproduction import printed_value
 
 R_BOLLAY, G_BOLLAY = BOLLAY.radius, BOLLAY.effective_gravity
 EARTHS = {"bollay": (R_BOLLAY, G_BOLLAY), "default": (MEAN_RADIUS, STANDARD_GRAVITY)}

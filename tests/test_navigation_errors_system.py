@@ -14,7 +14,12 @@ from schuler.core.earth import BOLLAY, FOOT, MEAN_RADIUS, STANDARD_GRAVITY, STAT
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
 from schuler.memory import MemoryBudgetExceeded
-from schuler.navigation_errors.actions import PERIOD_PARAMETERS, VERTICAL_PARAMETERS, period, vertical
+from schuler.navigation_errors.actions import (
+    PERIOD_PARAMETERS,
+    VERTICAL_PARAMETERS,
+    period,
+    vertical,
+)
 from schuler.navigation_errors.api import SYSTEM
 from schuler.navigation_errors.evaluation import OUTPUTS, PARAMETERS, evaluate, run_case
 from schuler.navigation_errors.files import write_files
@@ -88,12 +93,12 @@ def test_time_grid_ends_on_the_duration():
 # --- evaluate, run_case, fidelities ------------------------------------------------------------------
 
 CASES = [
-    dict(source="tilt", duration=5000.0, earth="bollay"),
-    dict(source="velocity", magnitude=0.5, duration=7000.0, output_step=35.0),
-    dict(source="accelerometer", magnitude=2e-3, duration=9000.0, earth="drozdovich"),
-    dict(source="drift", duration=3600.0, earth="bollay", radius=6.4e6),
-    dict(source="azimuth", duration=FLIGHT_TIME, speed=2000.0, gravity=9.81),
-    dict(source="drift", magnitude=2 * 0.01 * DEG_PER_H, duration=20_000.0, output_step=7.0),
+    {"source": "tilt", "duration": 5000.0, "earth": "bollay"},
+    {"source": "velocity", "magnitude": 0.5, "duration": 7000.0, "output_step": 35.0},
+    {"source": "accelerometer", "magnitude": 2e-3, "duration": 9000.0, "earth": "drozdovich"},
+    {"source": "drift", "duration": 3600.0, "earth": "bollay", "radius": 6.4e6},
+    {"source": "azimuth", "duration": FLIGHT_TIME, "speed": 2000.0, "gravity": 9.81},
+    {"source": "drift", "magnitude": 2 * 0.01 * DEG_PER_H, "duration": 20_000.0, "output_step": 7.0},
 ]
 
 
@@ -155,6 +160,21 @@ def test_a_sweep_over_sources_takes_each_source_default():
     assert out["final_flat_m"][1] / FOOT == pytest.approx(10_120, rel=1e-12)
     assert out["max_spherical_m"][1] / FOOT == pytest.approx(805.3, abs=0.05)
     assert out["final_spherical_m"][3] / FOOT == pytest.approx(10_258.5, abs=0.1)
+
+
+def test_one_si_magnitude_swept_over_sources_of_different_units_is_refused():
+    # a scenario's "0.01 deg/h" (rad/s) swept over source=tilt,drift would be 4.8e-8 rad of tilt
+    with pytest.raises(InvalidParameter, match="one value .* for sources of different units") as error:
+        SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object), "magnitude": 0.01 * DEG_PER_H})
+    assert error.value.name == "magnitude"
+    # written as text, each case reads it in its own source's unit
+    out = SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object),
+                                  "magnitude": np.array(["0.01", "0.01"], dtype=object)})
+    same = SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object)})  # Problem 3 values
+    np.testing.assert_allclose(out["max_spherical_m"], same["max_spherical_m"], rtol=1e-12)
+    # the same source: one number is fine
+    assert np.isfinite(SYSTEM.evaluate_values({"source": np.array(["tilt", "azimuth"], dtype=object),
+                                               "magnitude": 1e-4})["final_flat_m"]).all()
 
 
 def test_evaluate_is_independent_of_how_the_batch_is_cut():

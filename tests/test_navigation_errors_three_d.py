@@ -11,7 +11,11 @@ from schuler.core.earth import BOLLAY, EARTH_RATE, MEAN_RADIUS, STANDARD_GRAVITY
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
 from schuler.navigation_errors.single_channel import flat_error, spherical_error
-from schuler.navigation_errors.three_d import foucault_velocity_response, psi_angle_model, stationary_modes
+from schuler.navigation_errors.three_d import (
+    foucault_velocity_response,
+    psi_angle_model,
+    stationary_modes,
+)
 from schuler.navigation_errors.three_d_run import THREE_D_PARAMETERS, three_d
 
 

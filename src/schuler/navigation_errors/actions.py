@@ -32,7 +32,12 @@ from schuler.navigation_errors.effective_period import (
     orbital_speed,
     thrust_gravity,
 )
-from schuler.navigation_errors.inputs import EARTH_PARAMETERS, earth_constants, grid_points, time_grid
+from schuler.navigation_errors.inputs import (
+    EARTH_PARAMETERS,
+    earth_constants,
+    grid_points,
+    time_grid,
+)
 from schuler.navigation_errors.results import PeriodResult, VerticalResult
 from schuler.navigation_errors.vertical_channel import (
     BaroLoopGains,

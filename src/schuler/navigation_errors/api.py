@@ -17,10 +17,27 @@ Examples
 from __future__ import annotations
 
 from schuler.contract import Action, System
-from schuler.navigation_errors.actions import PERIOD_PARAMETERS, VERTICAL_PARAMETERS, period, vertical
-from schuler.navigation_errors.evaluation import FIDELITIES, OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case
+from schuler.navigation_errors.actions import (
+    PERIOD_PARAMETERS,
+    VERTICAL_PARAMETERS,
+    period,
+    vertical,
+)
+from schuler.navigation_errors.evaluation import (
+    FIDELITIES,
+    OUTPUTS,
+    PARAMETERS,
+    evaluate,
+    member_bytes,
+    run_case,
+)
 from schuler.navigation_errors.files import write_files
-from schuler.navigation_errors.reproduction import PLOT_PARAMETERS, plot, report, reproduce
+from schuler.navigation_errors.reproduction import (
+    PLOT_PARAMETERS,
+    plot,
+    report,
+    reproduce,
+)
 from schuler.navigation_errors.three_d_run import THREE_D_PARAMETERS, three_d
 from schuler.references import BOLLAY_1966
 

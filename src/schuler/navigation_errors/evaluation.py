@@ -25,10 +25,12 @@ from __future__ import annotations
 import numpy as np
 
 from schuler.contract import Cases, Output
+from schuler.exceptions import InvalidParameter
 from schuler.memory import require
 from schuler.navigation_errors.inputs import (
     EARTH_PARAMETERS,
     FLIGHT_TIME,
+    SOURCE_SI_UNITS,
     MagnitudeParameter,
     SourceParameters,
     earth_constant_arrays,
@@ -93,6 +95,12 @@ def _magnitudes(sources: np.ndarray, column: np.ndarray) -> np.ndarray:
     if column.dtype != object:
         values = column.astype(float)
         unset = np.isnan(values)
+        units = {SOURCE_SI_UNITS[source] for source in set(sources[~unset].tolist())}
+        if len(units) > 1 and np.unique(values[~unset]).size == 1:
+            # one SI number for sources of different units: a magnitude written for one source, swept over others
+            raise InvalidParameter("magnitude", f"one value ({values[~unset][0]:g} in SI) for sources of different "
+                                                f"units ({', '.join(sorted(units))}): leave magnitude unset (each "
+                                                "source takes its Problem 3 value) or sweep it with the source")
         for source in set(sources[unset].tolist()):
             values[unset & (sources == source)] = magnitude_si(str(source), None)
         return values

@@ -14,7 +14,10 @@ import numpy as np
 
 from schuler.io import save_figure_formats, write_dataframe_csv
 from schuler.navigation_errors import plots
-from schuler.navigation_errors.effective_period import effective_schuler_period, flight_gravity
+from schuler.navigation_errors.effective_period import (
+    effective_schuler_period,
+    flight_gravity,
+)
 from schuler.navigation_errors.inputs import SOURCE_DEFAULTS, SOURCE_UNITS
 from schuler.navigation_errors.results import (
     ErrorRunResult,

@@ -86,13 +86,13 @@ def magnitude_si(source: str, value, label: str = "magnitude") -> float:
     unit = SOURCE_UNITS[source]
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return parse_quantity(SOURCE_DEFAULTS[source], unit, name=label)
+    shown: object = value
     if isinstance(value, str):
         number = parse_quantity(value, unit, name=label)
-        shown = value
     else:
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
             raise InvalidParameter(label, f"{value!r} is not a number in SI ({SOURCE_SI_UNITS[source]})")
-        number, shown = float(value), value
+        number = float(value)
     if not math.isfinite(number) or number < 0:
         raise InvalidParameter(label, f"{shown!r} must be finite and >= 0 (the source's direction sets the sign)")
     return number
@@ -201,7 +201,7 @@ def earth_constants(earth: str = "default", radius: float | None = None, gravity
 
 def earth_constant_arrays(earth: np.ndarray, radius: np.ndarray, gravity: np.ndarray):
     """:func:`earth_constants` for arrays of cases (NaN radius or gravity: not set), m and m/s^2."""
-    earth = np.where(earth == None, "default", earth)  # noqa: E711 (element-wise test for None)
+    earth = np.where(earth == None, "default", earth)
     R, g = radius.astype(float).copy(), gravity.astype(float).copy()
     for name in set(earth.tolist()):
         chosen = earth == name

@@ -39,9 +39,18 @@ from schuler.navigation_errors.actions import altitude_errors, loop_gains
 from schuler.navigation_errors.files import write_problem3
 from schuler.navigation_errors.inputs import FLIGHT_TIME, time_grid
 from schuler.navigation_errors.results import Problem3Curves, Problem3Figures
-from schuler.navigation_errors.single_channel import SOURCES, flat_error, maximum_error, simulate_error, spherical_error
+from schuler.navigation_errors.single_channel import (
+    SOURCES,
+    flat_error,
+    maximum_error,
+    simulate_error,
+    spherical_error,
+)
 from schuler.navigation_errors.three_d import foucault_velocity_response
-from schuler.navigation_errors.vertical_channel import hover_altitude_error, printed_hover_expression
+from schuler.navigation_errors.vertical_channel import (
+    hover_altitude_error,
+    printed_hover_expression,
+)
 from schuler.params import Parameter, ParameterSet
 from schuler.references import BOLLAY_1966
 from schuler.reproduction import Reproduction, ReproductionRow, Tolerance, compare
@@ -207,8 +216,8 @@ def reproduce() -> Reproduction:
                   f"{BOLLAY.effective_gravity / FOOT:.3f} ft/s^2, t = 10,120 s, V = 0.5 mi/s",
         rows=problem3_rows(),
         notes=[
-            "2 pi sqrt(R / 32.2 ft/s^2) = 5063.1 s; only T = 5060 s gives omega t = 4 pi at 10,120 s as the source "
-            "states, so the loop's gravity is taken as omega^2 R. Flat and spherical use the same g_eff.",
+            ("2 pi sqrt(R / 32.2 ft/s^2) = 5063.1 s; only T = 5060 s gives omega t = 4 pi at 10,120 s as the source "
+            "states, so the loop's gravity is taken as omega^2 R. Flat and spherical use the same g_eff."),
             "Agreement: within 0.5 % (three printed significant figures) or 0.5 ft of a printed zero.",
         ],
         details=details,
@@ -316,6 +325,6 @@ def report(figures_dir: Path) -> ReportSection:
             "schuler errors three-d --latitude 45 --initial-velocity-error-north '1 ft/s' --out errors",
             "schuler sweep examples/errors_bollay_drift.toml --param duration=600:10120:100 --out errors-sweep",
         ],
-        notes=reproduction.notes + [f"Figures use {FIGURE_POINTS:,} points over 10,120 s; "
-                                    "'schuler errors plot --points N --out DIR' draws more."],
+        notes=reproduction.notes + [(f"Figures use {FIGURE_POINTS:,} points over 10,120 s; "
+                                    "'schuler errors plot --points N --out DIR' draws more.")],
     )

@@ -56,7 +56,8 @@ class ErrorRunResult(RunResult):
     ``simulation_minus_closed_m`` the largest difference from the closed form on
     the output grid; with ``"closed"`` both come from the closed form (the
     difference is NaN). Histories ``t_s``, ``flat_m``, ``spherical_m`` (closed
-    forms) and ``simulated_m`` feed the figures and CSV, not ``to_dict()``.
+    forms) and ``simulated_m`` (None with ``"closed"``) feed the figures and
+    CSV, not ``to_dict()``.
     """
 
     source: str
@@ -73,9 +74,9 @@ class ErrorRunResult(RunResult):
     max_flat_m: float
     max_spherical_m: float
     simulation_minus_closed_m: float
-    t_s: np.ndarray = field(default=None, repr=False)
-    flat_m: np.ndarray = field(default=None, repr=False)
-    spherical_m: np.ndarray = field(default=None, repr=False)
+    t_s: np.ndarray = field(repr=False)
+    flat_m: np.ndarray = field(repr=False)
+    spherical_m: np.ndarray = field(repr=False)
     simulated_m: np.ndarray | None = field(default=None, repr=False)
 
     def to_dict(self) -> dict[str, Any]:
@@ -109,20 +110,17 @@ class ErrorRunResult(RunResult):
             rows.append(("simulation - closed form (largest)", f"{self.simulation_minus_closed_m:.3g} m"))
         for row in rows:
             summary.add_row(*row)
-        parts = [summary]
-        if self.t_s is not None:
-            series = Table(title="error versus time")
-            columns = ["t (s)", "flat (m)", "spherical (m)"] + (["simulated (m)"] if self.simulated_m is not None
-                                                                 else [])
-            for column in columns:
-                series.add_column(column, justify="right")
-            for k in sample_indices(self.t_s.size):
-                cells = [f"{self.t_s[k]:,.6g}", length_text(self.flat_m[k], "m", floor),
-                         length_text(self.spherical_m[k], "m", floor)]
-                if self.simulated_m is not None:
-                    cells.append(length_text(self.simulated_m[k], "m", floor))
-                series.add_row(*cells)
-            parts.append(series)
+        series = Table(title="error versus time")
+        columns = ["t (s)", "flat (m)", "spherical (m)"] + (["simulated (m)"] if self.simulated_m is not None else [])
+        for column in columns:
+            series.add_column(column, justify="right")
+        for k in sample_indices(self.t_s.size):
+            cells = [f"{self.t_s[k]:,.6g}", length_text(self.flat_m[k], "m", floor),
+                     length_text(self.spherical_m[k], "m", floor)]
+            if self.simulated_m is not None:
+                cells.append(length_text(self.simulated_m[k], "m", floor))
+            series.add_row(*cells)
+        parts = [summary, series]
         if self.monte_carlo is not None:
             parts.append(self.monte_carlo.render())
         return Group(*parts)
@@ -150,10 +148,10 @@ class VerticalResult(Result):
     aided_steady_state_m: float
     poles_real_per_s: np.ndarray
     poles_imag_rad_s: np.ndarray
-    t_s: np.ndarray = field(default=None, repr=False)
-    unaided_m: np.ndarray = field(default=None, repr=False)
-    closed_form_m: np.ndarray = field(default=None, repr=False)
-    aided_m: np.ndarray = field(default=None, repr=False)
+    t_s: np.ndarray = field(repr=False)
+    unaided_m: np.ndarray = field(repr=False)
+    closed_form_m: np.ndarray = field(repr=False)
+    aided_m: np.ndarray = field(repr=False)
 
     units: ClassVar[dict[str, str]] = {"order": "1", "k1_per_s": "1/s", "k2_per_s2": "1/s^2", "k3_per_s3": "1/s^3",
                                        "poles_real_per_s": "1/s"}
@@ -267,7 +265,7 @@ class Problem3Figures(Result):
     max_flat_m: dict[str, float]
     max_spherical_m: dict[str, float]
     largest_simulation_minus_closed_m: float
-    curves: Problem3Curves = field(default=None, repr=False)
+    curves: Problem3Curves = field(repr=False)
 
     def render(self):
         from rich.console import Group

@@ -49,7 +49,12 @@ from schuler.core.earth import PRESETS
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
 from schuler.memory import require
-from schuler.navigation_errors.inputs import EARTH_PARAMETERS, earth_constants, grid_points, time_grid
+from schuler.navigation_errors.inputs import (
+    EARTH_PARAMETERS,
+    earth_constants,
+    grid_points,
+    time_grid,
+)
 from schuler.navigation_errors.results import lengths, sample_indices
 from schuler.navigation_errors.three_d import psi_angle_model
 from schuler.params import Parameter, ParameterSet
@@ -57,8 +62,6 @@ from schuler.results import Result
 from schuler.units import to_unit
 
 AXES = ("north", "east", "down")
-_BIAS_RANGE = {"minimum": -0.1, "maximum": 0.1}
-_RATE_RANGE = {"minimum": -3600.0, "maximum": 3600.0}
 
 LATITUDE_CHANGE_WARNING = math.radians(1.0)
 """A north speed that moves the vehicle by more than this in latitude over the run is warned about, rad."""
@@ -73,9 +76,10 @@ THREE_D_PARAMETERS = ParameterSet((
     Parameter("output_step", "s", 60.0, "Output step (the simulation is exact between outputs).", minimum=0.0,
               exclusive_minimum=True),
     *(Parameter(f"drift_{axis}", "deg/h", 0.0, f"Platform drift rate about {axis}: -(gyro bias) resolved "
-                f"{axis}.", **_RATE_RANGE) for axis in AXES),
+                f"{axis}.", minimum=-3600.0, maximum=3600.0) for axis in AXES),
     *(Parameter(f"accel_bias_{axis}", "g", 0.0, f"Accelerometer bias resolved {axis}, measured - true"
-                + (" (vertical channel only)." if axis == "down" else "."), **_BIAS_RANGE) for axis in AXES),
+                + (" (vertical channel only)." if axis == "down" else "."), minimum=-0.1, maximum=0.1)
+      for axis in AXES),
     *(Parameter(f"initial_velocity_error_{axis}", "m/s", 0.0, f"Velocity error {axis} at the start.",
                 minimum=-1e3, maximum=1e3) for axis in AXES[:2]),
     *(Parameter(f"initial_attitude_error_{axis}", "arcmin", 0.0, f"Platform attitude error psi_{axis[0].upper()} "
@@ -120,9 +124,9 @@ class ThreeDResult(Result):
     foucault_rate_rad_s: float
     eigenvalues_real_per_s: np.ndarray
     eigenvalues_imag_rad_s: np.ndarray
-    t_s: np.ndarray = field(default=None, repr=False)
-    histories: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
-    state_units: dict[str, str] = field(default_factory=dict, repr=False)
+    t_s: np.ndarray = field(repr=False)
+    histories: dict[str, np.ndarray] = field(repr=False)
+    state_units: dict[str, str] = field(repr=False)
 
     units: ClassVar[dict[str, str]] = {"eigenvalues_real_per_s": "1/s"}
 
@@ -141,8 +145,8 @@ class ThreeDResult(Result):
         rows = [
             ("Schuler period, Foucault rate Omega sin L",
              f"{self.schuler_period_s / 60:.2f} min, {foucault}"),
-            ("position error north, east at the end", f"{lengths(self.final_position_error_north_m, floor)}, "
-                                                      f"{lengths(self.final_position_error_east_m, floor)}"),
+            ("position error north, east at the end", (f"{lengths(self.final_position_error_north_m, floor)}, "
+                                                      f"{lengths(self.final_position_error_east_m, floor)}")),
             ("largest horizontal position error", lengths(self.max_horizontal_position_error_m, floor)),
             ("velocity error north, east at the end",
              f"{self.final_velocity_error_north_m_s:.4g} m/s, {self.final_velocity_error_east_m_s:.4g} m/s"),
