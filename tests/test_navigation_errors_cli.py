@@ -6,6 +6,8 @@ import math
 
 import pandas as pd
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from schuler.core.earth import FOOT, STATUTE_MILE
 
@@ -208,3 +210,36 @@ def test_help_lists_the_actions(run_cli):
     for command in ("run", "reproduce", "vertical", "period", "plot", "three-d"):
         assert command in out.stdout
     assert "Bollay" in out.stdout
+
+
+FUZZ_VALUES = ["0", "-1", "1", "1e300", "-1e300", "nan", "inf", "-inf", "1e-300", "abc", "", "5 m", "3 deg",
+               "1 g", "2 h", "0.5 mi/s", "1e5", "0.01 deg/h", "2"]
+FUZZ_OPTIONS = {
+    "run": ["--source", "--magnitude", "--duration", "--output-step", "--speed", "--earth", "--radius", "--gravity",
+            "--fidelity", "--monte-carlo", "--seed"],
+    "vertical": ["--accel-bias-up", "--duration", "--output-step", "--order", "--time-constant", "--k1", "--k2",
+                 "--k3", "--baro-bias", "--radius", "--gravity"],
+    "period": ["--thrust-factor", "--speed", "--path-radius", "--earth", "--gravity"],
+    "three-d": ["--latitude", "--velocity-north", "--duration", "--output-step", "--drift-east", "--accel-bias-down",
+                "--initial-attitude-error-down", "--earth-rate", "--radius"],
+    "plot": ["--points"],
+}
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_fuzz_every_command_ends_with_exit_0_or_one_line_exit_2(run_cli, monkeypatch, data):
+    # careless inputs: every outcome is a result or one line naming the problem, never a traceback
+    monkeypatch.setenv("SCHULER_MEMORY_BUDGET", "200 MiB")
+    command = data.draw(st.sampled_from(sorted(FUZZ_OPTIONS)))
+    options = data.draw(st.lists(st.sampled_from(FUZZ_OPTIONS[command]), min_size=1, max_size=3, unique=True))
+    args = []
+    for option in options:
+        args += [option, data.draw(st.sampled_from(FUZZ_VALUES) | st.floats(allow_nan=True).map(repr))]
+    out = run_cli("errors", command, *args, "--json")
+    assert out.code in (0, 2), (args, out.stderr)
+    assert "Traceback" not in out.stderr
+    if out.code == 2:
+        assert out.stderr.startswith("schuler: error:") and out.stderr.count("\n") == 1, (args, out.stderr)
+    else:
+        assert "NaN" not in out.stdout and "Infinity" not in out.stdout

@@ -65,6 +65,9 @@ def test_magnitude_takes_si_numbers_and_text_in_the_source_unit():
     ({"source": "gyro"}, "is not one of"),
     ({"duration": 0.0}, "is outside"),
     ({"speed": -1.0}, "is outside"),
+    ({"magnitude": "100", "source": "tilt"}, "more than 10 deg, the largest tilt error"),
+    ({"magnitude": 1.0, "source": "drift"}, "more than 3600 deg/h"),
+    ({"radius": 1.0}, "is outside"),
 ])
 def test_bad_values_are_refused_naming_the_parameter(kwargs, reason):
     with pytest.raises(InvalidParameter, match=reason) as error:
@@ -226,7 +229,7 @@ def test_memory_is_refused_before_allocating(monkeypatch):
     out = SYSTEM.evaluate_values({"duration": 1e9, "output_step": 1e-3}, fidelity="closed")
     assert np.isfinite(out["final_spherical_m"]).all()
     with pytest.raises(MemoryBudgetExceeded):
-        vertical(**VERTICAL_PARAMETERS.case(duration=1e7, output_step=1e-3))
+        vertical(**VERTICAL_PARAMETERS.case(duration=1e5, output_step=1e-3))
 
 
 # --- actions -----------------------------------------------------------------------------------------
@@ -247,8 +250,10 @@ def test_vertical_gains_from_tau_and_explicit_ones():
     ({"k2": 1e-7}, "k2"),
     ({"order": 4}, "order"),
     ({"accel_bias_up": 1.0}, "accel_bias_up"),
+    ({"duration": 1e5, "radius": 1e3, "gravity": 1e3}, "duration"),
 ])
 def test_vertical_refuses_conflicting_or_unstable_options(kwargs, name):
+    # a divergent run is refused before its numbers overflow: exp(sqrt(2) omega_s t) <= exp(200)
     with pytest.raises(InvalidParameter) as error:
         vertical(**VERTICAL_PARAMETERS.case(**kwargs))
     assert error.value.name == name

@@ -180,7 +180,8 @@ def test_action_warns_when_the_latitude_changes_much():
 @pytest.mark.parametrize("values, name", [({"accel_bias_down": 1e-3}, "accel_bias_down"),
                                           ({"latitude": math.pi / 2}, "latitude"),
                                           ({"output_step": 1e6}, "output_step"),
-                                          ({"drift_est": 1e-8}, "drift_est")])
+                                          ({"drift_est": 1e-8}, "drift_est"),
+                                          ({"vertical_channel": True, "duration": 2e5}, "duration")])
 def test_action_bad_input(values, name):
     with pytest.raises(InvalidParameter) as error:
         _three_d(**values)

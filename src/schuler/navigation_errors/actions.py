@@ -34,6 +34,7 @@ from schuler.navigation_errors.effective_period import (
 )
 from schuler.navigation_errors.inputs import (
     EARTH_PARAMETERS,
+    check_vertical_growth,
     earth_constants,
     grid_points,
     time_grid,
@@ -57,18 +58,21 @@ VERTICAL_PARAMETERS = ParameterSet((
     Parameter("accel_bias_up", "g", -1e-4,
               "Bias of the vertical accelerometer, measured - true along up (Problem 4: reads 1e-4 g low).",
               minimum=-0.1, maximum=0.1),
-    Parameter("duration", "s", 5060.0, "Length of the run.", minimum=0.0, exclusive_minimum=True),
+    Parameter("duration", "s", 5060.0, "Length of the run (the pure-inertial error grows as cosh(sqrt(2) omega_s t)).",
+              minimum=0.0, exclusive_minimum=True, maximum=1e5),
     Parameter("output_step", "s", None, "Output step (not set: duration / 1000).", minimum=0.0,
               exclusive_minimum=True),
     Parameter("order", "", 3, "Order of the baro-aided loop.", minimum=2, maximum=3, kind="integer"),
     Parameter("time_constant", "s", 100.0, "Loop time constant tau: critically damped gains, all poles at -1/tau "
-              "(gains not given explicitly).", minimum=0.0, exclusive_minimum=True),
-    Parameter("k1", "1/s", None, "Altitude feedback gain (not set: from tau).", minimum=0.0, exclusive_minimum=True),
+              "(gains not given explicitly).", minimum=1.0, maximum=1e6),
+    Parameter("k1", "1/s", None, "Altitude feedback gain (not set: from tau).", minimum=0.0, exclusive_minimum=True,
+              maximum=1e3),
     Parameter("k2", "1/s^2", None, "Velocity feedback gain (not set: from tau).", minimum=0.0,
-              exclusive_minimum=True),
+              exclusive_minimum=True, maximum=1e3),
     Parameter("k3", "1/s^3", None, "Accelerometer-bias estimator gain, third order only (not set: from tau).",
-              minimum=0.0, exclusive_minimum=True),
-    Parameter("baro_bias", "m", 0.0, "Constant error of the barometric altitude, measured - true."),
+              minimum=0.0, exclusive_minimum=True, maximum=1e3),
+    Parameter("baro_bias", "m", 0.0, "Constant error of the barometric altitude, measured - true.", minimum=-1e4,
+              maximum=1e4),
     *EARTH_PARAMETERS,
 ), owner="errors vertical", exclusive=(("time_constant", "k1"), ("time_constant", "k2"), ("time_constant", "k3")))
 """Options of ``schuler errors vertical``: an explicit gain and an explicit tau exclude each other."""
@@ -76,9 +80,9 @@ VERTICAL_PARAMETERS = ParameterSet((
 PERIOD_PARAMETERS = ParameterSet((
     Parameter("thrust_factor", "", 9.0, "Vertical thrust n in units of the weight (g_eff = n g).", minimum=0.0,
               exclusive_minimum=True, maximum=1e6),
-    Parameter("speed", "m/s", 0.0, "Level-flight speed V (g_eff = g - V^2/r).", minimum=0.0),
-    Parameter("path_radius", "km", None, "Radius of curvature r of the flight path (not set: R).", minimum=0.0,
-              exclusive_minimum=True),
+    Parameter("speed", "m/s", 0.0, "Level-flight speed V (g_eff = g - V^2/r).", minimum=0.0, maximum=1e5),
+    Parameter("path_radius", "km", None, "Radius of curvature r of the flight path (not set: R).", minimum=1e-3,
+              maximum=1e6),
     *EARTH_PARAMETERS,
 ), owner="errors period")
 """Options of ``schuler errors period``."""
@@ -162,9 +166,10 @@ def vertical(*, accel_bias_up: float, duration: float, output_step: float | None
     714.0
     """
     R, g = earth_constants(earth, radius, gravity)
+    check_vertical_growth(duration, R, g)
     gains = loop_gains(order, time_constant, k1, k2, k3, R, g)
     step = duration / 1000.0 if output_step is None else output_step
-    require(int(grid_points(duration, step)) * VERTICAL_BYTES_PER_POINT, "this run", "--duration or --output-step")
+    require(float(grid_points(duration, step)) * VERTICAL_BYTES_PER_POINT, "this run", "--duration or --output-step")
     t = time_grid(duration, step)
     unaided, aided = altitude_errors(t, gains, accel_bias_up, baro_bias, R, g)
     closed = hover_altitude_error(t, accel_bias_up, R, g)

@@ -48,6 +48,9 @@ from schuler.navigation_errors.single_channel import (
 )
 from schuler.params import Case, Parameter
 
+MAX_DURATION = 1e9
+"""Longest run, s (about 32 years: the closed forms stay finite for every allowed source and Earth)."""
+
 POINTS_PER_RUN = 1000
 """Output steps of a run whose ``output_step`` is not set."""
 
@@ -66,11 +69,12 @@ PARAMETERS = SourceParameters((
                        "Size of the error (>= 0); a bare number is in the source's unit: tilt and azimuth deg, "
                        "velocity ft/s, accelerometer g, drift deg/h (not set: Problem 3's 0.01 deg, 1 ft/s, "
                        "1e-4 g, 0.01 deg/h, 0.01 deg)."),
-    Parameter("duration", "s", FLIGHT_TIME, "Length of the run.", minimum=0.0, exclusive_minimum=True),
+    Parameter("duration", "s", FLIGHT_TIME, "Length of the run.", minimum=0.0, exclusive_minimum=True,
+              maximum=MAX_DURATION),
     Parameter("output_step", "s", None, "Output step (not set: duration / 1000; the simulation is exact between "
               "outputs).", minimum=0.0, exclusive_minimum=True),
     Parameter("speed", "m/s", "0.5 mi/s", "Vehicle speed V; the azimuth error grows with the range V t.",
-              minimum=0.0),
+              minimum=0.0, maximum=1e5),
     *EARTH_PARAMETERS,
 ), owner="errors")
 """Every option of ``schuler errors run`` (and key of an ``errors`` scenario)."""
@@ -153,7 +157,7 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
 
 def _simulate_groups(batch: dict[str, np.ndarray], points: np.ndarray, out: dict[str, np.ndarray]) -> None:
     """The simulated outputs, one simulation per distinct grid and model (errors are linear in the magnitude)."""
-    require(int(points.max()) * SIMULATION_BYTES_PER_POINT, "this run", "--duration or --output-step")
+    require(float(points.max()) * SIMULATION_BYTES_PER_POINT, "this run", "--duration or --output-step")
     codes = np.array([SOURCES.index(s) for s in batch["source"]], dtype=float)
     # the speed shapes only the azimuth model
     speed = np.where(codes == SOURCES.index("azimuth"), batch["speed"], 0.0)
@@ -188,7 +192,7 @@ def run_case(case: Case, fidelity: str | None = None) -> ErrorRunResult:
     cases = Cases.from_case(case, fidelity=fidelity)
     outputs = {name: float(values[0]) for name, values in evaluate(cases).items()}
     batch = {name: values[0] for name, values in _batch(cases).items()}
-    count = int(grid_points(batch["duration"], batch["step"]))
+    count = float(grid_points(batch["duration"], batch["step"]))
     require(count * HISTORY_BYTES_PER_POINT, "this run", "--duration or --output-step")
     t = time_grid(batch["duration"], batch["step"])
     source, magnitude = str(batch["source"]), float(batch["magnitude"])

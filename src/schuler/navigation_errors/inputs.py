@@ -56,8 +56,16 @@ SOURCE_DEFAULTS: dict[str, float] = {"tilt": 0.01, "velocity": 1.0, "acceleromet
                                      "azimuth": 0.01}
 """Problem 3's magnitudes (Bollay 1966) in the display units."""
 
+SOURCE_MAXIMA: dict[str, float] = {"tilt": 10.0, "velocity": 3e4, "accelerometer": 1.0, "drift": 3600.0,
+                                   "azimuth": 90.0}
+"""Largest magnitude of each source in the display units: the error equations are linearised (small angles),
+and beyond these the numbers would stand for no instrument."""
+
 FLIGHT_TIME = 10_120.0
 """Problem 3's flight time (Bollay 1966), s: 2 x 5060 s, the default duration of ``run``."""
+
+MAX_GROWTH_EXPONENT = 200.0
+"""Largest sqrt(2) omega_s t of a divergent vertical channel (its error grows as exp of it: e^200 = 7e86)."""
 
 GRID_TOLERANCE = 1e-9
 """A duration within this many steps of a whole number of steps ends on that step."""
@@ -95,6 +103,10 @@ def magnitude_si(source: str, value, label: str = "magnitude") -> float:
         number = float(value)
     if not math.isfinite(number) or number < 0:
         raise InvalidParameter(label, f"{shown!r} must be finite and >= 0 (the source's direction sets the sign)")
+    largest = parse_quantity(SOURCE_MAXIMA[source], unit, name=label)
+    if number > largest * (1 + 1e-12):
+        raise InvalidParameter(label, f"{shown!r} is more than {SOURCE_MAXIMA[source]:g} {unit}, the largest {source} "
+                                      "error the linearised equations stand for")
     return number
 
 
@@ -166,10 +178,9 @@ class SourceParameters(ParameterSet):
 EARTH_PARAMETERS: tuple[Parameter, ...] = (
     Parameter("earth", "", "default", "Earth constants preset (bollay: R = 3960 mi, T = 5060 s; "
               "drozdovich: R = 6400 km).", choices=tuple(PRESETS), kind="choice"),
-    Parameter("radius", "km", None, "Earth radius R (not set: the preset's).", minimum=0.0,
-              exclusive_minimum=True),
+    Parameter("radius", "km", None, "Earth radius R (not set: the preset's).", minimum=1.0, maximum=1e5),
     Parameter("gravity", "m/s^2", None, "Gravity g of the Schuler loop (not set: the preset's; with only the "
-              "radius set, the preset's g).", minimum=0.0, exclusive_minimum=True),
+              "radius set, the preset's g).", minimum=1e-3, maximum=1e3),
 )
 """The Earth of every command: a preset, its radius and gravity optionally overridden."""
 
@@ -212,8 +223,25 @@ def earth_constant_arrays(earth: np.ndarray, radius: np.ndarray, gravity: np.nda
     return R, g
 
 
+def check_vertical_growth(duration: float, radius: float, gravity: float) -> None:
+    """Refuse a run whose pure-inertial vertical error would grow beyond exp(:data:`MAX_GROWTH_EXPONENT`).
+
+    >>> check_vertical_growth(1e6, 6.371e6, 9.80665)
+    Traceback (most recent call last):
+    ...
+    schuler.exceptions.InvalidParameter: duration: 1e+06 s lets the vertical error grow as exp(1755); at most 113,988 s here
+    """
+    rate = math.sqrt(2.0 * gravity / radius)
+    if rate * duration > MAX_GROWTH_EXPONENT:
+        raise InvalidParameter("duration", f"{duration:g} s lets the vertical error grow as exp({rate * duration:.0f}); "
+                                           f"at most {MAX_GROWTH_EXPONENT / rate:,.0f} s here")
+
+
 def grid_points(duration, step, names: tuple[str, str] = ("duration", "output_step")) -> np.ndarray:
     """Number of points of :func:`time_grid` for each (duration, step), without building the grids.
+
+    Counts are floats (exact below 2^53), so that an absurd grid is sized, and
+    refused by :func:`schuler.memory.require`, rather than overflowing an integer.
 
     Raises :class:`InvalidParameter` (naming ``names``) for a non-finite or
     non-positive duration or step, or a step longer than the duration.
@@ -232,7 +260,7 @@ def grid_points(duration, step, names: tuple[str, str] = ("duration", "output_st
     steps = duration / step
     whole = np.round(steps)
     on_step = np.abs(steps - whole) <= GRID_TOLERANCE * np.maximum(1.0, steps)
-    return np.where(on_step, whole + 1, np.floor(steps) + 2).astype(np.int64)
+    return np.where(on_step, whole + 1, np.floor(steps) + 2)
 
 
 def time_grid(duration: float, step: float | None = None,

@@ -51,6 +51,7 @@ from schuler.exceptions import InvalidParameter
 from schuler.memory import require
 from schuler.navigation_errors.inputs import (
     EARTH_PARAMETERS,
+    check_vertical_growth,
     earth_constants,
     grid_points,
     time_grid,
@@ -63,6 +64,9 @@ from schuler.units import to_unit
 
 AXES = ("north", "east", "down")
 
+MAX_DURATION = 30 * 86_400.0
+"""Longest run, s (30 days)."""
+
 LATITUDE_CHANGE_WARNING = math.radians(1.0)
 """A north speed that moves the vehicle by more than this in latitude over the run is warned about, rad."""
 
@@ -72,7 +76,9 @@ THREE_D_PARAMETERS = ParameterSet((
     Parameter("velocity_north", "m/s", 0.0, "Vehicle's constant north ground speed V_N (coefficients frozen at L).",
               minimum=-1e4, maximum=1e4),
     Parameter("velocity_east", "m/s", 0.0, "Vehicle's constant east ground speed V_E.", minimum=-1e4, maximum=1e4),
-    Parameter("duration", "s", 86_400.0, "Length of the run.", minimum=0.0, exclusive_minimum=True),
+    Parameter("duration", "s", 86_400.0, "Length of the run (with the vertical channel: while its error grows "
+              "less than exp(200)).",
+              minimum=0.0, exclusive_minimum=True, maximum=MAX_DURATION),
     Parameter("output_step", "s", 60.0, "Output step (the simulation is exact between outputs).", minimum=0.0,
               exclusive_minimum=True),
     *(Parameter(f"drift_{axis}", "deg/h", 0.0, f"Platform drift rate about {axis}: -(gyro bias) resolved "
@@ -212,11 +218,13 @@ def three_d(*, latitude: float, velocity_north: float, velocity_east: float, dur
     if not vertical_channel and accel_bias_down != 0.0:
         raise InvalidParameter("accel_bias_down", "acts on the vertical channel only: set vertical_channel too")
     R, g = earth_constants(earth, radius, gravity)
+    if vertical_channel:
+        check_vertical_growth(duration, R, g)
     rate = PRESETS[earth].rate if earth_rate is None else earth_rate
     model = psi_angle_model(latitude=latitude, radius=R, gravity=g, rate=rate, velocity_north=velocity_north,
                             velocity_east=velocity_east, vertical_channel=vertical_channel)
     width = model.n_states + model.n_inputs
-    require(int(grid_points(duration, output_step)) * 8 * (width * width + 3 * model.n_states + 2),
+    require(float(grid_points(duration, output_step)) * 8 * (width * width + 3 * model.n_states + 2),
             "this run", "--duration or --output-step")
     latitude_change = abs(velocity_north) * duration / R
     if latitude_change > LATITUDE_CHANGE_WARNING:
