@@ -243,3 +243,20 @@ def test_fuzz_every_command_ends_with_exit_0_or_one_line_exit_2(run_cli, monkeyp
         assert out.stderr.startswith("schuler: error:") and out.stderr.count("\n") == 1, (args, out.stderr)
     else:
         assert "NaN" not in out.stdout and "Infinity" not in out.stdout
+
+
+@pytest.mark.slow
+def test_sweep_over_sources_reads_each_magnitude_in_its_source_unit(run_cli, tmp_path):
+    scenario = tmp_path / "errors.toml"
+    scenario.write_text('system = "errors"\n[parameters]\nsource = "tilt"\nmagnitude = 0.01\nearth = "bollay"\n')
+    out = run_cli("sweep", scenario, "--param", "source=tilt,drift", "--param", "magnitude=0.01,0.02",
+                  "--fidelity", "closed", "--out", tmp_path / "sweep", "--no-progress", "--json")
+    assert out.code == 0, out.stderr
+    table = pd.read_parquet(tmp_path / "sweep" / "results.parquet")
+    assert table["source"].tolist() == ["tilt", "tilt", "drift", "drift"]
+    # Bollay, Problem 3: 0.01 deg of tilt -> 7300 ft at most; 0.01 deg/h of drift -> 10,250 ft at 10,120 s
+    assert (table["max_spherical_m"] / FOOT).tolist() == pytest.approx([7298.5, 14597.1, 10258.5, 20517.0], abs=0.1)
+    # the scenario's magnitude, converted for its own source, is not applied to the other source
+    refused = run_cli("sweep", scenario, "--param", "source=tilt,drift", "--out", tmp_path / "refused",
+                      "--no-progress")
+    assert refused.code == 2 and "sources of different units" in refused.stderr

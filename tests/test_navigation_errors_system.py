@@ -170,11 +170,11 @@ def test_one_si_magnitude_swept_over_sources_of_different_units_is_refused():
     with pytest.raises(InvalidParameter, match="one value .* for sources of different units") as error:
         SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object), "magnitude": 0.01 * DEG_PER_H})
     assert error.value.name == "magnitude"
-    # written as text, each case reads it in its own source's unit
-    out = SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object),
-                                  "magnitude": np.array(["0.01", "0.01"], dtype=object)})
+    # written as text (an object or a string array, as a sweep axis gives), each case reads it in its source's unit
     same = SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object)})  # Problem 3 values
-    np.testing.assert_allclose(out["max_spherical_m"], same["max_spherical_m"], rtol=1e-12)
+    for text in (np.array(["0.01", "0.01"], dtype=object), np.array(["0.01", "0.01"])):
+        out = SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object), "magnitude": text})
+        np.testing.assert_allclose(out["max_spherical_m"], same["max_spherical_m"], rtol=1e-12)
     # the same source: one number is fine
     assert np.isfinite(SYSTEM.evaluate_values({"source": np.array(["tilt", "azimuth"], dtype=object),
                                                "magnitude": 1e-4})["final_flat_m"]).all()

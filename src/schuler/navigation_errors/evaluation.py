@@ -96,7 +96,7 @@ FIDELITIES = ("simulated", "closed")
 
 def _magnitudes(sources: np.ndarray, column: np.ndarray) -> np.ndarray:
     """SI magnitudes of a batch: numbers are SI, text takes its source's unit, None or NaN its Problem 3 value."""
-    if column.dtype != object:
+    if column.dtype.kind in "fiu":
         values = column.astype(float)
         unset = np.isnan(values)
         units = {SOURCE_SI_UNITS[source] for source in set(sources[~unset].tolist())}
