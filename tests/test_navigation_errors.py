@@ -1,4 +1,4 @@
-"""Single-channel, vertical-channel and effective-period models of source 002 (Bollay)."""
+"""Single-channel, vertical-channel and effective-period models of Bollay (1966), and its reproduction."""
 
 from __future__ import annotations
 
@@ -12,14 +12,21 @@ from hypothesis import strategies as st
 from schuler.core.earth import BOLLAY, FOOT, MEAN_RADIUS, STANDARD_GRAVITY, STATUTE_MILE
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
-from schuler.navigation_errors import api
+from schuler.navigation_errors.actions import VERTICAL_PARAMETERS, vertical
 from schuler.navigation_errors.effective_period import (
     effective_schuler_period,
     flight_gravity,
     orbital_speed,
     thrust_gravity,
 )
-from schuler.navigation_errors.reproduction import FLIGHT_TIME, MAGNITUDES, SPEED, problem3_rows
+from schuler.navigation_errors.inputs import FLIGHT_TIME
+from schuler.navigation_errors.reproduction import (
+    MAGNITUDES,
+    SPEED,
+    problem3_rows,
+    report,
+    reproduce,
+)
 from schuler.navigation_errors.single_channel import (
     SOURCES,
     channel_model,
@@ -39,6 +46,7 @@ from schuler.navigation_errors.vertical_channel import (
     printed_hover_expression,
     unaided_model,
 )
+from schuler.reproduction import printed_value
 
 R_BOLLAY, G_BOLLAY = BOLLAY.radius, BOLLAY.effective_gravity
 EARTHS = {"bollay": (R_BOLLAY, G_BOLLAY), "default": (MEAN_RADIUS, STANDARD_GRAVITY)}
@@ -130,58 +138,86 @@ def test_bad_input_raises_invalid_parameter_naming_it(call, name):
     assert error.value.name == name
 
 
-# --- source 002, Problem 3 table and Problem 4 --------------------------------------------------
+# --- Bollay (1966), Problem 3 table and Problem 4 --------------------------------------------------
 
 PUBLISHED = [
-    # (source, earth, quantity, printed ft, agrees): source 002, Problem 3 summary table / Problem 4
-    ("tilt", "flat", "at_10120s", 288_000, True),
-    ("tilt", "spherical", "at_10120s", 0, True),
-    ("tilt", "spherical", "max", 3_650, False),  # erratum: 2 R dtheta = 7,300 ft (solution text)
-    ("velocity", "flat", "at_10120s", 10_120, True),
-    ("velocity", "spherical", "at_10120s", 0, True),
-    ("velocity", "spherical", "max", 805, True),
-    ("accelerometer", "flat", "at_10120s", 341_000, False),  # erratum: k g t^2/2 = 165,089 ft
-    ("accelerometer", "spherical", "at_10120s", 0, True),
-    ("accelerometer", "spherical", "max", 4_170, True),
-    ("drift", "flat", "at_10120s", 1.62e6, False),  # erratum: the 1/6 dropped
-    ("drift", "spherical", "at_10120s", 10_250, True),
-    ("azimuth", "flat", "at_10120s", 4_660, True),
-    ("azimuth", "spherical", "at_10120s", 3_500, True),
-    ("hover", "vertical", "at_T", 724 * 5280, False),  # erratum: 715.4 mi
+    # (quantity, printed exactly as in Bollay 1966, where, unit, erratum?): Problem 3 summary table and
+    # solution text, Problem 4 solution
+    ("level misalignment 0.01 deg, flat Earth at 10,120 s", "288,000", "Problem 3, summary table", "ft", False),
+    ("level misalignment 0.01 deg, flat Earth at 10,120 s", "287,500", "Problem 3, solution (a)", "ft", False),
+    ("level misalignment, spherical Earth at 10,120 s", "0", "Problem 3, summary table", "ft", False),
+    ("level misalignment, spherical Earth, largest error", "3650", "Problem 3, summary table", "ft", True),
+    ("level misalignment, spherical Earth, largest error", "7300", "Problem 3, solution (a)", "ft", False),
+    ("level misalignment, amplitude R Delta_theta", "3650", "Problem 3, solution (a)", "ft", False),
+    ("launch velocity 1 ft/s, flat Earth at 10,120 s", "10,120", "Problem 3, summary table", "ft", False),
+    ("launch velocity, spherical Earth at 10,120 s", "0", "Problem 3, summary table", "ft", False),
+    ("launch velocity 1 ft/s, spherical Earth, largest error", "805", "Problem 3, summary table", "ft", False),
+    ("accelerometer 1e-4 g, flat Earth at 10,120 s", "341,000", "Problem 3, summary table", "ft", True),
+    ("accelerometer, spherical Earth at 10,120 s", "0", "Problem 3, summary table", "ft", False),
+    ("accelerometer 1e-4 g, spherical Earth, largest error", "4,170", "Problem 3, summary table", "ft", False),
+    ("accelerometer 1e-4 g, spherical Earth, largest error", "0.792", "Problem 3, solution (c)", "mi", False),
+    ("gyro drift 0.01 deg/h, flat Earth at 10,120 s", "1.62 \u00d7 10^6", "Problem 3, summary table", "ft", True),
+    ("gyro drift 0.01 deg/h, spherical Earth at 10,120 s", "10,250", "Problem 3, summary table", "ft", False),
+    ("gyro drift 0.01 deg/h, spherical Earth at 10,120 s", "1.94", "Problem 3, solution (d)", "mi", False),
+    ("gyro drift angle epsilon t after 2.8 h", "1.68", "Problem 3, solution (d)", "arcmin", False),
+    ("azimuth 0.01 deg, flat Earth at 10,120 s", "4660", "Problem 3, summary table", "ft", False),
+    ("azimuth 0.01 deg, spherical Earth at 10,120 s", "3500", "Problem 3, summary table", "ft", False),
+    ("azimuth: range angle phi = r / R", "73.3", "Problem 3, solution (a)", "deg", False),
+    ("azimuth: sin phi", ".957", "Problem 3, solution (a)", "1", False),
+    ("hover, k = 1e-4, altitude error after t = T", "724", "Problem 4, solution", "mi", True),
 ]
 
 
-def test_problem3_rows_have_the_published_values_and_flags():
+def test_problem3_rows_have_the_published_values_and_verdicts():
     rows = problem3_rows()
-    assert [(r.source, r.earth, r.quantity, r.printed_ft, r.agrees) for r in rows] == PUBLISHED
-    assert all(r.note for r in rows)
+    assert [(r.quantity, r.printed, r.where, r.unit, r.verdict == "erratum") for r in rows] == PUBLISHED
+    assert all(r.note for r in rows if r.verdict == "erratum")
+    assert not [r for r in rows if r.failed]  # no "differs": every disagreement is an explained erratum
 
 
-@pytest.mark.parametrize("row", [r for r in problem3_rows() if r.agrees], ids=lambda r: f"{r.source}-{r.earth}-{r.quantity}")
+@pytest.mark.parametrize("row", [r for r in problem3_rows() if r.verdict.startswith("agrees")],
+                         ids=lambda r: f"{r.quantity}-{r.printed}")
 def test_agreeing_rows_are_within_the_source_rounding(row):
-    # source 002 prints three significant figures: 0.5 % (or 0.5 ft of a printed zero)
-    if row.printed_ft == 0:
-        assert row.computed_ft < 0.5
+    # Bollay prints three significant figures: 0.5 % (or 0.5 ft of a printed zero)
+    if row.printed == "0":
+        assert row.verdict == "agrees within 0.5 ft" and row.computed < 0.5
     else:
-        assert row.computed_ft == pytest.approx(row.printed_ft, rel=0.005)
+        assert row.verdict == "agrees within 0.5 %"
+        assert row.computed == pytest.approx(printed_value(row.printed), rel=0.005)
 
 
 def test_errata_values_recomputed_from_the_formulas():
-    by_key = {(r.source, r.earth, r.quantity): r.computed_ft for r in problem3_rows()}
+    rows = problem3_rows()
+    by_key = {(r.quantity, r.printed): r.computed for r in rows}
+    tilt_max = by_key["level misalignment, spherical Earth, largest error", "3650"]
     # spec errata, recomputed with R = 3960 mi, omega = 2 pi / 5060 s, g_eff = omega^2 R
-    assert by_key["tilt", "spherical", "max"] == pytest.approx(2 * 3960 * 5280 * math.radians(0.01), rel=1e-12)
-    assert by_key["tilt", "spherical", "max"] == pytest.approx(7_300, rel=0.001)  # source 002 solution text
-    assert by_key["drift", "flat", "at_10120s"] == pytest.approx(2.70e5, rel=0.001)
-    assert 6 * by_key["drift", "flat", "at_10120s"] == pytest.approx(1.62e6, rel=0.002)  # the printed one: no 1/6
-    assert by_key["accelerometer", "flat", "at_10120s"] == pytest.approx(1.65e5, rel=0.001)
-    assert by_key["accelerometer", "spherical", "max"] == pytest.approx(4_181.76, abs=0.01)  # 2 k R exactly
-    assert by_key["azimuth", "spherical", "at_10120s"] == pytest.approx(3_494, abs=0.5)
-    assert by_key["drift", "spherical", "at_10120s"] == pytest.approx(
+    assert tilt_max == pytest.approx(2 * 3960 * 5280 * math.radians(0.01), rel=1e-12)
+    assert tilt_max == pytest.approx(7_300, rel=0.001)  # Bollay, solution text
+    drift_flat = by_key["gyro drift 0.01 deg/h, flat Earth at 10,120 s", "1.62 \u00d7 10^6"]
+    assert drift_flat == pytest.approx(2.70e5, rel=0.001)
+    assert 6 * drift_flat == pytest.approx(1.62e6, rel=0.002)  # the printed one: no 1/6
+    assert by_key["accelerometer 1e-4 g, flat Earth at 10,120 s", "341,000"] == pytest.approx(1.65e5, rel=0.001)
+    assert by_key["accelerometer 1e-4 g, spherical Earth, largest error", "4,170"] == pytest.approx(4_181.76, abs=0.01)
+    assert by_key["azimuth 0.01 deg, spherical Earth at 10,120 s", "3500"] == pytest.approx(3_494, abs=0.5)
+    assert by_key["gyro drift 0.01 deg/h, spherical Earth at 10,120 s", "10,250"] == pytest.approx(
         3960 * 5280 * math.radians(0.01) / 3600 * 10_120, rel=1e-12)
+    assert by_key["hover, k = 1e-4, altitude error after t = T", "724"] == pytest.approx(715.4085, abs=1e-3)
+    # zeros at omega t = 4 pi: rounding noise is shown as 0
+    assert [r.computed for r in rows if r.printed == "0"] == [0.0, 0.0, 0.0]
+
+
+def test_reproduction_carries_the_source_constants_and_curves():
+    reproduction = reproduce()
+    assert reproduction.system == "errors" and "Bollay" in reproduction.source and "1966" in reproduction.source
+    assert reproduction.details["schuler_period_s"] == pytest.approx(5060.0, rel=1e-12)
+    assert reproduction.details["effective_gravity_m_s2"] / FOOT == pytest.approx(32.24, abs=0.005)
+    assert reproduction.data.t_s.size == 1013 and reproduction.data.t_s[-1] == FLIGHT_TIME
+    data = reproduction.to_dict()
+    assert "data" not in data and data["units"] == {"computed": "the row's unit"}  # the curves stay internal
 
 
 def test_hover_error_after_one_schuler_period():
-    # source 002, Problem 4: k = 1e-4, t = T, R = 3960 mi: 715.4 mi with z(0) = z'(0) = 0 (printed: 724)
+    # Bollay (1966), Problem 4: k = 1e-4, t = T, R = 3960 mi: 715.4 mi with z(0) = z'(0) = 0 (printed: 724)
     z = hover_altitude_error(BOLLAY.schuler_period, -1e-4 * G_BOLLAY, R_BOLLAY, G_BOLLAY)
     assert -z / STATUTE_MILE == pytest.approx(715.4085, abs=1e-3)
     sinh = printed_hover_expression(BOLLAY.schuler_period, 1e-4, R_BOLLAY, G_BOLLAY) / STATUTE_MILE
@@ -222,10 +258,10 @@ def test_aided_loop_settles_to_its_closed_form_steady_state(order):
 
 
 def test_damping_stabilises_the_divergent_vertical_channel():
-    result = api.vertical(-1e-4 * STANDARD_GRAVITY, 5060.0, step=50.6, order=3)
+    result = vertical(**VERTICAL_PARAMETERS.case(accel_bias_up=-1e-4 * STANDARD_GRAVITY, output_step=50.6, order=3))
     assert np.max(result.poles_real_per_s) < 0
-    assert abs(result.unaided_m[-1]) > 1e6  # pure inertial: ~1,100 km after one period
-    assert abs(result.aided_m[-1]) < 1e-6  # third order estimates the bias away
+    assert abs(result.final_unaided_m) > 1e6  # pure inertial: ~1,100 km after one period
+    assert abs(result.final_aided_m) < 1e-6  # third order estimates the bias away
     np.testing.assert_allclose(result.unaided_m, result.closed_form_m, rtol=1e-9, atol=1e-9)
 
 
@@ -240,13 +276,13 @@ def test_unstable_gains_are_rejected(gains, name):
     assert error.value.name == name
 
 
-# --- effective Schuler period (source 002 footnote) -----------------------------------------------
+# --- effective Schuler period (Bollay (1966) footnote) -----------------------------------------------
 
 def test_thrust_of_nine_g_divides_the_period_by_three():
     T0 = effective_schuler_period(MEAN_RADIUS, STANDARD_GRAVITY)
     T9 = effective_schuler_period(MEAN_RADIUS, thrust_gravity(9.0, STANDARD_GRAVITY))
     assert T9 == pytest.approx(T0 / 3, rel=1e-14)
-    assert T9 / 60 == pytest.approx(28, abs=0.5)  # source 002 footnote: 84/3 = 28 minutes
+    assert T9 / 60 == pytest.approx(28, abs=0.5)  # Bollay (1966) footnote: 84/3 = 28 minutes
 
 
 def test_period_grows_without_bound_towards_orbital_speed():
@@ -259,56 +295,13 @@ def test_period_grows_without_bound_towards_orbital_speed():
     assert np.isinf(effective_schuler_period(MEAN_RADIUS, flight_gravity(STANDARD_GRAVITY, Vc * 1.01, MEAN_RADIUS)))
 
 
-# --- api: run, sweep, report ------------------------------------------------------------------------
-
-def test_run_bollay_velocity_case_and_simulation_agreement():
-    result = api.run(source="velocity", magnitude=FOOT, duration=FLIGHT_TIME, step=10.0, earth="bollay")
-    assert result.schuler_period_s == pytest.approx(5060.0, rel=1e-12)
-    assert result.max_spherical_m / FOOT == pytest.approx(805.32, abs=0.01)
-    assert result.max_simulation_difference_m < 1e-10 * result.max_spherical_m  # exact ZOH: rounding only
-    assert result.t_s[-1] == FLIGHT_TIME and result.t_s.size == 1013
-
-
-def test_run_takes_text_magnitudes_in_the_source_unit():
-    result = api.run(source="drift", magnitude="0.01", duration=3600.0)
-    assert result.magnitude_si == pytest.approx(math.radians(0.01) / 3600, rel=1e-12)
-    with pytest.raises(InvalidParameter):
-        api.run(source="drift", magnitude="1 ft/s")
-
-
-def test_sweep_matches_run_case_by_case():
-    values = {
-        "source": np.array(["tilt", "velocity", "accelerometer", "drift", "azimuth", "drift"]),
-        "magnitude": np.array([MAGNITUDES[s] for s in SOURCES] + [2 * MAGNITUDES["drift"]]),
-        "duration": np.array([5000.0, 7000.0, 9000.0, 3600.0, 10_120.0, 20_000.0]),
-        "speed": np.full(6, SPEED),
-        "earth": np.array(["bollay", "default", "drozdovich", "bollay", "bollay", "default"]),
-        "radius": np.array([np.nan] * 5 + [6.4e6]),
-        "gravity": np.full(6, np.nan),
-    }
-    out = api.sweep(values)
-    for k in range(6):
-        single = api.run(source=values["source"][k], magnitude=values["magnitude"][k],
-                         duration=values["duration"][k], step=values["duration"][k] / 50, speed=SPEED, earth=values["earth"][k],
-                         radius=None if np.isnan(values["radius"][k]) else values["radius"][k])
-        assert out["final_spherical_m"][k] == pytest.approx(single.final_spherical_m, rel=1e-12)
-        assert out["final_flat_m"][k] == pytest.approx(single.final_flat_m, rel=1e-12)
-        assert out["max_spherical_m"][k] == pytest.approx(single.max_spherical_m, rel=1e-12)
-        assert out["schuler_period_s"][k] == pytest.approx(single.schuler_period_s, rel=1e-12)
-        assert out["max_spherical_m"][k] >= np.max(np.abs(single.spherical_m)) * (1 - 1e-12)
-
-
-def test_system_parameters_are_the_run_keywords():
-    import inspect
-
-    assert [p.name for p in api.SYSTEM.parameters] == list(inspect.signature(api.run).parameters)
-
-
 @pytest.mark.slow
 def test_report_writes_its_figures_and_table(tmp_path):
-    section = api.report(tmp_path)
+    section = report(tmp_path)
     assert section.system == "errors"
-    assert len(section.rows) == 14 and sum(not row.agrees for row in section.rows) == 4
+    assert len(section.rows) == 22 and sum(row.verdict == "erratum" for row in section.rows) == 4
     for figure in section.figures:
         assert (tmp_path / figure.path).stat().st_size > 10_000
+        assert (tmp_path / figure.path).with_suffix(".svg").exists()
     assert all(figure.path.startswith("errors_") for figure in section.figures)
+    assert all(command.startswith("schuler ") and "--step" not in command for command in section.commands)

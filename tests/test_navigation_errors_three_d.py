@@ -1,4 +1,4 @@
-"""The 3-D psi-angle INS error model on a rotating Earth: modes and single-channel limit."""
+"""The 3-D psi-angle INS error model on a rotating Earth: modes, single-channel limit, the three-d action."""
 
 from __future__ import annotations
 
@@ -11,7 +11,12 @@ from schuler.core.earth import BOLLAY, EARTH_RATE, MEAN_RADIUS, STANDARD_GRAVITY
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
 from schuler.navigation_errors.single_channel import flat_error, spherical_error
-from schuler.navigation_errors.three_d import foucault_velocity_response, psi_angle_model, stationary_modes
+from schuler.navigation_errors.three_d import (
+    foucault_velocity_response,
+    psi_angle_model,
+    stationary_modes,
+)
+from schuler.navigation_errors.three_d_run import THREE_D_PARAMETERS, three_d
 
 
 def _sorted_by_frequency(values):
@@ -118,4 +123,66 @@ def test_three_d_bad_input(kwargs, name):
     arguments = {"latitude": 0.5, "radius": MEAN_RADIUS, "gravity": STANDARD_GRAVITY, "rate": EARTH_RATE} | kwargs
     with pytest.raises(InvalidParameter) as error:
         psi_angle_model(**arguments)
+    assert error.value.name == name
+
+
+# --- the three-d action -------------------------------------------------------------------------------
+
+def _three_d(**values):
+    return three_d(**THREE_D_PARAMETERS.case(**values))
+
+
+def test_action_sign_convention_a_positive_east_drift_makes_a_positive_north_error():
+    # drift = -(gyro bias) resolved east: the platform turns about east, Bollay's Delta_theta_y > 0 -> Delta_S_x > 0
+    epsilon = math.radians(0.01) / 3600
+    result = _three_d(drift_east=epsilon, earth_rate=0.0, earth="bollay", duration=10_120.0, output_step=10.0)
+    closed = spherical_error("drift", epsilon, result.t_s, BOLLAY.radius, BOLLAY.effective_gravity)
+    np.testing.assert_allclose(result.histories["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
+    assert result.final_position_error_north_m / 0.3048 == pytest.approx(10_258.5, abs=0.05)  # Bollay: 10,250 ft
+    np.testing.assert_allclose(result.histories["position_error_east"], 0.0, atol=1e-12)
+
+
+def test_action_accelerometer_bias_north_gives_the_single_channel_error():
+    bias = 1e-4 * STANDARD_GRAVITY
+    result = _three_d(accel_bias_north=bias, earth_rate=0.0, duration=8000.0, output_step=20.0)
+    closed = spherical_error("accelerometer", bias, result.t_s, MEAN_RADIUS, STANDARD_GRAVITY)
+    np.testing.assert_allclose(result.histories["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
+
+
+def test_action_foucault_rotation_and_modes_on_the_rotating_earth():
+    L = math.radians(45.0)
+    result = _three_d(latitude=L, initial_velocity_error_north=1.0, duration=86_400.0, output_step=180.0)
+    north, east = foucault_velocity_response(result.t_s, 1.0, L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE)
+    amplitude = 1.0 / math.sqrt(STANDARD_GRAVITY / MEAN_RADIUS)
+    np.testing.assert_allclose(result.histories["position_error_north"], north, atol=1e-7 * amplitude)
+    np.testing.assert_allclose(result.histories["position_error_east"], east, atol=1e-7 * amplitude)
+    assert result.foucault_rate_rad_s == pytest.approx(EARTH_RATE * math.sin(L), rel=1e-15)
+    eigenvalues = result.eigenvalues_real_per_s + 1j * result.eigenvalues_imag_rad_s
+    np.testing.assert_allclose(_sorted_by_frequency(eigenvalues),
+                               _sorted_by_frequency(stationary_modes(L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE)),
+                               atol=1e-6 * EARTH_RATE)
+    assert result.to_dict()["final_attitude_error_down_rad"] == result.final_attitude_error_down_rad
+
+
+def test_action_initial_attitude_error_is_a_tilt():
+    # psi_E(0) acts as Bollay's level misalignment on a non-rotating Earth: R psi (1 - cos omega t)
+    psi = math.radians(0.01)
+    result = _three_d(initial_attitude_error_east=psi, earth_rate=0.0, duration=6000.0, output_step=30.0)
+    closed = spherical_error("tilt", psi, result.t_s, MEAN_RADIUS, STANDARD_GRAVITY)
+    np.testing.assert_allclose(result.histories["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
+
+
+def test_action_warns_when_the_latitude_changes_much():
+    with pytest.warns(UserWarning, match="moves .* deg in latitude"):
+        _three_d(velocity_north=250.0, duration=3600.0)  # 900 km: 8 deg of latitude
+
+
+@pytest.mark.parametrize("values, name", [({"accel_bias_down": 1e-3}, "accel_bias_down"),
+                                          ({"latitude": math.pi / 2}, "latitude"),
+                                          ({"output_step": 1e6}, "output_step"),
+                                          ({"drift_est": 1e-8}, "drift_est"),
+                                          ({"vertical_channel": True, "duration": 2e5}, "duration")])
+def test_action_bad_input(values, name):
+    with pytest.raises(InvalidParameter) as error:
+        _three_d(**values)
     assert error.value.name == name

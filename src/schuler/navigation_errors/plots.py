@@ -155,3 +155,68 @@ def plot_foucault(time, north, east, unit: str, title: str):
     axis.grid(True, alpha=0.3)
     fig.tight_layout()
     return fig
+
+
+def plot_three_d(time, histories: dict, unit: str, title: str):
+    """3-D model: horizontal position errors (left) and attitude errors psi (right) against time.
+
+    Parameters
+    ----------
+    time : ndarray
+        t, s (shown in hours).
+    histories : dict of str -> ndarray
+        State histories of the psi-angle model (``position_error_north`` ... in m,
+        ``psi_north`` ... in rad).
+    unit : str
+        Display unit of the position errors.
+    title : str
+    """
+    fig, (position, attitude) = _figure(1, 2, figsize=(11, 4.2))
+    hours = np.asarray(time) / 3600.0
+    for index, axis_name in enumerate(("north", "east", "down")):
+        key = f"position_error_{axis_name}"
+        if key in histories:
+            position.plot(hours, to_unit(histories[key], unit), color=f"C{index}", lw=1.4, label=axis_name)
+        attitude.plot(hours, to_unit(histories[f"psi_{axis_name}"], "arcsec"), color=f"C{index}", lw=1.4,
+                      label=f"psi {axis_name}")
+    position.set_ylabel(f"position error [{unit}]")
+    attitude.set_ylabel("attitude error [arcsec]")
+    for axis in (position, attitude):
+        axis.set_xlabel("time [h]")
+        axis.grid(True, alpha=0.3)
+        axis.legend(loc="upper left")
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_period(speeds, periods, speed: float, orbital_speed: float, title: str):
+    """Effective Schuler period against level-flight speed, up to the orbital speed.
+
+    Parameters
+    ----------
+    speeds : ndarray
+        V, m/s.
+    periods : ndarray
+        T(V), s.
+    speed : float
+        The case's speed, m/s (marked).
+    orbital_speed : float
+        sqrt(g r), m/s (dashed line).
+    title : str
+    """
+    fig, axis = _figure(figsize=(7, 4.2))
+    axis.plot(np.asarray(speeds) / 1000.0, np.asarray(periods) / 60.0, color="C0", lw=1.6,
+              label="T = 2 pi sqrt(R / (g - V^2 / r))")
+    axis.axvline(orbital_speed / 1000.0, color="C3", ls="--", lw=1.2, label="orbital speed sqrt(g r)")
+    if speed < orbital_speed:
+        marked = np.interp(speed, speeds, periods) / 60.0
+        axis.plot([speed / 1000.0], [marked], "o", color="C2", label=f"V = {speed:,.0f} m/s")
+    axis.set_yscale("log")
+    axis.set_xlabel("speed [km/s]")
+    axis.set_ylabel("period [min] (log scale)")
+    axis.set_title(title)
+    axis.grid(True, which="both", alpha=0.3)
+    axis.legend(loc="upper left")
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,320 @@
+"""``errors`` on the contract: parameters, evaluate vs run_case, fidelities, Monte Carlo, memory, actions, files."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from schuler import get_system
+from schuler.contract import Cases, monte_carlo
+from schuler.core.earth import BOLLAY, FOOT, MEAN_RADIUS, STANDARD_GRAVITY, STATUTE_MILE
+from schuler.core.random import RandomStreams
+from schuler.exceptions import InvalidParameter
+from schuler.memory import MemoryBudgetExceeded
+from schuler.navigation_errors.actions import (
+    PERIOD_PARAMETERS,
+    VERTICAL_PARAMETERS,
+    period,
+    vertical,
+)
+from schuler.navigation_errors.api import SYSTEM
+from schuler.navigation_errors.evaluation import OUTPUTS, PARAMETERS, evaluate, run_case
+from schuler.navigation_errors.files import write_files
+from schuler.navigation_errors.inputs import FLIGHT_TIME, grid_points, time_grid
+from schuler.navigation_errors.reproduction import plot, reproduce
+from schuler.navigation_errors.single_channel import SOURCES
+
+DEG_PER_H = math.radians(1) / 3600
+
+
+# --- parameters -------------------------------------------------------------------------------------
+
+def test_misspelt_magnitude_is_refused_with_a_suggestion():
+    with pytest.raises(InvalidParameter, match="did you mean 'magnitude'") as error:
+        get_system("errors").run(magnitud=0.1)
+    assert error.value.name == "magnitud"
+
+
+def test_renamed_step_is_refused_listing_output_step():
+    # "step" is too far from "output_step" for a suggestion (difflib ratio 0.53): the allowed names show it
+    with pytest.raises(InvalidParameter, match="unknown parameter of errors; allowed: .*output_step"):
+        SYSTEM.run(step=10.0)
+
+
+def test_magnitude_takes_si_numbers_and_text_in_the_source_unit():
+    assert SYSTEM.case(source="drift", magnitude=1e-7)["magnitude"] == 1e-7
+    assert SYSTEM.case(source="drift", magnitude="0.01")["magnitude"] == pytest.approx(0.01 * DEG_PER_H, rel=1e-12)
+    assert SYSTEM.case(source="tilt", magnitude="36 arcsec")["magnitude"] == pytest.approx(math.radians(0.01))
+    assert SYSTEM.case(source="velocity", magnitude="1")["magnitude"] == pytest.approx(FOOT)  # ft/s
+    # as written in a scenario or on the command line: converted with the case's source
+    parsed = PARAMETERS.parse({"source": "accelerometer", "magnitude": 1e-4})
+    assert parsed["magnitude"] == pytest.approx(1e-4 * STANDARD_GRAVITY, rel=1e-12)
+    assert SYSTEM.case()["magnitude"] is None  # not given: each source's Problem 3 value
+
+
+@pytest.mark.parametrize("kwargs, reason", [
+    ({"magnitude": "1 ft/s", "source": "tilt"}, "is not an angle"),
+    ({"magnitude": -1e-8}, "must be finite and >= 0"),
+    ({"magnitude": "-0.01"}, "must be finite and >= 0"),
+    ({"magnitude": math.nan}, "must be finite and >= 0"),
+    ({"magnitude": "lots"}, "cannot read 'lots' as a magnitude"),
+    ({"magnitude": True}, "is not a number"),
+    ({"source": "gyro"}, "is not one of"),
+    ({"duration": 0.0}, "is outside"),
+    ({"speed": -1.0}, "is outside"),
+    ({"magnitude": "100", "source": "tilt"}, "more than 10 deg, the largest tilt error"),
+    ({"magnitude": 1.0, "source": "drift"}, "more than 3600 deg/h"),
+    ({"radius": 1.0}, "is outside"),
+])
+def test_bad_values_are_refused_naming_the_parameter(kwargs, reason):
+    with pytest.raises(InvalidParameter, match=reason) as error:
+        SYSTEM.run(**kwargs)
+    assert error.value.name == next(iter(kwargs))
+
+
+def test_speed_default_is_half_a_statute_mile_per_second():
+    assert SYSTEM.case()["speed"] == pytest.approx(0.5 * STATUTE_MILE, rel=1e-12)
+    assert PARAMETERS.parse({"speed": "800"})["speed"] == 800.0  # bare numbers: m/s
+    assert PARAMETERS.parse({"speed": "0.5 mi/s"})["speed"] == pytest.approx(804.672, rel=1e-12)
+
+
+def test_output_step_longer_than_the_duration_is_refused():
+    with pytest.raises(InvalidParameter, match="longer than the duration") as error:
+        SYSTEM.run(duration=100.0, output_step=200.0)
+    assert error.value.name == "output_step"
+
+
+def test_time_grid_ends_on_the_duration():
+    assert time_grid(100.0, 30.0).tolist() == [0.0, 30.0, 60.0, 90.0, 100.0]
+    assert time_grid(0.3, 0.1)[-1] == 0.3 and time_grid(0.3, 0.1).size == 4  # 0.3 / 0.1 = 2.9999999999999996
+    assert grid_points(np.array([10.0, 10.5]), 1.0).tolist() == [11, 12]
+
+
+# --- evaluate, run_case, fidelities ------------------------------------------------------------------
+
+CASES = [
+    {"source": "tilt", "duration": 5000.0, "earth": "bollay"},
+    {"source": "velocity", "magnitude": 0.5, "duration": 7000.0, "output_step": 35.0},
+    {"source": "accelerometer", "magnitude": 2e-3, "duration": 9000.0, "earth": "drozdovich"},
+    {"source": "drift", "duration": 3600.0, "earth": "bollay", "radius": 6.4e6},
+    {"source": "azimuth", "duration": FLIGHT_TIME, "speed": 2000.0, "gravity": 9.81},
+    {"source": "drift", "magnitude": 2 * 0.01 * DEG_PER_H, "duration": 20_000.0, "output_step": 7.0},
+]
+
+
+@pytest.mark.parametrize("fidelity", ["simulated", "closed"])
+def test_evaluate_equals_run_case_case_by_case(fidelity):
+    cases = [SYSTEM.case(**values) for values in CASES]
+    batch = Cases({name: np.array([case[name] for case in cases], dtype=object
+                                  if any(isinstance(case[name], str) or case[name] is None for case in cases)
+                                  else float) for name in PARAMETERS.names}, fidelity=fidelity)
+    out = evaluate(batch)
+    for k, case in enumerate(cases):
+        single = run_case(case, fidelity).to_dict()
+        for output in OUTPUTS:
+            if math.isnan(out[output.name][k]):
+                assert single[output.name] is None and fidelity == "closed"
+            else:
+                assert single[output.name] == pytest.approx(out[output.name][k], rel=1e-12, abs=1e-300)
+
+
+@pytest.mark.parametrize("source", SOURCES)
+def test_simulated_and_closed_fidelities_agree_to_rounding(source):
+    simulated = SYSTEM.run(source=source, earth="bollay", duration=7777.0)
+    closed = SYSTEM.run(source=source, earth="bollay", duration=7777.0, fidelity="closed")
+    # exact matrix exponential: rounding only, relative to the largest error of the run
+    assert simulated.final_spherical_m == pytest.approx(closed.final_spherical_m, abs=1e-9 * closed.max_spherical_m)
+    assert simulated.simulation_minus_closed_m <= 1e-9 * closed.max_spherical_m
+    assert math.isnan(closed.simulation_minus_closed_m) and closed.simulated_m is None
+    assert closed.to_dict()["simulation_minus_closed_m"] is None
+    assert simulated.fidelity == "simulated" and closed.fidelity == "closed"
+
+
+def test_unknown_fidelity_is_refused():
+    with pytest.raises(InvalidParameter, match="choose from simulated, closed"):
+        SYSTEM.run(fidelity="rough")
+
+
+def test_run_bollay_velocity_case_and_its_histories():
+    result = SYSTEM.run(source="velocity", magnitude=FOOT, duration=FLIGHT_TIME, output_step=10.0, earth="bollay")
+    assert result.schuler_period_s == pytest.approx(5060.0, rel=1e-12)
+    assert result.max_spherical_m / FOOT == pytest.approx(805.32, abs=0.01)  # Bollay, Problem 3: 805 ft
+    assert result.t_s[-1] == FLIGHT_TIME and result.t_s.size == 1013
+    np.testing.assert_allclose(result.simulated_m, result.spherical_m, rtol=0, atol=1e-9 * result.max_spherical_m)
+    assert result.final_flat_m / FOOT == pytest.approx(10_120, rel=1e-12)  # Delta_V t
+    assert result.to_dict()["units"] == {"magnitude": "m/s"}
+    assert "t_s" not in result.to_dict()  # histories go to the CSV of --out, not to JSON
+
+
+def test_largest_spherical_error_bounds_the_sampled_history():
+    for source in SOURCES:
+        result = SYSTEM.run(source=source, duration=30_000.0, output_step=15.0)
+        assert np.max(np.abs(result.spherical_m)) <= result.max_spherical_m * (1 + 1e-12)
+        assert np.max(np.abs(result.spherical_m)) == pytest.approx(result.max_spherical_m, rel=1e-4)
+
+
+def test_a_sweep_over_sources_takes_each_source_default():
+    out = SYSTEM.evaluate_values({"source": np.array(list(SOURCES), dtype=object),
+                                  "earth": np.array(["bollay"] * 5, dtype=object)})
+    # Bollay, Problem 3 at 10,120 s (the loop's g for the accelerometer: 1e-4 x 9.80665 here, 4,170 ft printed)
+    assert out["final_flat_m"][1] / FOOT == pytest.approx(10_120, rel=1e-12)
+    assert out["max_spherical_m"][1] / FOOT == pytest.approx(805.3, abs=0.05)
+    assert out["final_spherical_m"][3] / FOOT == pytest.approx(10_258.5, abs=0.1)
+
+
+def test_one_si_magnitude_swept_over_sources_of_different_units_is_refused():
+    # a scenario's "0.01 deg/h" (rad/s) swept over source=tilt,drift would be 4.8e-8 rad of tilt
+    with pytest.raises(InvalidParameter, match="one value .* for sources of different units") as error:
+        SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object), "magnitude": 0.01 * DEG_PER_H})
+    assert error.value.name == "magnitude"
+    # written as text (an object or a string array, as a sweep axis gives), each case reads it in its source's unit
+    same = SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object)})  # Problem 3 values
+    for text in (np.array(["0.01", "0.01"], dtype=object), np.array(["0.01", "0.01"])):
+        out = SYSTEM.evaluate_values({"source": np.array(["tilt", "drift"], dtype=object), "magnitude": text})
+        np.testing.assert_allclose(out["max_spherical_m"], same["max_spherical_m"], rtol=1e-12)
+    # the same source: one number is fine
+    assert np.isfinite(SYSTEM.evaluate_values({"source": np.array(["tilt", "azimuth"], dtype=object),
+                                               "magnitude": 1e-4})["final_flat_m"]).all()
+
+
+def test_evaluate_is_independent_of_how_the_batch_is_cut():
+    rng = np.random.default_rng(5)
+    n = 40
+    values = {name: np.asarray(column) for name, column in {
+        "source": rng.choice(np.array(SOURCES, dtype=object), n),
+        "magnitude": rng.uniform(0.0, 1e-3, n),
+        "duration": rng.choice([3000.0, 5060.0, 12_345.0], n),
+        "speed": rng.choice([100.0, 800.0], n),
+    }.items()}
+    whole = SYSTEM.evaluate_values(values)
+    parts = [SYSTEM.evaluate_values({k: v[lo:lo + 7] for k, v in values.items()}) for lo in range(0, n, 7)]
+    for name in whole:
+        np.testing.assert_allclose(np.concatenate([p[name] for p in parts]), whole[name], rtol=1e-12, atol=0)
+
+
+def test_monte_carlo_over_a_drawn_duration_is_independent_of_chunking():
+    case = SYSTEM.case(source="drift", earth="bollay")
+    streams = RandomStreams(3)
+
+    def draw(members):
+        return {"duration": FLIGHT_TIME + 100.0 * streams.normal("duration", members)}
+
+    summaries = [monte_carlo(SYSTEM.evaluate, SYSTEM.outputs, case, 23, streams, chunk=chunk, draw=draw)
+                 for chunk in (4, 23)]
+    for name, stats in summaries[0].statistics.items():
+        for key, value in stats.items():
+            other = summaries[1].statistics[name][key]
+            # a streamed std (and rms) rounds at about 1e-16 of the mean: compare it on the mean's scale
+            scale = 1e-12 * abs(stats["mean"]) if key in ("std", "rms") else 1e-300
+            assert value == pytest.approx(other, rel=1e-12, abs=scale), (name, key)
+    # 23 members: the mean drift error is near the nominal R epsilon t (sigma 100 s of 10,120 s)
+    mean = summaries[0].statistics["final_spherical_m"]["mean"] / FOOT
+    assert mean == pytest.approx(10_258.5, rel=0.01)
+
+
+def test_nominal_monte_carlo_of_a_system_without_random_terms_is_constant():
+    result = SYSTEM.run(monte_carlo=5, seed=1, source="tilt")
+    stats = result.monte_carlo.statistics["max_spherical_m"]
+    assert stats["std"] == 0.0 and stats["mean"] == pytest.approx(result.max_spherical_m, rel=1e-15)
+
+
+def test_memory_is_refused_before_allocating(monkeypatch):
+    monkeypatch.setenv("SCHULER_MEMORY_BUDGET", "64 MiB")
+    with pytest.raises(MemoryBudgetExceeded, match="--duration or --output-step"):
+        SYSTEM.run(duration=1e9, output_step=1e-3)
+    # the closed fidelity evaluates without a grid: a sweep of such cases stays small
+    out = SYSTEM.evaluate_values({"duration": 1e9, "output_step": 1e-3}, fidelity="closed")
+    assert np.isfinite(out["final_spherical_m"]).all()
+    with pytest.raises(MemoryBudgetExceeded):
+        vertical(**VERTICAL_PARAMETERS.case(duration=1e5, output_step=1e-3))
+
+
+# --- actions -----------------------------------------------------------------------------------------
+
+def test_vertical_gains_from_tau_and_explicit_ones():
+    result = vertical(**VERTICAL_PARAMETERS.case(order=2, time_constant=50.0))
+    assert result.k1_per_s == pytest.approx(0.04)  # 2 / tau
+    assert result.final_aided_m == pytest.approx(result.aided_steady_state_m, rel=1e-6)
+    explicit = vertical(**VERTICAL_PARAMETERS.case(order=2, k1=0.05))
+    # k2 from the default tau = 100 s: 1 / tau^2 + 2 g / R
+    assert explicit.k1_per_s == 0.05
+    assert explicit.k2_per_s2 == pytest.approx(1 / 100.0**2 + 2 * STANDARD_GRAVITY / MEAN_RADIUS, rel=1e-12)
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    ({"time_constant": 50.0, "k1": 0.1}, "time_constant"),
+    ({"order": 2, "k3": 1e-6}, "k3"),
+    ({"k2": 1e-7}, "k2"),
+    ({"order": 4}, "order"),
+    ({"accel_bias_up": 1.0}, "accel_bias_up"),
+    ({"duration": 1e5, "radius": 1e3, "gravity": 1e3}, "duration"),
+])
+def test_vertical_refuses_conflicting_or_unstable_options(kwargs, name):
+    # a divergent run is refused before its numbers overflow: exp(sqrt(2) omega_s t) <= exp(200)
+    with pytest.raises(InvalidParameter) as error:
+        vertical(**VERTICAL_PARAMETERS.case(**kwargs))
+    assert error.value.name == name
+
+
+def test_problem4_hover_error_through_the_action():
+    result = vertical(**VERTICAL_PARAMETERS.case(earth="bollay", accel_bias_up=-1e-4 * BOLLAY.effective_gravity,
+                                                 duration=BOLLAY.schuler_period))
+    # Bollay, Problem 4: 724 mi printed; 715.4 mi with z(0) = z'(0) = 0 (erratum)
+    assert -result.final_closed_form_m / STATUTE_MILE == pytest.approx(715.4085, abs=1e-3)
+    assert result.final_unaided_m == pytest.approx(result.final_closed_form_m, rel=1e-9)
+
+
+def test_period_warns_at_orbital_speed():
+    with pytest.warns(UserWarning, match="orbital speed"):
+        result = period(**PERIOD_PARAMETERS.case(speed=8000.0))
+    assert math.isinf(result.flight_period_s) and result.to_dict()["flight_period_s"] is None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        nine = period(**PERIOD_PARAMETERS.case(thrust_factor=9.0))
+    assert nine.thrust_period_s / 60 == pytest.approx(28.1, abs=0.05)  # Bollay's footnote: 84/3 = 28 min
+
+
+def test_plot_action_summarises_problem3():
+    result = plot(points=101)
+    assert result.max_spherical_m["tilt"] / FOOT == pytest.approx(7298.6, abs=0.1)
+    assert result.largest_simulation_minus_closed_m < 1e-6
+    assert result.curves.t_s.size == 101
+
+
+# --- files ---------------------------------------------------------------------------------------------
+
+@pytest.mark.slow
+def test_write_files_for_every_result_type(tmp_path, monkeypatch):
+    from schuler.navigation_errors import files
+
+    results = {
+        "run": SYSTEM.run(source="azimuth", duration=3600.0),
+        "vertical": vertical(**VERTICAL_PARAMETERS.case(duration=1000.0)),
+        "period": period(**PERIOD_PARAMETERS.case(speed=3000.0)),
+    }
+    expected = {
+        "run": {"errors_run_azimuth.png", "errors_run_azimuth.svg", "errors_run_azimuth.csv"},
+        "vertical": {"errors_vertical_run.png", "errors_vertical_run.svg", "errors_vertical_run.csv"},
+        "period": {"errors_period.png", "errors_period.svg", "errors_period.csv"},
+    }
+    for name, result in results.items():
+        folder = tmp_path / name
+        paths = write_files(result, folder)
+        assert {p.name for p in paths} == expected[name] == {p.name for p in folder.iterdir()}
+    import pandas as pd
+
+    run = pd.read_csv(tmp_path / "run" / "errors_run_azimuth.csv")
+    assert list(run.columns) == ["t_s", "flat_m", "spherical_m", "simulated_m"]
+    assert run["spherical_m"].iloc[-1] == pytest.approx(results["run"].final_spherical_m, rel=1e-12)
+    # reproduce and plot write the same Problem 3 figures (drawn in the CLI test of plot)
+    drawn = []
+    monkeypatch.setattr(files, "write_problem3", lambda curves, out_dir, formats: drawn.append(curves) or [])
+    reproduction, figures = reproduce(), plot(points=11)
+    write_files(reproduction, tmp_path)
+    write_files(figures, tmp_path)
+    assert drawn == [reproduction.data, figures.curves]
+    with pytest.raises(TypeError, match="errors writes no files"):
+        write_files(object(), tmp_path)
