@@ -142,7 +142,8 @@ class Cases:
         """A numeric parameter as a float array (NaN where not set)."""
         array = self._values[name]
         if array.dtype == object:
-            return np.array([np.nan if v is None else float(v) for v in array])
+            unset = np.equal(array, None)
+            return np.where(unset, np.nan, array).astype(float) if unset.any() else array.astype(float)
         return array.astype(float)
 
     def value_or(self, name: str, fallback) -> np.ndarray:
@@ -154,7 +155,7 @@ class Cases:
         """Which cases set the parameter (bool array)."""
         array = self._values[name]
         if array.dtype == object:
-            return np.array([v is not None for v in array], dtype=bool)
+            return ~np.equal(array, None)
         if array.dtype.kind == "f":
             return ~np.isnan(array)
         return np.ones(self.n, dtype=bool)

@@ -248,6 +248,9 @@ class ParameterSet:
         Who the parameters belong to (``"align"``), for messages.
     exclusive : iterable of tuple of str
         Groups of parameters of which at most one may be given.
+    renamed : mapping of str to str
+        Former names -> current names: a former name is refused with a message
+        naming its replacement (scripts written for an older version).
 
     Examples
     --------
@@ -264,9 +267,11 @@ class ParameterSet:
     schuler.exceptions.InvalidParameter: latitude: 114.592 deg is outside [-90, 90] deg
     """
 
-    def __init__(self, parameters: Iterable[Parameter], *, owner: str = "", exclusive: Iterable[tuple[str, ...]] = ()):
+    def __init__(self, parameters: Iterable[Parameter], *, owner: str = "", exclusive: Iterable[tuple[str, ...]] = (),
+                 renamed: Mapping[str, str] | None = None):
         self.parameters = tuple(parameters)
         self.owner = owner
+        self.renamed = dict(renamed or {})
         self._by_name = {p.name: p for p in self.parameters}
         if len(self._by_name) != len(self.parameters):
             raise ValueError(f"{owner}: a parameter is declared twice")
@@ -290,7 +295,9 @@ class ParameterSet:
 
     def __add__(self, other: Iterable[Parameter]) -> ParameterSet:
         extra = other.exclusive if isinstance(other, ParameterSet) else ()
-        return ParameterSet((*self.parameters, *other), owner=self.owner, exclusive=(*self.exclusive, *extra))
+        renamed = {**self.renamed, **(other.renamed if isinstance(other, ParameterSet) else {})}
+        return ParameterSet((*self.parameters, *other), owner=self.owner, exclusive=(*self.exclusive, *extra),
+                            renamed=renamed)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -299,6 +306,8 @@ class ParameterSet:
     def refuse_unknown(self, names: Iterable[str], label=lambda name: name) -> None:
         """Raise :class:`InvalidParameter` for the first name that is not a parameter, suggesting the closest."""
         for name in names:
+            if name in self.renamed and name not in self._by_name:
+                raise InvalidParameter(label(name), f"renamed to {label(self.renamed[name])!r} (see CHANGELOG.md)")
             if name not in self._by_name:
                 hint = difflib.get_close_matches(name, self.names, n=1, cutoff=0.6)
                 suggestion = f"did you mean {label(hint[0])!r}? " if hint else ""
@@ -335,8 +344,8 @@ class ParameterSet:
         """
         label = (lambda name: self._by_name[name].option if name in self._by_name else "--" + name.replace("_", "-")) \
             if labels == "option" else (lambda name: name)
-        self.refuse_unknown(written, label)
         given = {name: raw for name, raw in written.items() if raw is not None}
+        self.refuse_unknown(given, label)
         self._refuse_conflicts(given, label)
         values = self.defaults()
         for name, raw in given.items():

@@ -27,6 +27,9 @@ def parameter_options(parameters):
     """
 
     def decorate(function):
+        # former names stay known to click, so that the parameter set can say what they became
+        for old in reversed(tuple(getattr(parameters, "renamed", {}))):
+            function = click.option("--" + old.replace("_", "-"), old, default=None, hidden=True)(function)
         for spec in reversed(tuple(parameters)):
             if spec.kind == "flag":
                 option = click.option(

@@ -76,7 +76,7 @@ def _run_command(system: System) -> click.Command:
                             help=f"One case: {system.title}. The headline numbers; figures and data with --out.\n\n"
                                  "Bare numbers are in each option's display unit (shown below); values with "
                                  "units are converted. --monte-carlo N adds N random members around the case.")
-    decorated = parameter_options(tuple(system.parameters) + RUN_OPTIONS)(command.callback)
+    decorated = parameter_options(system.parameters + RUN_OPTIONS)(command.callback)
     for param in reversed(getattr(decorated, "__click_params__", [])):
         command.params.append(param)
     if system.fidelities:
@@ -130,7 +130,7 @@ def _action_command(system: System, action: Action) -> click.Command:
 
 def _command(name: str, callback, parameters: ParameterSet, help_text: str) -> click.Command:
     command = click.Command(name, callback=callback, help=help_text, context_settings=_CONTEXT)
-    decorated = parameter_options(tuple(parameters))(lambda **kw: None)
+    decorated = parameter_options(parameters)(lambda **kw: None)
     command.params.extend(reversed(getattr(decorated, "__click_params__", [])))
     command.params.extend(_output_params())
     return command
