@@ -32,7 +32,7 @@ from schuler.ground_gyrocompass.identification import identify
 from schuler.ground_gyrocompass.observations import read_record, write_record
 from schuler.ground_gyrocompass.results import NorthIdentification, ObservationRecord
 from schuler.memory import require
-from schuler.params import Parameter, ParameterSet
+from schuler.params import Case, Parameter, ParameterSet
 
 IDENTIFY_PARAMETERS = ParameterSet((*INSTRUMENT_PARAMETERS, READING_PARAMETER, *FIT_PARAMETERS),
                                    owner="north identify", exclusive=EXCLUSIVE)
@@ -69,7 +69,8 @@ def identify_record(record: Path, **values) -> NorthIdentification:
         require(record.stat().st_size / CSV_BYTES_PER_LINE * HELD_BYTES_PER_LINE, f"reading {record}",
                 "the record's length")
     time, observed = read_record(record)
-    require(fit_bytes(time.size, case["method"]), f"identifying {record}", "the record's length or --method")
+    require(fit_bytes(time.size, case["method"], case["unknowns"]), f"identifying {record}",
+            "the record's length or --method")
     estimate = identify(time, observed, case["unknowns"], decay_rate=case["decay_rate"], hm=case["hm"],
                         inertia=case["inertia"], omega_h=float(omega_h_of(Cases.from_case(case))[0]),
                         reading=case["reading"], method=case["method"])
@@ -90,7 +91,7 @@ def simulate_record(output: Path, **values) -> ObservationRecord:
     """
     case = SIMULATE_PARAMETERS.case(values)
     output = Path(output)
-    cases = Cases.from_case({name: case[name] for name in case if name != "seed"}, members=[0],
+    cases = Cases.from_case(Case({name: case[name] for name in case if name != "seed"}), members=[0],
                             random=RandomStreams(case["seed"]))
     time = record_window(cases, RECORD_BYTES_PER_SAMPLE)
     truth = truth_of(cases)

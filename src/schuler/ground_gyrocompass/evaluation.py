@@ -29,6 +29,7 @@ simulator did. They agree to 1e-9 rad (the tests check it).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -119,10 +120,24 @@ RECORD_BYTES_PER_SAMPLE = 8 * 24
 derivatives (9 columns), the predicted errors' Jacobian (up to 7), the motion, the
 noise, the observed coordinate, the time and slack."""
 
-FIT_BYTES_PER_SAMPLE = {"lsq": 8 * 60, "grid": 8 * 21 * 21 * 12}
-"""Bytes per sample one identification holds at its peak: variable projection keeps
-the design, its derivatives, Q and the Bessel intermediates (about 60 columns);
-the grid's first stage evaluates the basis on 21 x 21 (lambda, B) pairs."""
+LSQ_BYTES_PER_SAMPLE = 8 * 60
+"""Bytes per sample variable projection holds at its peak: the design, its derivatives,
+Q and the Bessel intermediates, about 60 columns (measured: 390-450 bytes)."""
+
+GRID_PAIRS = {2: 1, 3: 21, 4: 21 * 21, 5: 21 * 21}
+"""(lambda, B) pairs of the grid estimator's first stage for each number of unknowns."""
+
+
+def fit_bytes_per_sample(method: str, unknowns: int) -> int:
+    """Bytes per sample one identification holds at its peak.
+
+    The grid evaluates the basis on every (lambda, B) pair of a stage at once,
+    16 columns each (measured: 210 bytes for 2 unknowns, 26 kB for 4, 47 kB for 5).
+    """
+    if method == "grid":
+        return 8 * (30 + 16 * GRID_PAIRS[unknowns])
+    return LSQ_BYTES_PER_SAMPLE
+
 
 BATCH_BYTES = 64 * 2**20
 """Records made at once in a batch are limited to this many bytes."""
@@ -133,9 +148,9 @@ def sample_count(duration: float, step: float) -> int:
     return math.floor(duration / step * (1.0 + 1e-12)) + 1
 
 
-def fit_bytes(samples: int, method: str) -> int:
+def fit_bytes(samples: int, method: str, unknowns: int) -> int:
     """Memory one identification of a record of ``samples`` holds at its peak, bytes."""
-    return samples * (RECORD_BYTES_PER_SAMPLE + FIT_BYTES_PER_SAMPLE[method])
+    return samples * (RECORD_BYTES_PER_SAMPLE + fit_bytes_per_sample(method, unknowns))
 
 
 def member_bytes(case: Case) -> int:
@@ -232,8 +247,8 @@ def _evaluate(cases: Cases, strict: bool) -> tuple[dict[str, np.ndarray], list[N
     estimates: list[NorthEstimate | None] = [None] * n
     fidelity = cases.fidelity or FIDELITIES[0]
     for index, group in cases.groups("duration", "output_step", "unknowns", "method", "reading"):
-        method = str(group["method"][0])
-        time = record_window(group, RECORD_BYTES_PER_SAMPLE + FIT_BYTES_PER_SAMPLE[method])
+        per_sample = fit_bytes_per_sample(str(group["method"][0]), int(group["unknowns"][0]))
+        time = record_window(group, RECORD_BYTES_PER_SAMPLE + per_sample)
         batch = max(1, BATCH_BYTES // (time.size * RECORD_BYTES_PER_SAMPLE))
         for start in range(0, len(group), batch):
             part = group.take(np.arange(start, min(start + batch, len(group))))
@@ -261,7 +276,7 @@ def _evaluate_batch(time, cases: Cases, fidelity: str, strict: bool):
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     out.update(north_std_predicted_rad=predicted, omega_h=truth["omega_h"], samples=np.full(n, float(time.size)),
                converged=np.zeros(n))
-    estimates = []
+    estimates: list[NorthEstimate | None] = []
     for i in range(n):
         try:
             estimate = identify(time, observed[i], unknowns, decay_rate=float(truth["decay_rate"][i]),
@@ -313,13 +328,12 @@ def run_case(case: Case, fidelity: str | None = None) -> NorthRun:
     """
     fidelity = fidelity or FIDELITIES[0]
     outputs, estimates = _evaluate(Cases.from_case(case, fidelity=fidelity), strict=True)
-    values = {name: float(array[0]) for name, array in outputs.items()}
+    values: dict[str, Any] = {name: float(array[0]) for name, array in outputs.items()}
     values["north_std_rad"] = None if math.isnan(values["north_std_rad"]) else values["north_std_rad"]
+    values["converged"] = bool(values["converged"])
     return NorthRun(
         fidelity=fidelity, unknowns=case["unknowns"], method=case["method"], reading=case["reading"],
-        readout_noise_rad=case["readout_noise"], true_north_rad=-case["alpha0"],
-        **{name: bool(value) if name == "converged" else value for name, value in values.items()},
-        estimate=estimates[0])
+        readout_noise_rad=case["readout_noise"], true_north_rad=-case["alpha0"], **values, estimate=estimates[0])
 
 
 __all__ = ["FIDELITIES", "OUTPUTS", "PARAMETERS", "evaluate", "fit_bytes", "member_bytes", "omega_h_of",

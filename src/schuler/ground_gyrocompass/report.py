@@ -20,9 +20,9 @@ from schuler.ground_gyrocompass.reproduction import reproduce
 from schuler.ground_gyrocompass.results import error_vs_time_files, write_files
 from schuler.units import from_unit, to_unit
 
-REPORT_MEMBERS = 60
+REPORT_MEMBERS = 50
 """Records per point of the report's Monte Carlo (``north run --monte-carlo N`` scales it up)."""
-REPORT_WINDOWS = np.arange(60.0, 601.0, 90.0)
+REPORT_WINDOWS = np.array([60.0, 150.0, 300.0, 600.0])
 """Observation windows of the report's Monte Carlo, s."""
 REPORT_NOISES = (1.0, 10.0)
 """Read-out noise levels of the report's Monte Carlo, arcsec."""

@@ -311,6 +311,7 @@ def estimate_files(estimate: NorthEstimate, out_dir: Path, noise_rad: float | No
     import pandas as pd
 
 
+    out_dir = Path(out_dir)
     files = plots.plot_fit(estimate, out_dir / "north_fit")
     a0, rate = estimate.alpha0_rad, estimate.alpha0_dot
     box = {"alpha0": (a0 - 9 * STEP_ALPHA0, a0 + 9 * STEP_ALPHA0, STEP_ALPHA0),
