@@ -47,6 +47,7 @@ def test_identify_json_keys_and_values(record_file, run_cli):
     assert numeric_keys_without_unit(data) <= set(data["units"])
 
 
+@pytest.mark.slow
 def test_identify_grid_and_figures(record_file, run_cli, tmp_path):
     out = run_cli("north", "identify", record_file, "--unknowns", "2", "--method", "grid", "--out", tmp_path / "f",
                   "--json")
@@ -107,6 +108,7 @@ def test_run_monte_carlo_agrees_with_prediction(run_cli):
     assert abs(stats["north_error_rad"]["mean"]) < 4 * stats["north_error_rad"]["std"] / math.sqrt(300)
 
 
+@pytest.mark.slow
 def test_run_writes_figures_and_data(run_cli, tmp_path):
     out = run_cli("north", "run", "--readout-noise", "5 arcsec", "--monte-carlo", "20", "--out", tmp_path)
     assert out.code == 0, out.stderr

@@ -164,8 +164,16 @@ def test_memory_is_estimated_before_allocating(monkeypatch, tmp_path):
         identify_record(path)
 
 
+@pytest.mark.parametrize("fidelity", ["closed", "simulated"])
+def test_run_down_too_long_is_refused(fidelity):
+    # z = z0 exp(-lambda t / 2) (eq. (5)) underflows after lambda t ~ 1500: Y0(z) is infinite, refused by name
+    with pytest.raises(InvalidParameter, match="duration: 2000 s: the closed form"):
+        SYSTEM.run(decay_rate=1.0, duration=2000.0, fidelity=fidelity)
+
+
 def test_parameters_renamed_exclusive_and_suggested():
     assert SYSTEM.parameters.exclusive == (("latitude", "omega_h"),)
+    assert SYSTEM.case()["alpha0"] == motion.SOURCE_ALPHA0  # the default, written "3.69*pi/540 rad" as printed
     with pytest.raises(InvalidParameter, match="latitude: cannot be combined with omega_h"):
         SYSTEM.run(latitude=0.5, omega_h=3e-5)
     with pytest.raises(InvalidParameter, match="did you mean 'latitude'"):

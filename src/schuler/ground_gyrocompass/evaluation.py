@@ -24,6 +24,13 @@ so a member's record depends only on (seed, member), never on chunking.
 Fidelities: ``closed`` (default) makes the record from the closed form (9);
 ``simulated`` integrates eqs. (1)-(2) numerically (DOP853), as the source's
 simulator did. They agree to 1e-9 rad (the tests check it).
+
+References
+----------
+Fedorov, V. N.; Kikot, V. V.; Shtefan, N. I., "Determination of meridian position
+by a two-step ground gyrocompass during natural run-down of its rotor", Mechanics
+of Gyroscopic Systems, no. 40, 2020, doi:10.20535/0203-3771402020249107
+(:data:`schuler.references.FEDOROV_2020`).
 """
 
 from __future__ import annotations
@@ -44,9 +51,9 @@ from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
 
 MOTION_PARAMETERS = (
-    Parameter("alpha0", "rad", motion.SOURCE_ALPHA0,
-              "True initial angle alpha0 of the rotor axis from north (source: 3.69 pi/540; small angles).",
-              minimum=-0.5, maximum=0.5),
+    # the source's value as it prints it: 3.69 pi/540 rad (= motion.SOURCE_ALPHA0)
+    Parameter("alpha0", "rad", "3.69*pi/540 rad",
+              "True initial angle alpha0 of the rotor axis from north (small angles).", minimum=-0.5, maximum=0.5),
     Parameter("alpha0_dot", "rad/s", motion.SOURCE_ALPHA0_DOT, "True initial azimuth rate.",
               minimum=-0.01, maximum=0.01),
     Parameter("torque", "N*m", 0.0, "Constant harmful torque M about the suspension axis (simulated)."),
@@ -159,7 +166,18 @@ def member_bytes(case: Case) -> int:
 
 
 def omega_h_of(cases: Cases) -> np.ndarray:
-    """Omega_h of each case: from the latitude, as given, or the source's 3.65e-5 rad/s, rad/s."""
+    """The horizontal Earth rate Omega_h of each case, rad/s.
+
+    Omega cos(latitude) where the latitude is set, ``omega_h`` where that is set,
+    otherwise the source's 3.65e-5 rad/s (Fedorov et al. (2020), before Table 1).
+
+    Raises
+    ------
+    InvalidParameter
+        A case sets both (the options exclude each other).
+    NotObservable
+        A latitude of +-90 deg: no horizontal Earth rate, north is undefined.
+    """
     latitude, omega_h = cases.is_set("latitude"), cases.is_set("omega_h")
     if np.any(latitude & omega_h):
         raise InvalidParameter("latitude", "cannot be combined with omega_h; give one of them")
@@ -170,7 +188,15 @@ def omega_h_of(cases: Cases) -> np.ndarray:
 
 
 def truth_of(cases: Cases) -> dict[str, np.ndarray]:
-    """The true motion's parameters of each case (SI arrays), named as the estimator names them."""
+    """The true motion's parameters of each case, named as the estimator names them.
+
+    Returns
+    -------
+    dict of ndarray (n,)
+        ``alpha0`` (rad), ``alpha0_dot`` (rad/s), ``decay_rate`` lambda (1/s),
+        ``coefficient`` B = H_m Omega_h / J (1/s^2, eq. (3)), ``specific_torque``
+        m = M / J (rad/s^2), ``offset`` (rad), ``omega_h`` (rad/s).
+    """
     omega_h = omega_h_of(cases)
     inertia = cases.float("inertia")
     return {
@@ -199,6 +225,19 @@ def record_window(cases: Cases, bytes_per_sample: int) -> np.ndarray:
 
 def true_motion(time: np.ndarray, truth: dict[str, np.ndarray], fidelity: str) -> np.ndarray:
     """alpha(t_k) of each case, shape (cases, samples), rad: closed form (9) or numerical integration."""
+    # the closed form, which the estimator fits, needs z(t) = z0 exp(-lambda t / 2) > 0 (eq. (5)): after
+    # lambda t of about 1500 it underflows, Y0(z) is infinite, and neither record nor fit can be computed
+    z_end, _ = motion.bessel_argument(time[-1], truth["decay_rate"], truth["coefficient"])
+    with np.errstate(all="ignore"):
+        angle = _motion(time, truth, fidelity) if np.all(z_end > 0.0) else np.full((z_end.size, time.size), np.nan)
+    if not np.all(np.isfinite(angle)):
+        worst = float(np.max(truth["decay_rate"]) * time[-1])
+        raise InvalidParameter("duration", f"{time[-1]:g} s: the closed form (9) is not finite once the rotor has "
+                                           f"run down (lambda t = {worst:.3g}); observe for a shorter time")
+    return angle
+
+
+def _motion(time: np.ndarray, truth: dict[str, np.ndarray], fidelity: str) -> np.ndarray:
     if fidelity == "simulated":
         angle = np.stack([motion.simulate(time, *(truth[k][i] for k in
                                                   ("alpha0", "alpha0_dot", "decay_rate", "coefficient",
@@ -210,15 +249,30 @@ def true_motion(time: np.ndarray, truth: dict[str, np.ndarray], fidelity: str) -
                          derivatives=False).angle
         angle = (truth["alpha0"][:, None] * u[0] + truth["alpha0_dot"][:, None] * u[1]
                  + truth["specific_torque"][:, None] * u[2])
-    if not np.all(np.isfinite(angle)):
-        worst = float(np.max(truth["decay_rate"]) * time[-1])
-        raise InvalidParameter("duration", f"{time[-1]:g} s: the motion is not finite once the rotor has run down "
-                                           f"(lambda t = {worst:.3g}); observe for a shorter time")
     return angle
 
 
 def records(time: np.ndarray, cases: Cases, truth: dict[str, np.ndarray], fidelity: str) -> np.ndarray:
-    """The observed coordinate of each case (cases, samples), rad: read-out noise drawn for members only."""
+    """The observed coordinate of each case: what the read-out gives, rad.
+
+    Parameters
+    ----------
+    time : ndarray (samples,)
+        Sample times since the release, s.
+    cases : Cases
+        The cases (one reading for all); with ``cases.random`` set, member
+        ``cases.members[i]`` draws its read-out noise from the stream
+        ``"readout_noise"``, samples 0 .. samples - 1.
+    truth : dict
+        :func:`truth_of` the cases.
+    fidelity : {"closed", "simulated"}
+
+    Returns
+    -------
+    ndarray (cases, samples)
+        alpha - alpha0 (relative reading, eq. (10)) or alpha + c (absolute), plus
+        the noise, rounded to the quantisation step.
+    """
     angle = true_motion(time, truth, fidelity)
     if cases.random is not None:
         sigma = cases.float("readout_noise")
@@ -232,6 +286,19 @@ def records(time: np.ndarray, cases: Cases, truth: dict[str, np.ndarray], fideli
 def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
 
+    Parameters
+    ----------
+    cases : Cases
+        Every parameter of :data:`PARAMETERS` as arrays; ``cases.random`` None
+        for the nominal (noise-free) records, else the streams members draw from.
+
+    Returns
+    -------
+    dict of ndarray
+        One array per :class:`~schuler.contract.Output` of :data:`OUTPUTS`.
+
+    Notes
+    -----
     Cases are grouped by what fixes the shape of the computation (duration, output
     step, unknowns, method, reading); each group's records are made in batches and
     identified one by one by the production estimator. A record the estimator
