@@ -28,9 +28,11 @@ REPORT_NOISES = (1.0, 10.0)
 """Read-out noise levels of the report's Monte Carlo, arcsec."""
 
 
-def accuracy_against_window(windows, noises_arcsec, members: int, unknowns: int = 4, seed: int = 0):
+def accuracy_against_window(windows, noises_arcsec, members: int, unknowns: int = 4):
     """Monte Carlo and predicted standard error of north (arcsec) per window and noise level.
 
+    Noise level ``j`` uses seed ``j``, so the levels are independent samples (the
+    windows of one level share their members' noise series, as records cut short would).
     Returns ``(monte_carlo_std, predicted_std)``, arrays indexed [window, noise].
     """
     std = np.empty((len(windows), len(noises_arcsec)))
@@ -38,7 +40,7 @@ def accuracy_against_window(windows, noises_arcsec, members: int, unknowns: int 
     for i, window in enumerate(windows):
         for j, noise in enumerate(noises_arcsec):
             case = PARAMETERS.case(duration=float(window), readout_noise=from_unit(noise, "arcsec"), unknowns=unknowns)
-            summary = monte_carlo(evaluate, OUTPUTS, case, members, RandomStreams(seed))
+            summary = monte_carlo(evaluate, OUTPUTS, case, members, RandomStreams(j))
             std[i, j] = to_unit(summary.statistics["north_error_rad"]["std"], "arcsec")
             predicted[i, j] = to_unit(evaluate(Cases.from_case(case))["north_std_predicted_rad"][0], "arcsec")
     return std, predicted
