@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -138,6 +139,16 @@ def test_fidelities_give_the_same_record():
              for f in ("closed", "simulated")}
     assert north["closed"] == pytest.approx(north["simulated"], abs=1e-9)
     assert SYSTEM.fidelities == ("closed", "simulated")
+
+
+def test_estimator_trial_steps_do_not_warn():
+    # member 32 of seed 1 (60 s, 10 arcsec): a Levenberg-Marquardt trial step probes lambda ~ 5e14 1/s, where
+    # the Bessel basis overflows; the step is rejected and the fit converges, without a warning for the user
+    case = SYSTEM.case(duration=60.0, readout_noise=10 * ARCSEC)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = evaluate(Cases.from_case(case, members=[32], random=RandomStreams(1)))
+    assert out["converged"][0] == 1.0 and abs(out["north_error_rad"][0]) < 5 * out["north_std_predicted_rad"][0]
 
 
 def test_unidentifiable_record_nan_in_evaluate_raised_by_run():

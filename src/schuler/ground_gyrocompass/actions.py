@@ -23,12 +23,12 @@ from schuler.ground_gyrocompass.evaluation import (
     READING_PARAMETER,
     RECORD_BYTES_PER_SAMPLE,
     fit_bytes,
+    identify_north,
     omega_h_of,
     record_window,
     records,
     truth_of,
 )
-from schuler.ground_gyrocompass.identification import identify
 from schuler.ground_gyrocompass.observations import read_record, write_record
 from schuler.ground_gyrocompass.results import NorthIdentification, ObservationRecord
 from schuler.memory import require
@@ -71,9 +71,9 @@ def identify_record(record: Path, **values) -> NorthIdentification:
     time, observed = read_record(record)
     require(fit_bytes(time.size, case["method"], case["unknowns"]), f"identifying {record}",
             "the record's length or --method")
-    estimate = identify(time, observed, case["unknowns"], decay_rate=case["decay_rate"], hm=case["hm"],
-                        inertia=case["inertia"], omega_h=float(omega_h_of(Cases.from_case(case))[0]),
-                        reading=case["reading"], method=case["method"])
+    estimate = identify_north(time, observed, case["unknowns"], decay_rate=case["decay_rate"], hm=case["hm"],
+                              inertia=case["inertia"], omega_h=float(omega_h_of(Cases.from_case(case))[0]),
+                              reading=case["reading"], method=case["method"])
     return NorthIdentification.from_estimate(estimate)
 
 

@@ -346,9 +346,9 @@ def _evaluate_batch(time, cases: Cases, fidelity: str, strict: bool):
     estimates: list[NorthEstimate | None] = []
     for i in range(n):
         try:
-            estimate = identify(time, observed[i], unknowns, decay_rate=float(truth["decay_rate"][i]),
-                                hm=float(cases.float("hm")[i]), inertia=float(cases.float("inertia")[i]),
-                                omega_h=float(truth["omega_h"][i]), reading=reading, method=method)
+            estimate = identify_north(time, observed[i], unknowns, decay_rate=float(truth["decay_rate"][i]),
+                                      hm=float(cases.float("hm")[i]), inertia=float(cases.float("inertia")[i]),
+                                      omega_h=float(truth["omega_h"][i]), reading=reading, method=method)
         except IdentificationError:
             if strict:
                 raise
@@ -359,6 +359,26 @@ def _evaluate_batch(time, cases: Cases, fidelity: str, strict: bool):
             out[name][i] = value
         out["north_error_rad"][i] = truth["alpha0"][i] - estimate.alpha0_rad  # north is -alpha0
     return out, estimates
+
+
+def identify_north(time, observed, unknowns: int, **known) -> NorthEstimate:
+    """The production estimator (:func:`~.identification.identify`, keywords as there), quietly.
+
+    Levenberg-Marquardt's trial steps may probe a decay rate at which the Bessel
+    basis overflows; the fit rejects such steps, so numpy's floating-point warnings
+    about them are silenced here, and an estimate that is not finite raises instead.
+
+    Raises
+    ------
+    IdentificationError
+        The record does not determine the unknowns, or the fit ends at values that
+        are not finite.
+    """
+    with np.errstate(all="ignore"):
+        estimate = identify(time, observed, unknowns, **known)
+    if not (math.isfinite(estimate.alpha0_rad) and math.isfinite(estimate.misfit)):
+        raise IdentificationError(f"the {unknowns}-unknown fit ended at values that are not finite")
+    return estimate
 
 
 def estimate_outputs(estimate: NorthEstimate) -> dict[str, float]:
@@ -403,5 +423,5 @@ def run_case(case: Case, fidelity: str | None = None) -> NorthRun:
         readout_noise_rad=case["readout_noise"], true_north_rad=-case["alpha0"], **values, estimate=estimates[0])
 
 
-__all__ = ["FIDELITIES", "OUTPUTS", "PARAMETERS", "evaluate", "fit_bytes", "member_bytes", "omega_h_of",
-           "record_window", "records", "run_case", "sample_count", "truth_of"]
+__all__ = ["FIDELITIES", "OUTPUTS", "PARAMETERS", "evaluate", "fit_bytes", "identify_north", "member_bytes",
+           "omega_h_of", "record_window", "records", "run_case", "sample_count", "truth_of"]
