@@ -1,45 +1,53 @@
-"""``schuler north`` end to end, and the system's registry entry points."""
+"""``schuler north`` end to end in-process: run, reproduce, identify, simulate, files and errors."""
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
-import numpy as np
+import pandas as pd
 import pytest
 
-from schuler.ground_gyrocompass import motion
-from schuler.ground_gyrocompass.api import SYSTEM, PARAMETERS, resolve_omega_h, run
-from schuler.params import parse_parameters
-
-ESTIMATE_KEYS = {"alpha0_rad", "alpha0_dot", "lambda", "Hm", "north_deg", "misfit", "nfev", "method",
-                 "alpha0_rad_std", "alpha0_dot_std", "lambda_std", "Hm_std", "north_std_arcsec"}
+ARCSEC = math.radians(1.0) / 3600.0
+TRUE_NORTH = -3.69 * math.pi / 540  # -alpha0 of the source's simulator (Fedorov et al. 2020, before Table 1)
+IDENTIFY_KEYS = {"alpha0_rad", "alpha0_dot_rad_s", "decay_rate", "hm", "north_rad", "misfit_rad2",
+                 "model_evaluations", "method", "alpha0_std_rad", "alpha0_dot_std_rad_s", "decay_rate_std", "hm_std",
+                 "north_std_rad"}
+SI_SUFFIXES = ("_rad", "_s", "_rad_s", "_rad2")
 
 
 @pytest.fixture
 def record_file(tmp_path, run_cli):
     path = tmp_path / "record.csv"
-    out = run_cli("north", "simulate", "--noise", "2 arcsec", "--seed", "4", "--output", path)
+    out = run_cli("north", "simulate", "--readout-noise", "2 arcsec", "--seed", "4", "-o", path)
     assert out.code == 0, out.stderr
     return path
+
+
+def numeric_keys_without_unit(data: dict) -> set[str]:
+    return {key for key, value in data.items() if isinstance(value, (int, float)) and not isinstance(value, bool)
+            and not key.endswith(SI_SUFFIXES)}
 
 
 def test_simulate_writes_the_record(record_file):
     lines = record_file.read_text().splitlines()
     assert lines[0] == "t_s,alpha_rad"
-    assert len(lines) == 202  # 0..200 s every 1 s (source 004)
+    assert len(lines) == 202  # 0..200 s every 1 s (Fedorov et al. 2020, before Table 1)
 
 
 def test_identify_json_keys_and_values(record_file, run_cli):
     out = run_cli("north", "identify", record_file, "--unknowns", "4", "--json")
     assert out.code == 0, out.stderr
     data = out.json()
-    assert ESTIMATE_KEYS <= set(data)
-    assert data["method"] == "lsq"
+    assert IDENTIFY_KEYS <= set(data)
+    assert data["method"] == "lsq" and data["schuler_version"]
     # 2 arcsec noise: north within a few standard errors of the truth -1.23 deg
-    assert abs(data["north_deg"] + 1.23) * 3600 < 5 * data["north_std_arcsec"]
-    assert data["Hm"] == pytest.approx(0.432, rel=1e-3)
+    assert abs(data["north_rad"] - TRUE_NORTH) < 5 * data["north_std_rad"]
+    assert data["hm"] == pytest.approx(0.432, rel=1e-3)
+    assert numeric_keys_without_unit(data) <= set(data["units"])
 
 
+@pytest.mark.slow
 def test_identify_grid_and_figures(record_file, run_cli, tmp_path):
     out = run_cli("north", "identify", record_file, "--unknowns", "2", "--method", "grid", "--out", tmp_path / "f",
                   "--json")
@@ -48,6 +56,9 @@ def test_identify_grid_and_figures(record_file, run_cli, tmp_path):
     names = {p.name for p in (tmp_path / "f").iterdir()}
     for stem in ("north_fit", "north_misfit_map", "north_error_vs_time"):
         assert {f"{stem}.png", f"{stem}.svg"} <= names
+    table = pd.read_csv(tmp_path / "f" / "north_record_fit.csv")
+    assert list(table.columns) == ["t_s", "observed_rad", "fitted_rad", "residual_rad"]
+    assert (table["observed_rad"] - table["fitted_rad"] - table["residual_rad"]).abs().max() < 1e-15
 
 
 def test_identify_human_output_shows_deg_arcmin_arcsec(record_file, run_cli):
@@ -56,61 +67,142 @@ def test_identify_human_output_shows_deg_arcmin_arcsec(record_file, run_cli):
     for unit in ("deg", "arcmin", "arcsec"):
         assert unit in out.stdout
     assert "-1°13′" in out.stdout
+    # the optimiser's own words ("`xtol` termination condition is satisfied") never reach the user
+    assert "xtol" not in out.stdout and "termination" not in out.stdout and out.stderr == ""
+    assert "variable projection converged" in out.stdout
 
 
-def test_reproduce_json_keys(run_cli):
-    out = run_cli("north", "reproduce", "--unknowns", "4", "--json")
+def test_run_member_zero_is_simulate_then_identify(record_file, run_cli):
+    # the record of `simulate --seed 4` is member 0 of `run --monte-carlo 1 --seed 4`: same noise, same estimate
+    run = run_cli("north", "run", "--readout-noise", "2 arcsec", "--monte-carlo", "1", "--seed", "4", "--json").json()
+    identified = run_cli("north", "identify", record_file, "--json").json()
+    member = run["monte_carlo"]["statistics"]["north_error_rad"]["mean"]
+    # the CSV keeps every digit (repr), so only the fit's round-off separates them
+    assert member == pytest.approx(identified["north_rad"] - TRUE_NORTH, rel=1e-9, abs=1e-15)
+
+
+def test_run_json_nominal_case_and_units(run_cli):
+    out = run_cli("north", "run", "--readout-noise", "1 arcsec", "--latitude", "50", "--unknowns", "5", "--json")
     assert out.code == 0, out.stderr
     data = out.json()
-    assert ESTIMATE_KEYS <= set(data)
-    assert data["alpha0_rad"] == pytest.approx(3.69 * math.pi / 540, rel=1e-9)  # source 004 simulator input
-    assert data["lambda"] == pytest.approx(2.15e-3, rel=1e-9)
-    assert data["Hm"] == pytest.approx(0.432, rel=1e-9)
-    assert len(data["stages"]) == 9
-    assert data["table1"]["any_reading_reproduces"] is False
+    assert data["omega_h"] == pytest.approx(7.292115e-5 * math.cos(math.radians(50)), rel=1e-12)
+    # nominal case: the noise-free record gives north to round-off, beside the standard error the noise predicts
+    assert abs(data["north_error_rad"]) < 1e-12
+    assert 0.05 * ARCSEC < data["north_std_predicted_rad"] < 5 * ARCSEC
+    assert data["inputs"]["readout_noise"] == pytest.approx(ARCSEC)
+    assert data["inputs"]["fidelity"] == "closed"
+    assert numeric_keys_without_unit(data) <= set(data["units"])
+    assert data["units"]["readout_noise"] == "rad"
+
+
+def test_run_monte_carlo_agrees_with_prediction(run_cli):
+    out = run_cli("north", "run", "--readout-noise", "5 arcsec", "--duration", "300", "--monte-carlo", "300",
+                  "--seed", "11", "--json")
+    assert out.code == 0, out.stderr
+    data = out.json()
+    stats = data["monte_carlo"]["statistics"]
+    assert stats["converged"]["mean"] == 1.0
+    # 300 members: the sample std is within 4 standard errors (4.1 % each) of the linearised prediction
+    assert stats["north_error_rad"]["std"] == pytest.approx(data["north_std_predicted_rad"], rel=0.17)
+    # the estimator is unbiased to well within the scatter of the mean (std / sqrt(300))
+    assert abs(stats["north_error_rad"]["mean"]) < 4 * stats["north_error_rad"]["std"] / math.sqrt(300)
+
+
+@pytest.mark.slow
+def test_run_writes_figures_and_data(run_cli, tmp_path):
+    out = run_cli("north", "run", "--readout-noise", "5 arcsec", "--monte-carlo", "20", "--out", tmp_path)
+    assert out.code == 0, out.stderr
+    assert "records identified and converged" in out.stdout
+    for name in ("north_fit.png", "north_fit.svg", "north_monte_carlo.png", "north_monte_carlo.svg",
+                 "north_error_vs_time.png", "north_misfit_map.svg", "north_record_fit.csv"):
+        assert (tmp_path / name).stat().st_size > 500
+
+
+def test_simulated_fidelity_is_a_named_choice(run_cli):
+    closed = run_cli("north", "run", "--unknowns", "3", "--json").json()
+    simulated = run_cli("north", "run", "--unknowns", "3", "--fidelity", "simulated", "--json").json()
+    assert simulated["fidelity"] == "simulated" and closed["fidelity"] == "closed"
+    # eq. (9) against DOP853 at rtol 1e-12: the records differ by < 1e-9 rad, so does north
+    assert simulated["north_rad"] == pytest.approx(closed["north_rad"], abs=1e-9)
+    assert run_cli("north", "run", "--fidelity", "rough").code == 2
+
+
+def test_reproduce_json(run_cli, tmp_path):
+    out = run_cli("north", "reproduce", "--unknowns", "4", "--json", "--out", tmp_path)
+    assert out.code == 0, out.stderr
+    data = out.json()
+    assert data["schuler_version"] and "units" in data
+    rows = {row["quantity"]: row for row in data["rows"]}
+    assert not [row for row in data["rows"] if row["verdict"].startswith("differs")]
+    alpha0 = rows["alpha0 identified (4 unknowns, lsq)"]
+    assert (alpha0["printed"], alpha0["where"]) == ("3,69π/540", "simulator input, before Table 1")
+    assert alpha0["computed"] == pytest.approx(3.69, rel=1e-9)
+    identification = data["details"]["identification"]
+    assert identification["decay_rate"] == pytest.approx(2.15e-3, rel=1e-9)
+    assert identification["hm"] == pytest.approx(0.432, rel=1e-9)
+    assert len(data["details"]["stages_in_source_units"]) == 9
+    assert not any(reading["reproduces"] for reading in data["details"]["table1_readings"])
+    for name in ("north_fit.png", "north_misfit_map.svg", "north_table1.csv"):
+        assert (tmp_path / name).stat().st_size > 500
+    table = pd.read_csv(tmp_path / "north_table1.csv")
+    assert len(table) == 247 and {"printed_misfit_rad2", "sum_of_squares_rad2"} <= set(table.columns)
 
 
 def test_reproduce_human_explains_each_disagreement(run_cli):
     out = run_cli("north", "reproduce", "--unknowns", "2")
     assert out.code == 0, out.stderr
     lines = out.stdout.splitlines()
-    # source 004, Table 2 (2 unknowns, stage 2): printed F 3.62e-5 against the computed sum of squares
-    row = next(line for line in lines if line.replace(" ", "").startswith("│2│2│900│"))
-    assert "3.62e-05" in row and "✗" in row and "[1]" in row
-    assert next(line for line in lines if line.startswith("[1] ")).startswith("[1] erratum: the printed F is not")
-    # 4 unknowns, stage 1: the printed best cell is not the grid's minimum
-    row = next(line for line in lines if line.replace(" ", "").startswith("│4│1│"))
-    number = row.rsplit("[", 1)[1].split("]")[0]
+    # text after Table 1: the second approximation's printed F 0.362*10^-4 is not the computed sum of squares
+    start = next(i for i, line in enumerate(lines) if "2 unknowns, stage" in line and "0.362*10^-4" in line)
+    assert "erratum" in lines[start]
+    number = lines[start].rsplit("[", 1)[1].split("]")[0]
     note = next(line for line in lines if line.startswith(f"[{number}] "))
-    assert "the printed best (4, 4, 2.2, 0.43) is not the grid's minimum" in note
-
-
-def test_run_is_simulate_plus_identify(run_cli):
-    out = run_cli("north", "run", "--noise", "1 arcsec", "--latitude", "50", "--unknowns", "5", "--json")
-    assert out.code == 0, out.stderr
-    data = out.json()
-    assert data["omega_h"] == pytest.approx(7.292115e-5 * math.cos(math.radians(50)), rel=1e-12)
-    assert abs(data["north_error_arcsec"]) < 5 * data["north_std_arcsec"]
+    assert "the source's misfit is not F" in note
+    # 4 unknowns, stage 1: the printed best cell is not the grid's minimum
+    assert any("the printed best (4, 4, 2.2, 0.43) is not the grid's minimum" in line for line in lines)
 
 
 @pytest.mark.parametrize(
     "args, needle",
     [
-        (("run", "--lambda", "0"), "--lambda"),
-        (("run", "--lambda", "-1e-3"), "--lambda"),
+        (("run", "--decay-rate", "0"), "--decay-rate"),
+        (("run", "--decay-rate", "-1e-3"), "--decay-rate"),
         (("run", "--hm", "0"), "--hm"),
         (("run", "--latitude", "90"), "--latitude"),
         (("run", "--latitude", "-90"), "--latitude"),
         (("run", "--duration", "2", "--unknowns", "4"), "--unknowns"),
+        (("run", "--output-step", "300"), "--output-step"),
         (("run", "--latitude", "50", "--omega-h", "3e-5"), "--latitude"),
-        (("simulate", "--noise", "-1", "--output", "x.csv"), "--noise"),
+        (("run", "--readout-noise", "1 m"), "--readout-noise"),
+        (("run", "--seed", "-1"), "--seed"),
+        (("run", "--monte-carlo", "-1"), "--monte-carlo"),
+        (("run", "--lambda", "2e-3"), "--lambda"),
+        (("run", "--step", "1"), "--step"),
+        (("run", "--noise", "1"), "--noise"),
+        (("simulate", "--readout-noise", "-1", "-o", "x.csv"), "--readout-noise"),
+        (("simulate", "--seed", "-5", "-o", "x.csv"), "--seed"),
+        (("reproduce", "--unknowns", "6"), "--unknowns"),
+        (("reproduce", "--method", "fast"), "--method"),
     ],
 )
-def test_bad_input_is_one_line_exit_2(run_cli, args, needle):
+def test_bad_input_is_one_line_exit_2(run_cli, args, needle, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     out = run_cli("north", *args)
     assert out.code == 2
     lines = out.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("schuler: error:") and needle in lines[0]
+    assert not (tmp_path / "x.csv").exists()
+
+
+@pytest.mark.parametrize("command", [("run",), ("simulate", "-o", "big.csv")])
+def test_memory_refused_before_allocating(run_cli, command, tmp_path, monkeypatch):
+    # issue 13: 1e9 s every 1e-3 s is 1e12 samples (7 TiB for the record alone): one line naming the options
+    monkeypatch.chdir(tmp_path)
+    out = run_cli("north", *command, "--duration", "1e9 s", "--output-step", "1e-3 s")
+    assert out.code == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "memory budget" in lines[0] and "--duration or --output-step" in lines[0]
+    assert not list(tmp_path.iterdir())
 
 
 @pytest.mark.parametrize(
@@ -130,38 +222,53 @@ def test_bad_record_is_one_line_exit_2(tmp_path, run_cli, body, needle):
     assert len(out.stderr.strip().splitlines()) == 1 and needle in out.stderr
 
 
+@pytest.mark.parametrize(
+    "content",
+    [
+        "t_s,alpha_rad\n0,0\n1,1e-5\n# café\n".encode("latin-1"),
+        "t_s,alpha_rad\n0,0\n1,1e-5\n".encode("utf-16"),
+        b"\x7fELF\x02\x01\x01\x00\x00\x00\x00\x00\x00\x00\x00\x00\x03\x00>\x00\x01\x00\x00\x00" * 50,
+    ],
+    ids=["latin-1", "utf-16", "binary"],
+)
+def test_record_not_utf8_is_one_clear_error(tmp_path, run_cli, content):
+    path = tmp_path / "record.csv"
+    path.write_bytes(content)
+    out = run_cli("north", "identify", path)
+    assert out.code == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and str(path) in lines[0] and "UTF-8" in lines[0]
+    assert "UnicodeDecodeError" not in out.stderr
+
+
+def test_record_with_byte_order_mark_is_accepted(record_file, tmp_path, run_cli):
+    # a spreadsheet's "CSV UTF-8" starts with a byte-order mark
+    marked = tmp_path / "marked.csv"
+    marked.write_bytes(b"\xef\xbb\xbf" + record_file.read_bytes())
+    plain = run_cli("north", "identify", record_file, "--json").json()
+    out = run_cli("north", "identify", marked, "--json")
+    assert out.code == 0, out.stderr
+    assert out.json()["north_rad"] == plain["north_rad"]
+
+
 def test_missing_record_file(tmp_path, run_cli):
     out = run_cli("north", "identify", tmp_path / "none.csv")
     assert out.code == 2 and "no such file" in out.stderr
 
 
-def test_system_run_matches_parameters():
-    assert {p.name for p in SYSTEM.parameters} == {p.name for p in PARAMETERS}
-    values = parse_parameters(SYSTEM.parameters, {"unknowns": "2"})
-    result = run(**values)
-    assert abs(result.north_error_arcsec) < 1e-6  # noise-free, known lambda and Hm
-    assert resolve_omega_h() == motion.SOURCE_OMEGA_H
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="needs a folder where files cannot be created")
+def test_unwritable_output_names_the_users_path(run_cli):
+    out = run_cli("north", "simulate", "-o", "/proc/x.csv")
+    assert out.code == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "/proc/x.csv" in lines[0] and ".part" not in lines[0]
 
 
-def test_sweep_is_vectorised_and_matches_single_cases():
-    durations = np.array([60.0, 120.0, 300.0, 600.0])
-    values = {"duration": durations, "noise": np.full(4, 1e-5), "unknowns": np.array([4, 4, 4, 4])}
-    out = SYSTEM.sweep(values)
-    assert out["north_std_arcsec"].shape == (4,)
-    assert np.all(np.diff(out["north_std_arcsec"]) < 0)  # accuracy improves with observation time
-    single = SYSTEM.sweep({"duration": durations[2:3], "noise": np.array([1e-5]), "unknowns": np.array([4])})
-    assert single["north_std_arcsec"][0] == pytest.approx(out["north_std_arcsec"][2], rel=1e-12)
-    mixed = SYSTEM.sweep({"unknowns": np.array([2, 5]), "noise": np.array([1e-5, 1e-5]),
-                          "latitude": np.array([np.nan, 0.9])})
-    assert mixed["north_std_arcsec"][1] > mixed["north_std_arcsec"][0]
-
-
-def test_report_section(tmp_path):
-    section = SYSTEM.report(tmp_path)
-    assert section.system == "north"
-    assert all((tmp_path / figure.path).is_file() for figure in section.figures)
-    assert len(section.figures) == 4
-    rows = {row.quantity: row for row in section.rows}
-    assert rows["2 unknowns, stage 1: best cell"].agrees
-    assert not rows["4 unknowns, stage 1: best cell"].agrees
-    assert rows["4 unknowns: alpha0 by least squares"].agrees
+def test_help_shows_the_new_names(run_cli):
+    help_text = run_cli("north", "run", "--help").stdout
+    for option in ("--decay-rate", "--output-step", "--readout-noise", "--monte-carlo", "--seed", "--fidelity"):
+        assert option in help_text
+    for old in ("--lambda", "--noise ", "--step "):
+        assert old not in help_text
+    assert "--seed" in run_cli("north", "simulate", "--help").stdout
+    assert "--seed" not in run_cli("north", "identify", "--help").stdout

@@ -1,4 +1,6 @@
-"""Ground gyrocompass during natural rotor run-down (source 004, Fedorov, Kikot, Shtefan).
+"""Ground gyrocompass during natural rotor run-down (Fedorov, Kikot, Shtefan (2020)).
+
+Source: :data:`schuler.references.FEDOROV_2020`; equation numbers are the article's.
 
 Modules:
 
@@ -11,7 +13,10 @@ Modules:
 * :mod:`.observations` -- sampling, noise, quantisation, CSV records;
 * :mod:`.monte_carlo` -- accuracy against observation time, predicted and simulated;
 * :mod:`.reproduction` -- the source's Tables 1-3 against the toolkit;
-* :mod:`.plots`, :mod:`.api` -- figures, and ``SYSTEM`` for the CLI and the report.
+* :mod:`.evaluation`, :mod:`.results`, :mod:`.actions`, :mod:`.report`, :mod:`.api` --
+  the system on the contract: parameters, ``evaluate`` and ``run_case``, result
+  types and files, ``identify`` and ``simulate``, the report, and ``SYSTEM``;
+* :mod:`.plots` -- figures.
 """
 
 from schuler.ground_gyrocompass.identification import NorthEstimate, identify

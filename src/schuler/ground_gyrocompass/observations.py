@@ -83,18 +83,34 @@ def write_record(path, time, observed) -> Path:
 def read_record(path):
     """Read and validate a CSV record; returns (time s, observed rad) arrays.
 
+    The file must be UTF-8 text; a byte-order mark (spreadsheets' "CSV UTF-8") is
+    accepted.
+
     Raises
     ------
     InvalidParameter
-        Named after the file and line: a missing file, missing columns, an empty or
-        non-numeric or non-finite value, a negative time, a time not after the
-        previous one, or no samples.
+        Named after the file and line: a missing file, text that is not UTF-8 (or
+        not text at all), missing columns, an empty or non-numeric or non-finite
+        value, a negative time, a time not after the previous one, or no samples.
     """
     path = Path(path)
     if not path.is_file():
         raise InvalidParameter(str(path), "no such file")
+    with path.open("rb") as handle:
+        head = handle.read(4096)
+    if b"\x00" in head:  # UTF-16 text (one NUL per ASCII character) or a binary file
+        raise InvalidParameter(str(path), "not UTF-8 text (binary, or UTF-16); save the record as CSV (UTF-8)")
+    try:
+        return _read_rows(path)
+    except UnicodeDecodeError:
+        raise InvalidParameter(str(path), "not UTF-8 text; save the record as CSV (UTF-8)") from None
+    except csv.Error as error:  # NUL bytes, an endless field: a binary file
+        raise InvalidParameter(str(path), f"not a CSV text file ({error})") from None
+
+
+def _read_rows(path: Path):
     times, angles = [], []
-    with path.open(newline="", encoding="utf-8") as handle:
+    with path.open(newline="", encoding="utf-8-sig") as handle:
         reader = csv.reader(handle)
         header = next(reader, None)
         if header is None:

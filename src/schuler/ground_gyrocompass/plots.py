@@ -36,7 +36,7 @@ def plot_fit(estimate, stem, formats=("png", "svg")):
     top.plot(time, fitted * ARCMIN_PER_RAD, "-", lw=1.2, label=f"fit, {estimate.unknowns} unknowns ({estimate.method})")
     top.set_ylabel("observed azimuth motion, arcmin")
     top.set_title(f"Rotor run-down: north {estimate.north_dms} from the rotor axis at release")
-    top.legend(loc="best")
+    top.legend(loc="upper right")  # "best" scans every point: slow (and warns) on long records
     top.grid(alpha=0.3)
     bottom.plot(time, estimate.residuals * ARCSEC_PER_RAD, ".", ms=3, color="C3")
     bottom.axhline(0.0, color="k", lw=0.6)
@@ -47,7 +47,7 @@ def plot_fit(estimate, stem, formats=("png", "svg")):
     return save_figure_formats(fig, stem, formats)
 
 
-def plot_misfit_map(stage, stem, formats=("png", "svg")):
+def plot_misfit_map(stage, stem, formats=("png", "svg"), title=None):
     """log10 of the misfit over (alpha0, alpha0_dot) of a grid stage, best cell marked."""
     plt = _pyplot()
     alpha0 = axis(*stage.box["alpha0"]) * ARCMIN_PER_RAD
@@ -60,7 +60,7 @@ def plot_misfit_map(stage, stem, formats=("png", "svg")):
     ax.plot(best_rate, best_angle, "r+", ms=14, mew=2, label="best cell")
     ax.set_xlabel("initial rate alpha0_dot, 1e-4 rad/s")
     ax.set_ylabel("initial angle alpha0, arcmin")
-    ax.set_title(f"First grid stage ({stage.cells} cells), at the best lambda and B")
+    ax.set_title(title or f"First grid stage ({stage.cells} cells), at the best lambda and B")
     ax.legend(loc="upper right")
     fig.tight_layout()
     return save_figure_formats(fig, stem, formats)
@@ -80,7 +80,7 @@ def plot_error_vs_time(durations, series, stem, title, formats=("png", "svg")):
     ax.set_ylabel("north standard error, arcsec")
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
-    ax.legend(loc="best", fontsize="small")
+    ax.legend(loc="upper right", fontsize="small")
     fig.tight_layout()
     return save_figure_formats(fig, stem, formats)
 
@@ -93,3 +93,36 @@ def plot_study(study, stem, formats=("png", "svg")):
         series.append((f'predicted (Jacobian), noise {noise:g}"', study.predicted_std_arcsec[:, j], f"C{j}-"))
     title = f"Accuracy against time: {study.unknowns} unknowns, {study.members} runs per point"
     return plot_error_vs_time(study.durations_s, series, stem, title, formats)
+
+
+def plot_record(time, observed, stem, title, formats=("png", "svg")):
+    """An observation record: the observed coordinate (arcmin) against time."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    ax.plot(time, observed * ARCMIN_PER_RAD, ".", ms=3)
+    ax.set_xlabel("time since release, s")
+    ax.set_ylabel("observed azimuth motion, arcmin")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return save_figure_formats(fig, stem, formats)
+
+
+def plot_error_histogram(errors_arcsec, predicted_std_arcsec, stem, title, formats=("png", "svg")):
+    """Histogram of Monte Carlo north errors (arcsec) with the normal density of the predicted standard error."""
+    plt = _pyplot()
+    errors = np.asarray(errors_arcsec, dtype=float)
+    errors = errors[np.isfinite(errors)]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    ax.hist(errors, bins=max(10, min(60, errors.size // 20)), density=True, alpha=0.6, label="Monte Carlo")
+    if predicted_std_arcsec > 0.0:
+        x = np.linspace(-4 * predicted_std_arcsec, 4 * predicted_std_arcsec, 201)
+        density = np.exp(-0.5 * (x / predicted_std_arcsec) ** 2) / (predicted_std_arcsec * math.sqrt(2 * math.pi))
+        ax.plot(x, density, "k-", label=f"predicted, sigma = {predicted_std_arcsec:.3g} arcsec")
+    ax.set_xlabel("north error (identified - true), arcsec")
+    ax.set_ylabel("probability density, 1/arcsec")
+    ax.set_title(title)
+    ax.legend(loc="upper right", fontsize="small")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return save_figure_formats(fig, stem, formats)
