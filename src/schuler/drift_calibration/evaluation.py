@@ -125,7 +125,13 @@ PARAMETERS = ParameterSet((
               minimum=0, maximum=3600),
     Parameter("sigma_latitude", "arcmin", 1.0, "Random: 1-sigma error of the latitude entered.",
               minimum=0, maximum=600),
-), owner="calibrate")
+), owner="calibrate", renamed={
+    "drift": "drift_x", "tau": "pulse_duration", "k1": "sensor_gain", "sensor_noise": "sensor_noise_density",
+    "sensor_scale_error": "sigma_sensor_scale", "amplitude_mismatch": "sigma_amplitude_mismatch",
+    "duration_mismatch": "sigma_duration_mismatch", "pulse_asymmetry": "sigma_pulse_asymmetry",
+    "integrator_offset": "sigma_integrator_offset", "lag_compensation_error": "sigma_lag_compensation",
+    "sway_amplitude": "sigma_sway", "turn_angle_error": "sigma_turn_angle", "levelling_residual": "sigma_levelling",
+    "initial_angle": "sigma_initial_angle", "latitude_error": "sigma_latitude"})
 """Every option of ``schuler calibrate run`` (and key of a ``calibrate`` scenario)."""
 
 BUDGET_TERMS = {

@@ -96,7 +96,7 @@ EXCLUSIVE = (("latitude", "omega_h"),)
 
 PARAMETERS = ParameterSet(
     (*MOTION_PARAMETERS, *INSTRUMENT_PARAMETERS, *OBSERVATION_PARAMETERS, READING_PARAMETER, *FIT_PARAMETERS),
-    owner="north", exclusive=EXCLUSIVE)
+    owner="north", exclusive=EXCLUSIVE, renamed={"lambda": "decay_rate", "step": "output_step", "noise": "readout_noise"})
 """Every option of ``schuler north run`` (and key of a ``north`` scenario)."""
 
 OUTPUTS = (

@@ -69,7 +69,7 @@ PARAMETERS = ParameterSet((
     Parameter("sigma_drift", "deg/h", 0.01, "Monte Carlo: 1-sigma of the x and y residual drifts.", minimum=0),
     Parameter("sigma_drift_z", "deg/h", 0.01, "Monte Carlo: 1-sigma of the z residual drift.", minimum=0),
     Parameter("sigma_accel", "g", 1e-4, "Monte Carlo: 1-sigma of each accelerometer bias.", minimum=0),
-), owner="align")
+), owner="align", renamed={"time_step": "output_step", "accel_error_x": "accel_bias_x", "accel_error_y": "accel_bias_y"})
 """Every option of ``schuler align run`` (and key of an ``align`` scenario)."""
 
 OUTPUTS = (

@@ -76,7 +76,7 @@ PARAMETERS = SourceParameters((
     Parameter("speed", "m/s", "0.5 mi/s", "Vehicle speed V; the azimuth error grows with the range V t.",
               minimum=0.0, maximum=1e5),
     *EARTH_PARAMETERS,
-), owner="errors")
+), owner="errors", renamed={"step": "output_step"})
 """Every option of ``schuler errors run`` (and key of an ``errors`` scenario)."""
 
 OUTPUTS = (
