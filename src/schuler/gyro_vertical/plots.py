@@ -65,6 +65,21 @@ def plot_velocity_errors(analysis, compensated=None, title: str = "Gyro vertical
     return _finish(fig, axes, title)
 
 
+def plot_quasi_steady(quasi, title: str = "Gyro vertical: quasi-steady velocity errors (29)"):
+    """Forced tilts (26) (arcmin) and the quasi-steady errors (29) (m/s) of a closed-form run."""
+    hours = quasi.time / HOUR
+    fig, axes = _figure(2)
+    axes[0].plot(hours, quasi.alpha_r / ARCMIN, lw=1.2, label="alpha_r")
+    axes[0].plot(hours, quasi.beta_r / ARCMIN, "--", lw=1.2, label="beta_r")
+    _dress(axes[0], "forced tilt [arcmin]")
+    for name, forced, slow, style in (("Delta v_x", quasi.dv_x, quasi.slow_dv_x, "-"),
+                                      ("Delta v_y", quasi.dv_y, quasi.slow_dv_y, "--")):
+        axes[1].plot(hours, forced, style, lw=1.2, label=f"{name} (29)")
+        axes[1].plot(hours, slow, ":", lw=1.0, label=f"{name} slowly varying")
+    _dress(axes[1], "velocity error [m/s]")
+    return _finish(fig, axes, title)
+
+
 def plot_spectrum(analysis, title: str = "Spectrum of the velocity-error oscillation"):
     """Amplitude of u = Delta v_x - i Delta v_y minus (29) against signed frequency (cycles/h)."""
     fig, axes = _figure(1, height=3.6)
