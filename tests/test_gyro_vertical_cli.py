@@ -41,7 +41,7 @@ def test_run_json_and_files(run_cli, tmp_path):
 def test_bare_duration_is_seconds_and_human_output(run_cli):
     data = run_cli("vertical", "run", "--duration", "7200", "--output-step", "60", "--trajectory", "frozen",
                    "--json").json()
-    assert data["duration_s"] == 7200.0 and data["method"] == "exact"
+    assert data["end_time_s"] == 7200.0 and data["method"] == "exact"
     text = run_cli("vertical", "run", "--duration", "3 h", "--output-step", "30", "--speed-profile", "0: 0, 1 h: 20")
     assert text.code == 0, text.stderr
     assert "split Schuler periods" in text.stdout and "arcmin" in text.stdout and text.stderr == ""

@@ -8,6 +8,8 @@ import tracemalloc
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from schuler.contract import Cases
 from schuler.core.earth import DROZDOVICH, STANDARD_GRAVITY
@@ -79,7 +81,28 @@ def test_evaluate_equals_run_per_case_and_is_independent_of_chunking(fidelity):
         for name in batch:
             assert same(float(single[name][0]), float(batch[name][i]), 1e-12), (i, name)
     # each case was simulated on its own grid
-    assert batch["duration_s"].tolist() == CASES["duration"].tolist()
+    assert batch["end_time_s"].tolist() == CASES["duration"].tolist()
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    latitudes=st.lists(st.floats(-90, 90), min_size=1, max_size=5),
+    speed=st.floats(0.0, 300.0), gamma=st.floats(-180, 180), hours=st.floats(0.2, 6.0), step=st.sampled_from([30, 60]),
+)
+def test_any_batch_splits_into_the_same_cases(latitudes, speed, gamma, hours, step):
+    """Closed fidelity over random paths: finite outputs, and a batch equals its cases one by one (to 1e-12)."""
+    n = len(latitudes)
+    values = {"latitude": np.radians(latitudes), "speed": np.full(n, speed),
+              "velocity_angle": np.full(n, math.radians(gamma)), "duration": np.full(n, hours * HOUR),
+              "output_step": np.full(n, float(step))}
+    batch = SYSTEM.evaluate_values(values, fidelity="closed")
+    for i in range(n):
+        single = SYSTEM.evaluate_values({k: v[i:i + 1] for k, v in values.items()}, fidelity="closed")
+        for name, array in batch.items():
+            assert same(float(single[name][0]), float(array[i]), 1e-12), name
+    for name in ("steady_velocity_error_y_m_s", "velocity_error_y_mean_m_s", "split_period_slow_s", "end_time_s"):
+        assert np.isfinite(batch[name]).all(), name
+    assert (batch["split_period_fast_s"] <= batch["split_period_slow_s"]).all()
 
 
 def test_closed_form_outputs_of_a_batch():
@@ -151,7 +174,21 @@ def test_defaults_and_cross_checks():
     with pytest.raises(InvalidParameter, match="speed_profile"):
         SYSTEM.run(speed_profile="0: 0, 1 h: 9e3")  # above the orbital speed
     result = SYSTEM.run(duration=3 * HOUR, output_step=60.0, trajectory="frozen")
-    assert result.method == "exact" and result.duration_s == 3 * HOUR
+    assert result.method == "exact" and result.end_time_s == 3 * HOUR
+
+
+def test_awkward_grids_give_numbers_not_tracebacks():
+    # a speed-profile piece shorter than the output step holds no output time (formerly a ValueError in scipy)
+    quick = SYSTEM.run(speed_profile="0: 0, 1: 20", duration=3 * HOUR, output_step=10.0)
+    assert quick.analysis.response.true_velocity_y[-1] == pytest.approx(20.0)
+    assert math.isfinite(quick.velocity_error_y_rms_m_s)
+    # an output step above half the faster split period would alias the modes: no fit rather than a wrong one
+    for step in (3 * HOUR, 48 * HOUR):
+        coarse = SYSTEM.run(output_step=step)
+        assert math.isnan(coarse.fitted_period_fast_s) and coarse.analysis.spectrum is None
+        assert math.isfinite(coarse.velocity_error_y_max_abs_m_s)
+    fine = SYSTEM.run(output_step=1200.0)  # 20 min < 41 min: resolved, and the fit finds the eigenvalue
+    assert fine.fitted_period_fast_s == pytest.approx(fine.split_period_fast_s, rel=1e-3)
 
 
 def test_memory_is_refused_before_allocating(monkeypatch):

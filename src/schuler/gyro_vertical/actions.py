@@ -102,7 +102,7 @@ def friction(dead_zone: float = 0.01, inner_ratio: float = 1.0, initial_beta: fl
         max_static_velocity_error_y_m_s=float(static[:, [1, 3]].max()) if static.size else 0.0,
         velocity_error_x_max_abs_m_s=float(np.abs(response.velocity_error_x).max()),
         velocity_error_y_max_abs_m_s=float(np.abs(response.velocity_error_y).max()),
-        growth_rate_x_m_s2=float(rate_x), growth_rate_y_m_s2=float(rate_y), duration_s=float(time[-1]),
+        growth_rate_x_m_s2=float(rate_x), growth_rate_y_m_s2=float(rate_y), end_time_s=float(time[-1]),
         nfev=response.nfev, response=response,
     )
 

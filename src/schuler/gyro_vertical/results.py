@@ -48,7 +48,7 @@ class VerticalResult(RunResult):
     """
 
     fidelity: str
-    duration_s: float
+    end_time_s: float
     final_latitude_rad: float
     transport_coriolis_x_m_s2: float
     transport_coriolis_y_m_s2: float
@@ -118,7 +118,7 @@ class VerticalResult(RunResult):
         beat = "none (omega_2 = 0)" if math.isinf(self.beat_period_s) else f"{_shown(self.beat_period_s, 'h', 4)} h"
         solver = (f"{self.method}: {self.n_steps} steps, {self.nfev} evaluations" if self.fidelity == "simulated"
                   else self.method)
-        table.caption = (f"{_shown(self.duration_s, 'h', 4)} h, final latitude "
+        table.caption = (f"{_shown(self.end_time_s, 'h', 4)} h, final latitude "
                          f"{_shown(self.final_latitude_rad, 'deg', 6)} deg, Schuler period "
                          f"{_shown(self.schuler_period_s, 'min', 4)} min, beat period {beat}; {solver}")
         parts: list[Any] = [table]
@@ -148,7 +148,7 @@ class FrictionResult(Result):
     velocity_error_y_max_abs_m_s: float
     growth_rate_x_m_s2: float
     growth_rate_y_m_s2: float
-    duration_s: float
+    end_time_s: float
     nfev: int
     response: Any = field(default=None, repr=False)
 
@@ -172,7 +172,7 @@ class FrictionResult(Result):
         for name, x, y, unit in rows:
             convert = {"deg/h": "deg/h", "m/s per h": "m/s/h"}.get(unit, "")
             table.add_row(name, _shown(x, convert), _shown(y, convert), unit)
-        table.caption = (f"{_shown(self.duration_s, 'h', 4)} h: {self.stick_intervals} stick intervals, "
+        table.caption = (f"{_shown(self.end_time_s, 'h', 4)} h: {self.stick_intervals} stick intervals, "
                          f"{self.switches} stick/slip switches, {self.nfev} evaluations")
         return table
 
