@@ -234,6 +234,11 @@ def test_write_files_of_each_result(tmp_path):
     closed = write_files(run_case(short, "closed"), tmp_path / "closed")
     assert {p.name for p in closed} == {"vertical_quasi_steady.csv", "vertical_quasi_steady.png",
                                         "vertical_quasi_steady.svg"}
+    spread = SYSTEM.run(monte_carlo=40, fidelity="closed", duration=HOUR, output_step=60.0,
+                        draw=lambda members: {"drift_x": 0.01 * DEG_PER_H * np.sin(members)})
+    names = {p.name for p in write_files(spread, tmp_path / "monte_carlo")}
+    assert names == {"vertical_quasi_steady.csv", "vertical_quasi_steady.png", "vertical_quasi_steady.svg",
+                     "vertical_monte_carlo.png", "vertical_monte_carlo.svg"}
     stuck = friction(initial_beta=math.radians(0.2 / 3600), duration=3 * HOUR)
     names = {p.name for p in write_files(stuck, tmp_path / "friction")}
     assert names == {"vertical_friction.csv", "vertical_friction_stick_intervals.csv", "vertical_friction.png",

@@ -185,9 +185,9 @@ def write_files(result: Result, out_dir: Path) -> list[Path]:
         files = _analysis_files(data["example"], out_dir, "vertical_example", compensated=data["compensated"])
         return files + _friction_files(data["friction"], out_dir)
     if isinstance(result, VerticalResult):
-        if result.analysis is not None:
-            return _analysis_files(result.analysis, out_dir, "vertical")
-        return _quasi_steady_files(result.quasi_steady, out_dir)
+        files = (_analysis_files(result.analysis, out_dir, "vertical") if result.analysis is not None
+                 else _quasi_steady_files(result.quasi_steady, out_dir))
+        return files + (_monte_carlo_files(result.monte_carlo, out_dir) if result.monte_carlo is not None else [])
     if isinstance(result, FrictionResult):
         return _friction_files(result, out_dir)
     raise TypeError(f"vertical writes no files for {type(result).__name__}")
@@ -215,6 +215,16 @@ def _analysis_files(analysis, out_dir: Path, prefix: str, compensated=None) -> l
     if analysis.spectrum is not None:
         files += save_figure_formats(plots.plot_spectrum(analysis), out_dir / f"{prefix}_spectrum")
     return files
+
+
+def _monte_carlo_files(summary, out_dir: Path) -> list[Path]:
+    """Histograms of the members' systematic velocity errors."""
+    from schuler.gyro_vertical import plots
+    from schuler.io import save_figure_formats
+
+    figure = plots.plot_monte_carlo(summary.samples["velocity_error_x_mean_m_s"],
+                                    summary.samples["velocity_error_y_mean_m_s"])
+    return save_figure_formats(figure, out_dir / "vertical_monte_carlo")
 
 
 def _quasi_steady_files(quasi, out_dir: Path) -> list[Path]:
