@@ -205,6 +205,18 @@ def test_memory_is_refused_before_allocating(monkeypatch):
     assert peak < 5 * 2**20
 
 
+def test_a_batch_holds_one_case_histories_at_a_time():
+    values = {"duration": np.full(8, 12 * HOUR), "output_step": np.full(8, 1.0)}
+    peaks = []
+    for n in (1, 8):
+        tracemalloc.start()
+        SYSTEM.evaluate_values({k: v[:n] for k, v in values.items()}, fidelity="closed")
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+    # 43,201 points: about 11 MB per case; eight cases at once must not hold eight cases' histories
+    assert peaks[1] < 1.5 * peaks[0], peaks
+
+
 def test_monte_carlo_of_scenario_draws():
     """A scenario's draws enter ``evaluate`` per member; statistics of the closed forms are exact."""
     draws = []

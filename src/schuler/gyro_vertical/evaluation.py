@@ -240,11 +240,13 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     >>> round(float(out["steady_velocity_error_y_m_s"][0]), 3), bool(np.isnan(out["velocity_error_y_rms_m_s"][0]))
     (0.557, True)
     """
-    return _evaluate(cases)[0]
+    return _evaluate(cases, keep_histories=False)[0]
 
 
-def _evaluate(cases: Cases) -> tuple[dict[str, np.ndarray], list[Any]]:
-    """The outputs of :func:`evaluate`, and per case its analysis (simulated) or quasi-steady error (closed)."""
+def _evaluate(cases: Cases, keep_histories: bool) -> tuple[dict[str, np.ndarray], list[Any]]:
+    """The outputs of :func:`evaluate`, and with ``keep_histories`` per case its analysis (simulated) or
+    quasi-steady error (closed); without, each case's histories are dropped once its outputs are taken, so a
+    batch holds one case's histories at a time."""
     n = len(cases)
     fidelity = cases.fidelity or FIDELITIES[0]
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
@@ -266,13 +268,15 @@ def _evaluate(cases: Cases) -> tuple[dict[str, np.ndarray], list[Any]]:
         if fidelity == "simulated":
             analysis = analyse(model, time)
             _simulated_outputs(out, i, analysis)
-            details.append(analysis)
+            detail: Any = analysis
         else:
             quasi = quasi_steady_response(model, time)
             for axis, values in (("x", quasi.dv_x), ("y", quasi.dv_y)):
                 out[f"quasi_steady_velocity_error_{axis}_mean_m_s"][i] = np.mean(values)
                 out[f"velocity_error_{axis}_mean_m_s"][i] = np.mean(values)
-            details.append(quasi)
+            detail = quasi
+        if keep_histories:
+            details.append(detail)
     # -(0)/g is -0.0: no negative zeros in tables and files
     return {name: values + 0.0 for name, values in out.items()}, details
 
@@ -336,7 +340,7 @@ def run_case(case: Case, fidelity: str | None = None) -> VerticalResult:
     (0.557, 82.45, 'DOP853')
     """
     fidelity = fidelity or FIDELITIES[0]
-    outputs, details = _evaluate(Cases.from_case(case, fidelity=fidelity))
+    outputs, details = _evaluate(Cases.from_case(case, fidelity=fidelity), keep_histories=True)
     values: dict[str, Any] = {name: float(array[0]) for name, array in outputs.items()}
     detail = details[0]
     if fidelity == "simulated":
