@@ -1,4 +1,4 @@
-"""Coulomb friction in the gimbal bearings, eqs. (30)-(32) of source 000 (Drozdovich 1959)."""
+"""Coulomb friction in the gimbal bearings, eqs. (30)-(32) of Drozdovich (1959)."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ SCHULER_PERIOD = 2 * math.pi * math.sqrt(R / G)
 
 
 def test_friction_example_value_and_erratum():
-    # source 000 after (32): M_fr/H = 0.01 / 6.4e6 "~ 1.6e-6 1/s"; the quotient is 1.5625e-9 1/s
+    # Drozdovich (1959) after (32): M_fr/H = 0.01 / 6.4e6 "~ 1.6e-6 1/s"; the quotient is 1.5625e-9 1/s
     q = friction_from_velocity_error(0.01, R)
     assert q == pytest.approx(1.5625e-9)
     assert 1.6e-6 / q == pytest.approx(1024, rel=0.01)
@@ -122,9 +122,18 @@ def test_cli_friction(run_cli, tmp_path):
     out = run_cli("vertical", "friction", "--duration", "6 h", "--json", "--out", tmp_path)
     assert out.code == 0, out.stderr
     data = out.json()
-    assert data["dead_zone_x"] == pytest.approx(0.01)
-    assert data["q_1"] == pytest.approx(1.5625e-9)
-    assert data["max_static_dv_x"] <= 0.01 * (1 + 1e-9)
-    assert (tmp_path / "vertical_friction.png").exists()
+    assert data["dead_zone_x_m_s"] == pytest.approx(0.01)
+    assert data["friction_x_rad_s"] == pytest.approx(1.5625e-9)
+    assert data["max_static_velocity_error_x_m_s"] <= 0.01 * (1 + 1e-9)
+    assert data["inputs"]["duration"] == 6 * 3600.0 and data["inputs"]["initial_beta"] == pytest.approx(
+        math.radians(0.2 / 3600))
+    assert data["units"]["switches"] == "1"
+    for name in ("vertical_friction.png", "vertical_friction.svg", "vertical_friction.csv"):
+        assert (tmp_path / name).exists()
+    human = run_cli("vertical", "friction", "--duration", "3600", "--ramp-acceleration", "1e-4",
+                    "--ramp-duration", "1800")
+    assert human.code == 0 and "dead zone R q (32)" in human.stdout
     bad = run_cli("vertical", "friction", "--dead-zone", "-1")
     assert bad.code == 2 and "--dead-zone" in bad.stderr
+    former = run_cli("vertical", "friction", "--ramp-time", "1")
+    assert former.code == 2 and "--ramp-time" in former.stderr

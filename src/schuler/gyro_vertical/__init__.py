@@ -1,4 +1,8 @@
-"""Gyro vertical with integral correction measuring velocity (Drozdovich, 1959).
+"""Gyro vertical with integral correction measuring velocity.
+
+Source: Drozdovich, V. N., "On an inertial method of measuring velocities",
+Izvestiya VUZ, Priborostroyeniye, no. 3, pp. 29-39, 1959
+(:data:`schuler.references.DROZDOVICH_1959`); equation numbers are the paper's.
 
 - :mod:`~schuler.gyro_vertical.model`: the vehicle on a great circle of the rotating
   Earth, the accelerations (19)/(21), the equations of the vertical (5)-(13) with
@@ -8,6 +12,9 @@
   analysis and mode fit of simulations.
 - :mod:`~schuler.gyro_vertical.friction`: Coulomb friction (30)-(32) with exact
   stick/slip switching.
-- :mod:`~schuler.gyro_vertical.reproduction`: the source's worked example and errata.
-- :mod:`~schuler.gyro_vertical.api`: ``run``, ``reproduce``, ``report``, ``sweep``, ``SYSTEM``.
+- :mod:`~schuler.gyro_vertical.evaluation`: parameters, outputs, ``evaluate``, ``run_case``.
+- :mod:`~schuler.gyro_vertical.actions`: the ``friction`` command.
+- :mod:`~schuler.gyro_vertical.reproduction`: the source's worked example and errata, ``report``.
+- :mod:`~schuler.gyro_vertical.results`: the result types and ``write_files``.
+- :mod:`~schuler.gyro_vertical.api`: ``SYSTEM`` (``schuler vertical``).
 """

@@ -1,5 +1,7 @@
 """Coulomb friction in the gimbal bearings, eqs. (30)-(32), solved as a differential inclusion.
 
+Equation numbers are those of Drozdovich (1959) (:data:`schuler.references.DROZDOVICH_1959`).
+
 With the simplest base motion (no Earth rotation, Schuler-tuned) the vertical obeys
 
     beta'  = Delta v_x / R - q_1 sign(alpha'),      Delta v_x' = -g beta + W_x(t),

@@ -709,7 +709,8 @@ class GyroVertical:
                                  rtol=RTOL, atol=atol)
             if not solution.success:
                 raise SimulationError(f"gyro vertical ODE solve failed: {solution.message}")
-            out[inside] = solution.sol(t[inside]).T
+            if inside.any():  # a piece shorter than the output step may hold no output time
+                out[inside] = solution.sol(t[inside]).T
             nfev += solution.nfev
             n_steps += solution.t.size - 1
             state = solution.y[:, -1]

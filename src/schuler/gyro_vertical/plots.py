@@ -22,16 +22,20 @@ def _figure(rows: int, height: float = 2.6):
     return fig, axes[:, 0]
 
 
-def _dress(axis, ylabel: str, legend_location: str | None = "upper right") -> None:
+def _dress(axis, ylabel: str, legend_location: str | None = "outside") -> None:
+    """Label and grid; the legend beside the axes (``"outside"``: off the data), at a location, or none."""
     axis.set_ylabel(ylabel)
     axis.grid(True, alpha=0.3)
-    if legend_location:
+    if legend_location == "outside":
+        axis.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    elif legend_location:
         axis.legend(loc=legend_location, fontsize=8)
 
 
 def _finish(fig, axes, title: str, xlabel: str = "time [h]"):
     axes[0].set_title(title)
     axes[-1].set_xlabel(xlabel)
+    fig.tight_layout()  # no label clipped at the figure's edge
     return fig
 
 
@@ -65,6 +69,44 @@ def plot_velocity_errors(analysis, compensated=None, title: str = "Gyro vertical
     return _finish(fig, axes, title)
 
 
+def plot_quasi_steady(quasi, title: str = "Gyro vertical: quasi-steady velocity errors (29)"):
+    """Forced tilts (26) (arcmin) and the quasi-steady errors (29) (m/s) of a closed-form run."""
+    hours = quasi.time / HOUR
+    fig, axes = _figure(2)
+    axes[0].plot(hours, quasi.alpha_r / ARCMIN, color="C0", lw=1.2, label="alpha_r")
+    axes[0].plot(hours, quasi.beta_r / ARCMIN, color="C1", lw=1.2, label="beta_r")
+    for name, forced, slow, colour in (("Delta v_x", quasi.dv_x, quasi.slow_dv_x, "C0"),
+                                       ("Delta v_y", quasi.dv_y, quasi.slow_dv_y, "C1")):
+        axes[1].plot(hours, forced, color=colour, lw=1.2, label=f"{name} (29)")
+        axes[1].plot(hours, slow, ":", color=colour, lw=1.4, label=f"{name} slowly varying")
+    _dress(axes[0], "forced tilt [arcmin]")
+    _dress(axes[1], "velocity error [m/s]")
+    return _finish(fig, axes, title)
+
+
+def plot_monte_carlo(samples_x, samples_y, title: str = "Monte Carlo: systematic velocity errors"):
+    """Histograms of the members' mean velocity errors Delta v_x and Delta v_y (m/s), each on its own axis."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1, figsize=(9, 5.6))
+    for axis, name, samples in zip(axes, ("Delta v_x", "Delta v_y"), (samples_x, samples_y)):
+        values = np.asarray(samples, dtype=float)
+        values = values[np.isfinite(values)]
+        if values.size and np.ptp(values) > 1e-12 * max(np.max(np.abs(values)), 1e-300):
+            axis.hist(values, bins=min(60, max(10, values.size // 25)), alpha=0.7, label=f"{values.size} members")
+        else:  # nothing to bin: every member has the same value (or none)
+            for value in values[:1]:
+                axis.axvline(value, lw=2, label=f"the same in all {values.size} members: {value:.4g} m/s")
+        _dress(axis, "members")
+        axis.set_xlabel(f"mean {name} over the run [m/s]")
+    axes[0].set_title(title)
+    fig.tight_layout()
+    return fig
+
+
 def plot_spectrum(analysis, title: str = "Spectrum of the velocity-error oscillation"):
     """Amplitude of u = Delta v_x - i Delta v_y minus (29) against signed frequency (cycles/h)."""
     fig, axes = _figure(1, height=3.6)
@@ -78,7 +120,7 @@ def plot_spectrum(analysis, title: str = "Spectrum of the velocity-error oscilla
     axis.axvline(HOUR / 86400, color="C3", ls=":", lw=1.0, label="24 h (source's claim)")
     axis.axvline(-HOUR / 86400, color="C3", ls=":", lw=1.0)
     axis.plot([], [], color="C1", ls="--", label="eigenvalues (split Schuler modes)")
-    _dress(axis, "amplitude [m/s]", "best")
+    _dress(axis, "amplitude [m/s]", "upper center")  # between the mode lines; "best" is slow on long spectra
     return _finish(fig, axes, title, "frequency [cycles/h] (sign: sense of rotation of the error vector)")
 
 

@@ -1,5 +1,8 @@
 """Quasi-steady velocity error (28)/(29), the split Schuler modes, and their identification.
 
+Equation numbers are those of Drozdovich (1959) (:data:`schuler.references.DROZDOVICH_1959`);
+frames and signs are the model's (:mod:`schuler.gyro_vertical.model`).
+
 Closed forms (all vectorised over arrays of cases):
 
 * :func:`steady_errors`: the slowly-varying approximation of (29) at a point of the
@@ -377,10 +380,11 @@ class Analysis:
     response : VerticalResponse
     quasi_steady : QuasiSteady
     spectrum : Spectrum or None
-        Of the oscillation (simulation minus forced motion); None for short records.
+        Of the oscillation (simulation minus forced motion); None for short or coarsely sampled records.
     fit : ModeFit or None
         The two split Schuler modes fitted to the oscillation; None when there is no
-        oscillation to speak of or the record is shorter than two Schuler periods.
+        oscillation to speak of, the record is shorter than two Schuler periods, or
+        its output step is not below half the faster period (the modes would alias).
     eigen_periods : ndarray
         Periods (s) of the error model's modes at the mean omega_2, fastest first.
     """
@@ -416,10 +420,12 @@ def analyse(vertical: GyroVertical, time, method: str = "auto") -> Analysis:
     periods = 2 * np.pi / eigen
     ox, oy = Analysis(response, q, None, None, periods).oscillation
     uniform = np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0)
-    spectrum = velocity_error_spectrum(t, ox, oy) if uniform and t[-1] >= 2 * periods[-1] else None
+    # the modes are seen only in a record of two slow periods sampled below half the fast one (no aliasing)
+    resolved = t.size >= 8 and np.max(np.diff(t)) < periods[0] / 2 and t[-1] >= 2 * periods[-1]
+    spectrum = velocity_error_spectrum(t, ox, oy) if uniform and resolved else None
     fit = None
     moving = np.sqrt(np.mean(ox**2 + oy**2)) > 1e-9
-    if moving and t[-1] >= 2 * periods[-1]:
+    if moving and resolved:
         # sign of each mode on the complex axis: the fast one turns with omega_2
         signs = (1.0, -1.0) if omega_2 >= 0 else (-1.0, 1.0)
         guesses = [s * w for s, w in zip(signs, eigen)]

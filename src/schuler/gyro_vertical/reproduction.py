@@ -1,10 +1,12 @@
 """The source's worked example and friction estimate, recomputed, with its errata flagged.
 
-Drozdovich (1959), "On an inertial method of measuring velocities" (JPRS 2912):
-v_y = 10 m/s, v_x = 0, phi = 60 deg, R = 6.4e6 m, Omega = 7.3e-5 1/s,
-psi + gamma = 0 (here theta = 0, gamma = 90 deg: x0 north, v due west), and
-g = 9.81 m/s^2 (the source gives none). All constants are the
-:data:`~schuler.core.earth.DROZDOVICH` preset.
+Source: Drozdovich, "On an inertial method of measuring velocities" (1959)
+(:data:`schuler.references.DROZDOVICH_1959`); equation numbers are the paper's.
+The worked example after (29): v_y = 10 m/s, v_x = 0, phi = 60 deg,
+R = 6.4e6 m, Omega = 7.3e-5 1/s, psi + gamma = 0 (here theta = 0, gamma = 90 deg:
+x0 north, the velocity due west) and g = 9.81 m/s^2 (the source gives none): the
+:data:`~schuler.core.earth.DROZDOVICH` constants. Every printed value below is
+copied as the source prints it; the verdicts follow from the stated tolerances.
 
 Examples
 --------
@@ -16,37 +18,35 @@ Examples
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import ClassVar
+from pathlib import Path
 
-import numpy as np
-
+from schuler.contract import FigureRef, ReportSection
 from schuler.core.earth import DROZDOVICH, EarthModel
+from schuler.gyro_vertical.actions import friction
+from schuler.gyro_vertical.evaluation import PARAMETERS, run_case
 from schuler.gyro_vertical.friction import friction_from_velocity_error
-from schuler.gyro_vertical.model import GreatCircleTrajectory, GyroVertical, transport_coriolis_acceleration
-from schuler.gyro_vertical.quasi_steady import Analysis, analyse, split_schuler_frequencies, steady_errors
-from schuler.registry import ReproductionRow
-from schuler.results import Footnotes, Result
+from schuler.gyro_vertical.model import GreatCircleTrajectory, transport_coriolis_acceleration
+from schuler.gyro_vertical.quasi_steady import steady_errors
+from schuler.gyro_vertical.results import write_files
+from schuler.references import DROZDOVICH_1959
+from schuler.reproduction import Reproduction, Tolerance, compare
+from schuler.units import from_unit, to_unit
 
-SOURCE = "Drozdovich (1959), 'On an inertial method of measuring velocities', JPRS 2912 (source 000)"
 LATITUDE = math.radians(60.0)
 SPEED = 10.0
 FRICTION_VELOCITY_ERROR = 0.01
-PRINTED = {
-    "W_star_x": 0.0136,
-    "beta_r": 0.0014,
-    "dv_y": 0.67,
-    "schuler_period_min": 84.4,
-    "friction_q": 1.6e-6,
-}
-"""Numbers as printed in the source (m/s^2, rad, m/s, min, 1/s)."""
-
-LEVELLING_ERROR = math.radians(1.0 / 3600)
+"""|Delta v| = 0.01 m/s of the friction example after (32), m/s."""
+LEVELLING_ERROR = from_unit(1.0, "arcsec")
 """A 1-arcsec levelling error about y in both compensation runs, rad: without any
 error the compensated run is identically zero and a ratio of means says nothing."""
-SIMULATION_HOURS = 48.0
+FRICTION_TILT = from_unit(0.2, "arcsec")
+"""Initial tilt of the friction simulation, rad (small enough to start inside the dead zone)."""
+SIMULATED_TIME = 48 * 3600.0
 OUTPUT_STEP = 10.0
-DEG_PER_HOUR = math.pi / 180 / 3600
+FRICTION_TIME = 12 * 3600.0
+"""Simulated time of the friction example, s: the stick phase ends after about 1,050 s, and eight
+Schuler periods show the growth of the slip."""
+EXAMPLE = "worked example after (29)"
 
 
 def worked_example(earth: EarthModel = DROZDOVICH, latitude: float = LATITUDE, speed: float = SPEED) -> dict:
@@ -65,8 +65,8 @@ def worked_example(earth: EarthModel = DROZDOVICH, latitude: float = LATITUDE, s
     -------
     dict of float
         ``W_star_x``, ``W_star_y`` (m/s^2), ``alpha_r``, ``beta_r`` (rad), ``dv_x``,
-        ``dv_y`` (m/s), ``source_chain_dv_y``: the source's own rounded chain
-        6.4e6 x 7.3e-5 x 0.87 x 1.4e-3 (m/s).
+        ``dv_y`` (m/s), and the source's own rounded arithmetic: ``source_chain_W_star_x``
+        (sin 60 deg = 0.87, m/s^2) and ``source_chain_dv_y`` = 6.4e6 x 7.3e-5 x 0.87 x 1.4e-3 (m/s).
     """
     path = GreatCircleTrajectory.from_source(latitude, speed, radius=earth.radius, rate=earth.rate, frozen=True)
     kinematics = path.kinematics(0.0)
@@ -74,168 +74,172 @@ def worked_example(earth: EarthModel = DROZDOVICH, latitude: float = LATITUDE, s
     steady = steady_errors(W_x, W_y, float(kinematics.omega_2), earth.gravity, earth.radius)
     values = {"W_star_x": W_x, "W_star_y": W_y}
     values.update({key: float(value) for key, value in steady.items()})
-    values["source_chain_dv_y"] = earth.radius * earth.rate * 0.87 * PRINTED["beta_r"]
+    values["source_chain_W_star_x"] = 6.4e6 * 7.3**2 * 0.87 * 0.5 * 1e-10 - 2 * 7.3 * 0.87 * 1e-5 * 10
+    values["source_chain_dv_y"] = 6.4e6 * 7.3e-5 * 0.87 * 1.4e-3
     return values
 
 
-@dataclass
-class VerticalReproduction(Result):
-    """The worked example, the oscillation modes and the friction estimate, recomputed."""
-
-    W_star_x: float
-    W_star_y: float
-    alpha_r: float
-    beta_r: float
-    dv_x: float
-    dv_y: float
-    printed_dv_y: float
-    printed_W_star_x: float
-    printed_beta_r: float
-    source_chain_dv_y: float
-    schuler_period_min: float
-    printed_schuler_period_min: float
-    split_period_fast_min: float
-    split_period_slow_min: float
-    beat_period_h: float
-    printed_periods: str
-    simulated_period_fast_min: float
-    simulated_period_slow_min: float
-    simulated_beat_period_h: float
-    amplitude_24h: float
-    mode_amplitude: float
-    simulated_mean_dv_y: float
-    quasi_steady_mean_dv_y: float
-    compensated_mean_dv: float
-    compensation_ratio: float
-    friction_velocity_error: float
-    friction_q: float
-    friction_q_deg_per_h: float
-    printed_friction_q: float
-    constants: str
-    errata: list[str]
-    analysis: Analysis = field(repr=False)
-    compensated: Analysis = field(repr=False)
-
-    units: ClassVar[dict[str, str]] = {
-        "W_star_x": "m/s^2", "W_star_y": "m/s^2", "alpha_r": "rad", "beta_r": "rad", "dv_x": "m/s",
-        "dv_y": "m/s", "printed_dv_y": "m/s", "printed_W_star_x": "m/s^2", "printed_beta_r": "rad",
-        "source_chain_dv_y": "m/s", "amplitude_24h": "m/s", "mode_amplitude": "m/s",
-        "simulated_mean_dv_y": "m/s", "quasi_steady_mean_dv_y": "m/s", "compensated_mean_dv": "m/s",
-        "friction_velocity_error": "m/s", "friction_q": "1/s", "printed_friction_q": "1/s",
-    }
-
-    def rows(self) -> list[ReproductionRow]:
-        """Printed value beside the computed one, for the table and the report."""
-        def close(computed, printed, digits):
-            return round(computed, digits) == round(printed, digits)
-
-        return [
-            ReproductionRow("W*_x (21)", self.printed_W_star_x, self.W_star_x, "m/s^2",
-                            abs(self.W_star_x / self.printed_W_star_x - 1) < 0.01,
-                            "source rounds sin 60 = 0.87 (gives 0.01357); exact 0.01350"),
-            ReproductionRow("beta_r = W*_x / g", self.printed_beta_r, self.beta_r, "rad",
-                            close(self.beta_r, self.printed_beta_r, 4), "g = 9.81 m/s^2 assumed"),
-            ReproductionRow("Delta v_y = R omega_2 beta_r (29)", self.printed_dv_y, self.dv_y, "m/s",
-                            close(self.dv_y, self.printed_dv_y, 2),
-                            f"ERRATUM: the source's own chain gives {self.source_chain_dv_y:.3f} m/s; "
-                            "0.67 is a misprint of 0.57"),
-            ReproductionRow("Delta v_x", 0.0, self.dv_x, "m/s", abs(self.dv_x) < 1e-9, ""),
-            ReproductionRow("Schuler period 2 pi sqrt(R/g)", self.printed_schuler_period_min,
-                            self.schuler_period_min, "min", close(self.schuler_period_min, 84.4, 1),
-                            "84.4 min belongs to R = 6.371e6 m; R = 6.4e6 m gives 84.6 min"),
-            ReproductionRow("oscillation periods (27)", self.printed_periods,
-                            self.split_period_fast_min, "min", False,
-                            f"ERRATUM: split Schuler modes {self.split_period_fast_min:.2f} and "
-                            f"{self.split_period_slow_min:.2f} min (simulated {self.simulated_period_fast_min:.2f}, "
-                            f"{self.simulated_period_slow_min:.2f}), beating with 2 pi/(Omega sin phi) = "
-                            f"{self.beat_period_h:.1f} h; no 24 h line (its amplitude {self.amplitude_24h:.1e} m/s)"),
-            ReproductionRow("M_fr / H for |Delta v| = 0.01 m/s (32)", self.printed_friction_q, self.friction_q,
-                            "1/s", close(self.friction_q, self.printed_friction_q, 8),
-                            f"ERRATUM: 0.01 / 6.4e6 = 1.56e-9 1/s ({self.friction_q_deg_per_h:.1e} deg/h), "
-                            "not 1.6e-6; (32) as printed drops the factor R"),
-            ReproductionRow("mean |Delta v| with W* compensated (conclusions)", "removed",
-                            self.compensated_mean_dv, "m/s", self.compensation_ratio >= 100,
-                            f"{self.compensation_ratio:.0f} times smaller than without (both runs with a "
-                            "1-arcsec levelling error)"),
-        ]
-
-    def render(self):
-        from rich.console import Group
-        from rich.table import Table
-
-        table = Table(title=f"Gyro vertical: worked example of {SOURCE}")
-        for column in ("quantity", "source", "computed", "unit", "agrees", "note"):
-            table.add_column(column, overflow="fold")
-        # notes are long: the table refers to them by number and lists them below it
-        footnotes = Footnotes()
-        for row in self.rows():
-            printed = row.printed if isinstance(row.printed, str) else f"{row.printed:.4g}"
-            table.add_row(row.quantity, printed, f"{row.computed:.4g}", row.unit, "yes" if row.agrees else "NO",
-                          footnotes.reference(row.note))
-        return Group(table, *footnotes.lines(), f"Constants: {self.constants}")
+def _example_case(**changes):
+    return PARAMETERS.case(latitude=LATITUDE, speed=SPEED, earth="drozdovich", duration=SIMULATED_TIME,
+                           output_step=OUTPUT_STEP, **changes)
 
 
-def mean_velocity_error(response) -> float:
-    """Magnitude of the time-averaged velocity-error vector (the systematic error), m/s."""
-    return float(np.hypot(np.mean(response.velocity_error_x), np.mean(response.velocity_error_y)))
+def _mean_error(result) -> float:
+    """Magnitude of the mean velocity-error vector (the systematic error) of a run, m/s."""
+    return math.hypot(result.velocity_error_x_mean_m_s, result.velocity_error_y_mean_m_s)
 
 
-def reproduce(earth: EarthModel = DROZDOVICH) -> VerticalReproduction:
+def reproduce() -> Reproduction:
     """Recompute the worked example, simulate it for 48 h along its great circle, and check the errata.
 
     The simulation starts levelled on the accelerometers with the integrators
     preset to the true velocity. The source's conclusion is checked by two more
     runs, with and without the transport and Coriolis terms compensated, both
-    with a 1-arcsec levelling error (:data:`LEVELLING_ERROR`).
+    with a 1-arcsec levelling error (:data:`LEVELLING_ERROR`); the friction
+    example by a simulation of (30) with the dead zone the source assumes.
     """
+    earth = DROZDOVICH
     example = worked_example(earth)
-    omega_2 = earth.rate * math.sin(LATITUDE)
-    fast, slow = (float(w) for w in split_schuler_frequencies(earth.gravity, earth.radius, omega_2))
-    time = np.arange(0.0, SIMULATION_HOURS * 3600 + OUTPUT_STEP / 2, OUTPUT_STEP)
-    path = GreatCircleTrajectory.from_source(LATITUDE, SPEED, radius=earth.radius, rate=earth.rate)
-    analysis = analyse(GyroVertical(path, earth.gravity), time)
-    tilt = (0.0, LEVELLING_ERROR)
-    uncompensated = GyroVertical(path, earth.gravity, initial_tilt=tilt).simulate(time)
-    compensated = analyse(GyroVertical(path, earth.gravity, transport_coriolis_compensation=True,
-                                       initial_tilt=tilt), time)
-    fit = analysis.fit
-    simulated = np.sort(fit.periods)
-    r, rc = analysis.response, compensated.response
-    mean_error = mean_velocity_error(uncompensated)
-    mean_compensated = mean_velocity_error(rc)
+    run = run_case(_example_case())
+    tilted = run_case(_example_case(initial_beta=LEVELLING_ERROR))
+    compensated = run_case(_example_case(initial_beta=LEVELLING_ERROR, compensation="trajectory"))
+    stuck = friction(dead_zone=FRICTION_VELOCITY_ERROR, initial_beta=FRICTION_TILT, duration=FRICTION_TIME,
+                     output_step=OUTPUT_STEP)
     q = float(friction_from_velocity_error(FRICTION_VELOCITY_ERROR, earth.radius))
-    return VerticalReproduction(
-        W_star_x=example["W_star_x"], W_star_y=example["W_star_y"], alpha_r=example["alpha_r"],
-        beta_r=example["beta_r"], dv_x=example["dv_x"], dv_y=example["dv_y"], printed_dv_y=PRINTED["dv_y"],
-        printed_W_star_x=PRINTED["W_star_x"], printed_beta_r=PRINTED["beta_r"],
-        source_chain_dv_y=example["source_chain_dv_y"],
-        schuler_period_min=2 * math.pi * math.sqrt(earth.radius / earth.gravity) / 60,
-        printed_schuler_period_min=PRINTED["schuler_period_min"],
-        split_period_fast_min=2 * math.pi / fast / 60, split_period_slow_min=2 * math.pi / slow / 60,
-        beat_period_h=2 * math.pi / (fast - slow) / 3600, printed_periods="24 h and 84.4 min",
-        simulated_period_fast_min=float(simulated[0]) / 60, simulated_period_slow_min=float(simulated[1]) / 60,
-        simulated_beat_period_h=float(2 * math.pi / abs(abs(fit.frequencies[0]) - abs(fit.frequencies[1])) / 3600),
-        amplitude_24h=max(analysis.spectrum.amplitude_at(1 / 86400), analysis.spectrum.amplitude_at(-1 / 86400)),
-        mode_amplitude=float(fit.amplitudes.max()),
-        simulated_mean_dv_y=float(np.mean(r.velocity_error_y)),
-        quasi_steady_mean_dv_y=float(np.mean(analysis.quasi_steady.dv_y)),
-        compensated_mean_dv=mean_compensated,
-        compensation_ratio=mean_error / mean_compensated,
-        friction_velocity_error=FRICTION_VELOCITY_ERROR, friction_q=q, friction_q_deg_per_h=q / DEG_PER_HOUR,
-        printed_friction_q=PRINTED["friction_q"],
-        constants=f"R = {earth.radius:g} m, g = {earth.gravity:g} m/s^2, Omega = {earth.rate:g} 1/s, "
-                  f"phi = 60 deg, v = 10 m/s due west (theta = 0, gamma = 90 deg); "
-                  f"simulation {SIMULATION_HOURS:g} h along the great circle, output every {OUTPUT_STEP:g} s",
-        errata=[
-            f"Delta v_y: printed 0.67 m/s; R omega_2 beta_r = {example['dv_y']:.3f} m/s "
-            f"(the source's rounded chain gives {example['source_chain_dv_y']:.3f} m/s).",
-            f"Friction: printed M_fr/H = 1.6e-6 1/s; 0.01/6.4e6 = {q:.3g} 1/s. Eq. (32) drops the factor R.",
-            "Periods: printed '24 h and 84.4 min'; the modes are the split Schuler periods "
-            f"{2 * math.pi / fast / 60:.2f} and {2 * math.pi / slow / 60:.2f} min beating every "
-            f"{2 * math.pi / (fast - slow) / 3600:.1f} h (2 pi / (Omega sin phi)); there is no 24-h mode.",
-            f"Schuler period: 84.4 min needs R = 6.371e6 m; with R = 6.4e6 m and g = 9.81 it is "
-            f"{2 * math.pi * math.sqrt(earth.radius / earth.gravity) / 60:.2f} min.",
+    spectrum, fit = run.analysis.spectrum, run.analysis.fit
+    line_24h = max(spectrum.amplitude_at(1 / 86400), spectrum.amplitude_at(-1 / 86400))
+    mode_amplitude = float(fit.amplitudes.max())
+    schuler = 2 * math.pi * math.sqrt(earth.radius / earth.gravity)
+    schuler_mean_radius = 2 * math.pi * math.sqrt(6.371e6 / earth.gravity)
+    fast, slow = run.split_period_fast_s, run.split_period_slow_s
+    ratio = _mean_error(tilted) / _mean_error(compensated)
+    minutes, hours = (lambda s: float(to_unit(s, "min"))), (lambda s: float(to_unit(s, "h")))
+    splitting = (f"with the torques (8) the vertical Earth rate omega_2 splits the Schuler period into "
+                 f"{minutes(fast):.2f} and {minutes(slow):.2f} min (eigenvalues of (27); fitted to the 48-h "
+                 f"simulation: {minutes(run.fitted_period_fast_s):.2f} and {minutes(run.fitted_period_slow_s):.2f} "
+                 f"min), sqrt(g/R + omega_2^2/4) +- omega_2/2")
+    rows = [
+        compare("W*_x (21), the source's arithmetic (sin 60 deg = 0.87)", example["source_chain_W_star_x"], "m/s^2",
+                printed="0.0136", where=EXAMPLE, tolerance=Tolerance(0.0, 5e-5),
+                note="the printed chain 6.4e6 x 7.3^2 x 0.87 x 0.5 x 1e-10 - 2 x 7.3 x 0.87 x 1e-5 x 10, "
+                     "within the rounding of the last printed digit"),
+        compare("W*_x (21)", example["W_star_x"], "m/s^2", printed="0.0136", where=EXAMPLE,
+                tolerance=Tolerance(0.01), note="exact sin 60 deg; the source's 0.87 moves the third digit"),
+        compare("W*_y (21)", example["W_star_y"], "m/s^2", printed="0", where=EXAMPLE,
+                tolerance=Tolerance(0.0, 1e-12)),
+        compare("alpha_r = -W*_y / g", example["alpha_r"], "rad", printed="0", where=EXAMPLE,
+                tolerance=Tolerance(0.0, 1e-12)),
+        compare("beta_r = W*_x / g", example["beta_r"], "rad", printed="0.0014", where=EXAMPLE,
+                tolerance=Tolerance(0.0, 5e-5),
+                note="g = 9.81 m/s^2 assumed (the source gives none); within the rounding of the printed digit"),
+        compare("Delta v_y = R omega_2 beta_r (29)", example["dv_y"], "m/s", printed="0.67", where=EXAMPLE,
+                tolerance=Tolerance(0.01),
+                erratum=f"the source's own chain 6.4e6 x 7.3e-5 x 0.87 x 1.4e-3 gives "
+                        f"{example['source_chain_dv_y']:.3f} m/s; 0.67 is a misprint of 0.57"),
+        compare("Delta v_x (29)", example["dv_x"], "m/s", printed="0", where=EXAMPLE,
+                tolerance=Tolerance(0.0, 1e-9)),
+        compare("mean Delta v_y of the 48-h simulation along the great circle", run.velocity_error_y_mean_m_s, "m/s",
+                note=f"oscillates about the quasi-steady error (29), whose mean is "
+                     f"{run.quasi_steady_velocity_error_y_mean_m_s:.4f} m/s; the path turns, so it drifts from the "
+                     f"slowly-varying {example['dv_y']:.3f} m/s"),
+        compare("Schuler period 2 pi sqrt(R/g)", minutes(schuler), "min", printed="84.4 min", where="after (12)",
+                tolerance=Tolerance(0.0, 0.05),
+                erratum=f"84.4 min belongs to R = 6.371e6 m ({minutes(schuler_mean_radius):.2f} min); the "
+                        f"example's R = 6.4e6 m gives {minutes(schuler):.2f} min"),
+        compare("long period of the error oscillation about the forced motion", hours(run.beat_period_s), "h",
+                printed="24 hours", where="after (27)",
+                erratum=f"there is no 24-h mode: the split modes beat every 2 pi/(Omega sin phi) = "
+                        f"{hours(run.beat_period_s):.1f} h (shown); the simulated spectrum's 24-h line is "
+                        f"{line_24h:.1e} m/s against {mode_amplitude:.2f} m/s for the modes"),
+        compare("short period of the error oscillation: fast split mode (simulated)",
+                minutes(run.fitted_period_fast_s), "min", printed="84.4 min", where="after (27)", erratum=splitting),
+        compare("short period of the error oscillation: slow split mode (simulated)",
+                minutes(run.fitted_period_slow_s), "min", printed="84.4 min", where="after (27)", erratum=splitting),
+        compare("M_fr / H for |Delta v| = 0.01 m/s (32)", q, "1/s", printed="1.6 · 10^-6", where="after (32)",
+                erratum=f"0.01 / 6.4e6 = {q:.3g} 1/s ({float(to_unit(q, 'deg/h')):.1e} deg/h), not 1.6e-6; (32) "
+                        "as printed drops the factor R: |Delta v_i| = R M_fr / H"),
+        compare("largest static velocity error of the friction simulation (32)",
+                stuck.max_static_velocity_error_x_m_s, "m/s", printed="0.01", where="after (32)",
+                tolerance=Tolerance(1e-6),
+                tuned="q = M_fr / H was set to 0.01 m/s / R from this value; the simulation of (30) confirms the "
+                      "static errors stay within +-R q and reach its edge",
+                note=f"{hours(FRICTION_TIME):g} h from a {to_unit(FRICTION_TILT, 'arcsec'):g}-arcsec tilt; stick "
+                     f"intervals: {stuck.stick_intervals}"),
+        compare("mean |Delta v| with W* compensated (conclusions)", _mean_error(compensated), "m/s",
+                note=f"{ratio:.0f} times smaller than without compensation (both runs 48 h with a 1-arcsec "
+                     "levelling error): the source's 'additional devices' remove the systematic error"),
+    ]
+    return Reproduction(
+        system="vertical",
+        source=DROZDOVICH_1959.citation,
+        constants=f"R = {earth.radius:g} m, g = {earth.gravity:g} m/s^2 (assumed; the source gives none), "
+                  f"Omega = {earth.rate:g} 1/s; phi = 60 deg, v = 10 m/s due west (theta = 0, gamma = 90 deg); "
+                  f"simulation {hours(SIMULATED_TIME):g} h along the great circle, output every {OUTPUT_STEP:g} s",
+        rows=rows,
+        notes=[
+            "The source's verbal angle definitions contradict its example; one azimuth theta = psi + gamma of the "
+            "x0 axis is used in the torques (8) and the accelerations (19), (21) alike.",
+            "The step from (13) to (24) needs the integrators preset to the true initial velocity; the simulations "
+            "start so, levelled on the accelerometers.",
+            "Friction: in (30) each bearing's friction precesses the other axis, so both gimbals stick together "
+            "exactly when |Delta v_x| <= R q_1 and |Delta v_y| <= R q_2; in slip the friction drives the other "
+            "Schuler loop in resonance and the velocity-error amplitudes grow by 2 q_i sqrt(g R)/pi per second "
+            "(4 R q_i per Schuler period).",
         ],
-        analysis=analysis,
-        compensated=compensated,
+        details={
+            "W_star_x_m_s2": example["W_star_x"], "beta_r_rad": example["beta_r"], "dv_y_m_s": example["dv_y"],
+            "source_chain_dv_y_m_s": example["source_chain_dv_y"], "schuler_period_s": schuler,
+            "split_period_fast_s": fast, "split_period_slow_s": slow, "beat_period_s": run.beat_period_s,
+            "fitted_period_fast_s": run.fitted_period_fast_s, "fitted_period_slow_s": run.fitted_period_slow_s,
+            "line_24h_amplitude_m_s": line_24h, "mode_amplitude_m_s": mode_amplitude,
+            "simulated_mean_dv_y_m_s": run.velocity_error_y_mean_m_s,
+            "quasi_steady_mean_dv_y_m_s": run.quasi_steady_velocity_error_y_mean_m_s,
+            "compensated_mean_dv_m_s": _mean_error(compensated), "compensation_ratio": ratio,
+            "friction_q_rad_s": q, "friction_max_static_dv_x_m_s": stuck.max_static_velocity_error_x_m_s,
+        },
+        data={"example": run.analysis, "compensated": compensated.analysis, "friction": stuck},
+    )
+
+
+CAPTIONS = {
+    "vertical_example_tilts": "Tilts of the worked example (60 deg, 10 m/s due west, 48 h on the great circle) "
+                              "about the forced motion (26).",
+    "vertical_example_velocity_errors": "Velocity errors: simulation, the quasi-steady error (29), its slowly-varying "
+                                        "form, and the run with W* compensated (with a 1-arcsec levelling error, "
+                                        "hence its small oscillation).",
+    "vertical_example_spectrum": "Spectrum of the oscillation about (29): the split Schuler lines at 82.5 and "
+                                 "86.8 min on either side of zero; nothing at 24 h.",
+    "vertical_friction": "Coulomb friction (30), q = 0.01 m/s / R on both axes, initial tilt 0.2 arcsec: stick while "
+                         "the integrator crosses the dead zone, then slip whose amplitude grows by 4 R q per Schuler "
+                         "period.",
+}
+
+
+def report(figures_dir: Path) -> ReportSection:
+    """The reproduction, its figures (worked example, spectrum, friction) and the commands (a few seconds)."""
+    reproduction = reproduce()
+    files = write_files(reproduction, Path(figures_dir))
+    figures = [FigureRef(path.name, CAPTIONS[path.stem]) for path in files if path.suffix == ".png"]
+    return ReportSection(
+        system="vertical",
+        title="Gyro vertical with integral correction measuring velocity",
+        source=reproduction.source,
+        summary=("A gyro vertical whose accelerometer integrators drive its torquers (integral correction, "
+                 "Schuler-tuned) measures velocity. Moving along a great circle on the rotating Earth, the "
+                 "transport and Coriolis accelerations leave a systematic velocity error (0.557 m/s in the "
+                 "source's example, printed as 0.67) and split Schuler oscillations that beat every "
+                 "2 pi/(Omega sin phi); compensating them from the trajectory removes the systematic error. "
+                 "Coulomb friction leaves static errors within +-R q, but its coupled slip is self-exciting."),
+        rows=reproduction.rows,
+        figures=figures,
+        commands=[
+            "schuler vertical reproduce --out DIR",
+            "schuler vertical run --latitude 60 --speed 10 --earth drozdovich --duration '48 h' --out DIR",
+            "schuler vertical run --latitude 60 --earth drozdovich --fidelity closed",
+            "schuler vertical friction --initial-beta '0.2 arcsec' --duration '48 h' --out DIR",
+            "schuler sweep examples/vertical_gyro_vertical.toml --param latitude=0:80:20 --out DIR",
+        ],
+        notes=reproduction.notes + [
+            "Scale up: 'schuler vertical run --duration \"720 h\" --output-step 10' simulates 30 days.",
+        ],
     )
