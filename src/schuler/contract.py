@@ -341,6 +341,9 @@ class System:
         case = self.case(**si_values)
         fidelity = self.check_fidelity(fidelity)
         members = _count(monte_carlo, "monte_carlo")
+        if members and not self.random_terms and draw is None:
+            raise InvalidParameter("monte_carlo", f"{self.name} has no random terms of its own: every member would be "
+                                   "the nominal case; draw parameters with a scenario's [monte_carlo] tables")
         streams = RandomStreams(_count(seed, "seed"))
         result = self.run_case(case, fidelity)
         if members:

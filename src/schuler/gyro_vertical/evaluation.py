@@ -125,7 +125,9 @@ PARAMETERS = ParameterSet((
     Parameter("trajectory", "", "great-circle", "Move along the great circle, or freeze latitude and azimuth "
               "(the source's slowly-varying assumption; exact matrix-exponential solution).",
               choices=("great-circle", "frozen"), kind="choice"),
-), owner="vertical", exclusive=(("speed", "speed_profile"),))
+), owner="vertical", exclusive=(("speed", "speed_profile"),), renamed={
+    "accelerometer_bias_x": "accel_bias_x", "accelerometer_bias_y": "accel_bias_y", "gyro_drift_x": "drift_x",
+    "gyro_drift_y": "drift_y", "step": "output_step"})
 """Every option of ``schuler vertical run`` (and key of a ``vertical`` scenario)."""
 
 FIDELITIES = ("simulated", "closed")
