@@ -10,7 +10,8 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from schuler.core.earth import EARTH_RATE
-from schuler.drift_calibration.error_budget import NONE, TYPICAL, monte_carlo
+from schuler.drift_calibration.error_budget import NONE, TYPICAL
+from schuler.drift_calibration.monte_carlo import monte_carlo
 from schuler.drift_calibration.plant import plant_reading
 from schuler.drift_calibration.procedure import (
     apparent_drift, azimuth_from_channels, azimuth_from_single_channel, azimuth_sensitivity, rate_from_reading,

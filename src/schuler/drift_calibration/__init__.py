@@ -6,5 +6,6 @@ apparent drift (-Omega . e_X); the command-sensor angle is the platform's angle
 relative to the base about +X. Modules: ``pulses`` (shapes, symmetry),
 ``stabilizer`` (one cycle, exact simulation and closed forms), ``procedure``
 ((15)/(16), asin/atan2, multi-position), ``plant`` (3-D first-principles plant),
-``error_budget`` (budget, Monte Carlo), ``reproduction``, ``plots``, ``api``.
+``error_budget`` (the budget), ``monte_carlo`` (the procedure over the budget),
+``reproduction``, ``plots``, ``api``.
 """

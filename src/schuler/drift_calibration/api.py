@@ -17,7 +17,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from schuler.drift_calibration.error_budget import ErrorBudget, monte_carlo
+from schuler.drift_calibration.error_budget import ErrorBudget
+from schuler.drift_calibration.monte_carlo import monte_carlo
 from schuler.drift_calibration.procedure import procedure_time, run_procedure
 from schuler.drift_calibration.pulses import SHAPES
 from schuler.drift_calibration.reproduction import (

@@ -42,16 +42,14 @@ Example
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE
+from schuler.core.geometry import horizontal_earth_rate, level_frame_earth_rate
+from schuler.drift_calibration.error_budget import ErrorBudget
 from schuler.drift_calibration.stabilizer import Stabilizer, simulate_cycle
-from schuler.exceptions import InvalidParameter, NotObservable
-
-if TYPE_CHECKING:
-    from schuler.drift_calibration.error_budget import ErrorBudget
+from schuler.exceptions import InvalidParameter
 
 MODES = ("three-axis", "single-axis")
 
@@ -68,11 +66,17 @@ def apparent_drift(latitude, azimuth, earth_rate: float = EARTH_RATE):
     earth_rate : float
         Omega, rad/s.
 
-    >>> [round(float(w) / EARTH_RATE, 12) for w in apparent_drift(0.0, np.pi / 2)]
-    [1.0, -0.0, -0.0]
+    Notes
+    -----
+    The platform's (Y, X, -Z) axes form the core's level frame at azimuth A0
+    (:func:`~schuler.core.geometry.level_frame_earth_rate`), and the apparent
+    drift is minus the Earth rate's component: omega_j0 = -Omega . e_j.
+
+    >>> [round(float(w) / EARTH_RATE, 12) + 0.0 for w in apparent_drift(0.0, np.pi / 2)]
+    [1.0, 0.0, 0.0]
     """
-    horizontal = earth_rate * np.cos(latitude)
-    return horizontal * np.sin(azimuth), -horizontal * np.cos(azimuth), -earth_rate * np.sin(latitude) * np.ones_like(azimuth)
+    along_y, along_x, down = level_frame_earth_rate(latitude, azimuth, earth_rate)
+    return -along_x, -along_y, down
 
 
 def rate_from_reading(reading, k1: float, tau: float):
@@ -131,7 +135,7 @@ def azimuth_from_single_channel(omega_x0, latitude, earth_rate: float = EARTH_RA
     >>> round(float(np.degrees(a)), 9), round(float(np.degrees(b)), 9)
     (30.0, 150.0)
     """
-    ratio = np.asarray(omega_x0) / (earth_rate * np.cos(latitude))
+    ratio = np.asarray(omega_x0) / horizontal_earth_rate(latitude, earth_rate)
     saturated = np.abs(ratio) > 1.0
     principal = np.arcsin(np.clip(ratio, -1.0, 1.0))
     return np.mod(principal, 2 * np.pi), np.mod(np.pi - principal, 2 * np.pi), saturated
@@ -148,7 +152,7 @@ def azimuth_sensitivity(azimuth, latitude, mode: str = "three-axis", earth_rate:
     >>> round(float(s1 / s3), 3)   # 1 / cos 80 deg
     5.759
     """
-    base = 1.0 / (earth_rate * np.cos(latitude))
+    base = 1.0 / horizontal_earth_rate(latitude, earth_rate)
     if mode == "three-axis":
         return base * np.ones_like(np.asarray(azimuth, dtype=float))
     with np.errstate(divide="ignore"):
@@ -246,10 +250,7 @@ class ProcedureOutcome:
 
 
 def _validate_site(latitude, azimuth, mode, positions, cycles):
-    latitude = np.asarray(latitude, dtype=float)
-    if not np.all(np.isfinite(latitude)) or np.any(np.abs(latitude) >= np.pi / 2):
-        raise NotObservable(
-            "latitude: +/-90 deg (or beyond) leaves no horizontal Earth rate, the azimuth is not observable")
+    horizontal_earth_rate(latitude)  # NotObservable at the poles: no horizontal Earth rate, no azimuth
     if not np.all(np.isfinite(azimuth)):
         raise InvalidParameter("azimuth", "must be finite")
     if mode not in MODES:
@@ -270,7 +271,7 @@ def run_procedure(
     mode: str = "three-axis",
     positions: int = 2,
     cycles: int = 1,
-    budget: "ErrorBudget | None" = None,
+    budget: ErrorBudget | None = None,
     members: int | None = None,
     rng: np.random.Generator | None = None,
     earth_rate: float = EARTH_RATE,

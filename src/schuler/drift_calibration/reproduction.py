@@ -22,7 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from schuler.drift_calibration.error_budget import TYPICAL, MonteCarloSummary, monte_carlo
+from schuler.core.geometry import ARCMIN, DEG_PER_HOUR
+from schuler.drift_calibration.error_budget import TYPICAL
+from schuler.drift_calibration.monte_carlo import MonteCarloSummary, monte_carlo
 from schuler.drift_calibration.pulses import rectangular
 from schuler.drift_calibration.stabilizer import Stabilizer
 
@@ -61,8 +63,8 @@ class SourceComparison:
 def _row(summary: MonteCarloSummary) -> dict:
     return {
         "mean_relative_drift_error_percent": 100.0 * summary.mean_relative_drift_error,
-        "rms_azimuth_error_arcmin": math.degrees(summary.rms_azimuth_error) * 60.0,
-        "mean_abs_azimuth_error_arcmin": math.degrees(summary.mean_abs_azimuth_error) * 60.0,
+        "rms_azimuth_error_arcmin": summary.rms_azimuth_error / ARCMIN,
+        "mean_abs_azimuth_error_arcmin": summary.mean_abs_azimuth_error / ARCMIN,
     }
 
 
@@ -78,14 +80,14 @@ def reproduce_source(trials: int = 2000, seed: int = 0) -> SourceComparison:
     """
     stabilizer = default_stabilizer()
     latitude, azimuth = math.radians(SOURCE_LATITUDE_DEG), math.radians(SOURCE_AZIMUTH_DEG)
-    drift = math.radians(REPRODUCTION_DRIFT_DEG_H) / 3600.0
+    drift = REPRODUCTION_DRIFT_DEG_H * DEG_PER_HOUR
     typical, scaled = {}, {}
     runs = {}
     for mode in ("three-axis", "single-axis"):
         runs[mode] = monte_carlo(stabilizer, latitude, azimuth, drift, budget=TYPICAL, trials=trials, mode=mode,
                                  seed=seed)
         typical[mode] = _row(runs[mode])
-    target = math.radians(SOURCE_AZIMUTH_ERROR_ARCMIN / 60.0)
+    target = SOURCE_AZIMUTH_ERROR_ARCMIN * ARCMIN
     scale = float(target / runs["three-axis"].rms_azimuth_error)
     for mode in ("three-axis", "single-axis"):
         scaled[mode] = _row(monte_carlo(stabilizer, latitude, azimuth, drift, budget=TYPICAL.scaled(scale),
@@ -101,7 +103,7 @@ def error_versus_positions(positions=(2, 3, 4, 6, 8), trials: int = 1000, seed: 
     True
     """
     stabilizer = default_stabilizer()
-    drift = math.radians(REPRODUCTION_DRIFT_DEG_H) / 3600.0
+    drift = REPRODUCTION_DRIFT_DEG_H * DEG_PER_HOUR
     results = [monte_carlo(stabilizer, math.radians(70.0), math.radians(80.0), drift, trials=trials, mode=mode,
                            positions=n, seed=seed) for n in positions]
     return (np.asarray(positions), np.array([r.rms_azimuth_error for r in results]),
@@ -110,7 +112,7 @@ def error_versus_positions(positions=(2, 3, 4, 6, 8), trials: int = 1000, seed: 
 
 def error_versus_tau(taus=(1.0, 2.0, 4.0, 5.0, 7.5, 10.0), trials: int = 1000, seed: int = 0):
     """Cycle time 2 tau (s) versus RMS azimuth error (rad) and RMS relative drift error (three-axis)."""
-    drift = math.radians(REPRODUCTION_DRIFT_DEG_H) / 3600.0
+    drift = REPRODUCTION_DRIFT_DEG_H * DEG_PER_HOUR
     results = [monte_carlo(default_stabilizer(tau), math.radians(70.0), math.radians(80.0), drift, trials=trials,
                            seed=seed) for tau in taus]
     return (2.0 * np.asarray(taus), np.array([r.rms_azimuth_error for r in results]),
