@@ -24,11 +24,10 @@ from schuler.core.earth import PRESETS
 from schuler.exceptions import InvalidParameter
 from schuler.gyro_vertical import friction as friction_model
 from schuler.gyro_vertical import plots
-from schuler.gyro_vertical.model import (
+from schuler.gyro_vertical.model import GyroVertical, forcing
+from schuler.gyro_vertical.trajectory import (
     GreatCircleTrajectory,
-    GyroVertical,
     SpeedProfile,
-    forcing,
     start_kinematics,
     transport_coriolis_acceleration,
 )

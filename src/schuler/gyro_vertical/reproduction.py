@@ -22,9 +22,11 @@ from typing import ClassVar
 import numpy as np
 
 from schuler.core.earth import DROZDOVICH, EarthModel
+from schuler.core.geometry import ARCSEC, DEG_PER_HOUR, earth_rate_north_up, time_grid
 from schuler.gyro_vertical.friction import friction_from_velocity_error
-from schuler.gyro_vertical.model import GreatCircleTrajectory, GyroVertical, transport_coriolis_acceleration
+from schuler.gyro_vertical.model import GyroVertical
 from schuler.gyro_vertical.quasi_steady import Analysis, analyse, split_schuler_frequencies, steady_errors
+from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, transport_coriolis_acceleration
 from schuler.registry import ReproductionRow
 from schuler.results import Footnotes, Result
 
@@ -41,12 +43,11 @@ PRINTED = {
 }
 """Numbers as printed in the source (m/s^2, rad, m/s, min, 1/s)."""
 
-LEVELLING_ERROR = math.radians(1.0 / 3600)
+LEVELLING_ERROR = 1.0 * ARCSEC
 """A 1-arcsec levelling error about y in both compensation runs, rad: without any
 error the compensated run is identically zero and a ratio of means says nothing."""
 SIMULATION_HOURS = 48.0
 OUTPUT_STEP = 10.0
-DEG_PER_HOUR = math.pi / 180 / 3600
 
 
 def worked_example(earth: EarthModel = DROZDOVICH, latitude: float = LATITUDE, speed: float = SPEED) -> dict:
@@ -189,9 +190,9 @@ def reproduce(earth: EarthModel = DROZDOVICH) -> VerticalReproduction:
     with a 1-arcsec levelling error (:data:`LEVELLING_ERROR`).
     """
     example = worked_example(earth)
-    omega_2 = earth.rate * math.sin(LATITUDE)
+    _, omega_2 = earth_rate_north_up(LATITUDE, earth.rate)
     fast, slow = (float(w) for w in split_schuler_frequencies(earth.gravity, earth.radius, omega_2))
-    time = np.arange(0.0, SIMULATION_HOURS * 3600 + OUTPUT_STEP / 2, OUTPUT_STEP)
+    time = time_grid(SIMULATION_HOURS * 3600.0, OUTPUT_STEP)
     path = GreatCircleTrajectory.from_source(LATITUDE, SPEED, radius=earth.radius, rate=earth.rate)
     analysis = analyse(GyroVertical(path, earth.gravity), time)
     tilt = (0.0, LEVELLING_ERROR)
