@@ -22,12 +22,12 @@ Examples
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from schuler.core.earth import BOLLAY, FOOT, STATUTE_MILE
+from schuler.core.geometry import DEG_PER_HOUR, DEGREE
 from schuler.navigation_errors.single_channel import flat_error, maximum_error, spherical_error
 from schuler.navigation_errors.vertical_channel import hover_altitude_error, printed_hover_expression
 
@@ -41,11 +41,11 @@ HOVER_K = 1e-4
 """Problem 4's accelerometer error, in units of g."""
 
 MAGNITUDES: dict[str, float] = {
-    "tilt": math.radians(0.01),
+    "tilt": 0.01 * DEGREE,
     "velocity": 1.0 * FOOT,
     "accelerometer": 1e-4 * BOLLAY.effective_gravity,
-    "drift": math.radians(0.01) / 3600.0,
-    "azimuth": math.radians(0.01),
+    "drift": 0.01 * DEG_PER_HOUR,
+    "azimuth": 0.01 * DEGREE,
 }
 """Problem 3's error sizes, SI (Delta_a = k g with the loop's g, as the source writes kR)."""
 
