@@ -114,13 +114,13 @@ class ErrorBudget:
         if self.sway_frequency <= 0:
             raise InvalidParameter("sway_frequency", "must be > 0")
 
-    def scaled(self, factor: float) -> "ErrorBudget":
+    def scaled(self, factor: float) -> ErrorBudget:
         """Every random item times ``factor`` (the deterministic loop values kept)."""
         keep = {"loop_time_constant", "sway_frequency"}
         return dataclasses.replace(self, **{f.name: getattr(self, f.name) * factor
                                            for f in dataclasses.fields(self) if f.name not in keep})
 
-    def only(self, *names: str) -> "ErrorBudget":
+    def only(self, *names: str) -> ErrorBudget:
         """This budget with every item but ``names`` set to zero (loop lag off unless named)."""
         zero = {f.name: 0.0 for f in dataclasses.fields(self)}
         zero["sway_frequency"] = self.sway_frequency

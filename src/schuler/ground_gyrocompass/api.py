@@ -15,12 +15,13 @@ from pathlib import Path
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE
+from schuler.core.geometry import ARCSEC, horizontal_earth_rate, time_grid
 from schuler.exceptions import InvalidParameter
 from schuler.ground_gyrocompass import motion
+from schuler.ground_gyrocompass.estimate import NorthEstimate, identify
 from schuler.ground_gyrocompass.grid import first_box, run_stage
-from schuler.ground_gyrocompass.identification import NorthEstimate, identify
-from schuler.ground_gyrocompass.monte_carlo import ARCSEC, monte_carlo, predicted_errors
-from schuler.ground_gyrocompass.observations import observe, sample_times
+from schuler.ground_gyrocompass.monte_carlo import monte_carlo, predicted_errors
+from schuler.ground_gyrocompass.observations import observe
 from schuler.ground_gyrocompass.reproduction import reproduce
 from schuler.params import Parameter, parse_parameters
 from schuler.registry import FigureRef, ReportSection, ReproductionRow, System
@@ -79,7 +80,7 @@ def resolve_omega_h(latitude=None, omega_h=None) -> float:
     if latitude is not None and omega_h is not None:
         raise InvalidParameter("latitude", "give either the latitude or omega_h, not both")
     if latitude is not None:
-        return motion.horizontal_earth_rate(latitude, EARTH_RATE)
+        return horizontal_earth_rate(latitude, EARTH_RATE)
     return motion.SOURCE_OMEGA_H if omega_h is None else float(omega_h)
 
 
@@ -107,7 +108,7 @@ def simulate_record(**values) -> ObservationRecord:
     values = _with_defaults(SIMULATE_PARAMETERS, values)
     omega_h = resolve_omega_h(values["latitude"], values["omega_h"])
     b = float(motion.directive_coefficient(values["hm"], omega_h, values["inertia"]))
-    time = sample_times(values["duration"], values["step"])
+    time = time_grid(values["duration"], values["step"])
     angle = motion.closed_form(
         time, values["alpha0"], values["alpha0_dot"], values["lambda"], b, values["torque"] / values["inertia"]
     )
@@ -337,7 +338,7 @@ def sweep(values: dict) -> dict:
     omega_h = np.where(np.isfinite(omega_given), omega_given, motion.SOURCE_OMEGA_H)
     has_latitude = np.isfinite(latitude)
     if np.any(has_latitude):
-        omega_h = np.where(has_latitude, motion.horizontal_earth_rate(np.where(has_latitude, latitude, 0.0)), omega_h)
+        omega_h = np.where(has_latitude, horizontal_earth_rate(np.where(has_latitude, latitude, 0.0)), omega_h)
     hm, inertia, lam = (filled[k].astype(float) for k in ("hm", "inertia", "lambda"))
     b = motion.directive_coefficient(hm, omega_h, inertia)
     motion.check_decay_rate(lam)

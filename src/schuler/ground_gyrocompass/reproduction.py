@@ -16,10 +16,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from schuler.core.geometry import time_grid
 from schuler.ground_gyrocompass import motion
+from schuler.ground_gyrocompass.estimate import NorthEstimate, identify
 from schuler.ground_gyrocompass.grid import STEP_ALPHA0, misfit_grid, refine, refine_around, source_boxes
-from schuler.ground_gyrocompass.identification import NorthEstimate, identify
-from schuler.ground_gyrocompass.observations import sample_times
 from schuler.results import Footnotes, Result
 
 K_VALUES = np.arange(-9, 10)  # alpha0 = k pi/540
@@ -75,7 +75,7 @@ READINGS = {
 
 def source_record():
     """The source's simulator output: times (s) and the observed alpha - alpha0 (rad)."""
-    time = sample_times(motion.SOURCE_DURATION, motion.SOURCE_STEP)
+    time = time_grid(motion.SOURCE_DURATION, motion.SOURCE_STEP)
     angle = motion.simulate(time, motion.SOURCE_ALPHA0, motion.SOURCE_ALPHA0_DOT, motion.SOURCE_LAMBDA, source_b())
     return time, angle - motion.SOURCE_ALPHA0
 
