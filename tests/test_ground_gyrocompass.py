@@ -216,6 +216,32 @@ def test_batched_fits_equal_what_identify_gives(unknowns):
         assert batch[k].covariance[0, 0] == pytest.approx(single.alpha0_rad_std**2, rel=1e-9)
 
 
+@pytest.mark.parametrize("record_index", [43, 248])
+def test_trial_steps_far_out_are_rejected_quietly(record_index):
+    # 60 s, 10 arcsec: the regression start is far off for a few records and MINPACK tries lambda ~ 1e4 1/s,
+    # where z underflows and Y0(0) = -inf. Formerly record 43 warned (invalid value) and record 248 raised
+    # OverflowError; a non-finite trial is now a rejected step (and RuntimeWarnings fail this suite).
+    t = sample_times(60.0, 1.0)
+    clean = motion.closed_form(t, TRUE["alpha0"], TRUE["alpha0_dot"], LAM, B) - TRUE["alpha0"]
+    noisy = clean + 10 * ARCSEC * np.random.default_rng(1).standard_normal((record_index + 1, t.size))[-1]
+    fit = fit_least_squares(t, noisy, 4, LAM, B)
+    assert fit.converged
+    sigma = predicted_errors({k: np.array([v]) for k, v in TRUE.items()}, np.array([60.0]), np.array([1.0]),
+                             np.array([10 * ARCSEC]), unknowns=4)["alpha0_std"][0]
+    assert abs(fit.values["alpha0"] - TRUE["alpha0"]) < 5 * sigma
+
+
+def test_monte_carlo_counts_the_estimators_refusals_and_off_nominal_starts():
+    # 5 samples over 4 ms: identify() raises IdentificationError on every record, the study counts them
+    refused = monte_carlo(TRUE, [0.004], [ARCSEC], members=5, step=0.001, unknowns=4)
+    assert refused.converged_fraction[0, 0] == 0.0
+    # nominal lambda +30 %, B -20 % (a poor catalogue value): every record still fits, none in a wrong minimum
+    off = monte_carlo(TRUE, [60.0], [10 * ARCSEC], members=200, unknowns=4, seed=4,
+                      nominal={"decay_rate": 1.3 * LAM, "coefficient": 0.8 * B})
+    assert off.converged_fraction[0, 0] == 1.0 and off.gross_error_fraction[0, 0] == 0.0
+    assert off.std_error_arcsec[0, 0] == pytest.approx(off.predicted_std_arcsec[0, 0], rel=0.2)
+
+
 def test_quantisation_enters_predicted_error():
     values = {k: np.array([v, v]) for k, v in TRUE.items()}
     out = predicted_errors(values, np.array([200.0, 200.0]), np.array([1.0, 1.0]), np.array([0.0, 0.0]),

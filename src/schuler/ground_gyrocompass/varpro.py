@@ -153,7 +153,8 @@ class _Projected:
     def parameters(self, x):
         values = dict(self.known)
         for name, value in zip(self.free, x):
-            values[name] = float(np.exp(value))
+            # numpy scalars: a trial step far out overflows to inf (a rejected step), not an OverflowError
+            values[name] = np.exp(np.float64(value))
         return values
 
     def evaluate(self, x):
@@ -370,7 +371,7 @@ def _nonlinear_fit(time, observed, unknowns, decay_rate, coefficient, reading, s
     _, x, status = best
     converged, message = status in TERMINATION, TERMINATION.get(status, MAXIMUM_EVALUATIONS)
     residual, _, coefficients, names, values, columns = problem.evaluate(np.asarray(x, dtype=float))
-    values = {"specific_torque": 0.0, "offset": 0.0, **values}
+    values = {"specific_torque": 0.0, "offset": 0.0, **{name: float(value) for name, value in values.items()}}
     values.update({name: float(value) for name, value in zip(names, coefficients)})
     order = parameter_order(unknowns, reading)
     cov = covariance(jacobian_from_design(*columns, coefficients, unknowns), residual, unknowns)
