@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from schuler.core.earth import EARTH_RATE
+from schuler.core.geometry import ARCSEC, DEG_PER_HOUR
 from schuler.drift_calibration.error_budget import NONE, TYPICAL
 from schuler.drift_calibration.monte_carlo import monte_carlo
 from schuler.drift_calibration.plant import plant_reading
@@ -21,7 +22,6 @@ from schuler.drift_calibration.stabilizer import (
     Stabilizer, leak_error_initial_angle, loop_lag_error_rectangular, reading_closed_form, simulate_cycle)
 from schuler.exceptions import InvalidParameter, NotObservable
 
-DEG_H = math.radians(1.0) / 3600.0
 SHAPES = [rectangular(), triangular(), from_function(lambda u: np.sin(np.pi * u) ** 2, 51),
           from_samples([0, 0.3, 0.7, 1], [0.2, 1.0, 1.0, 0.2])]
 
@@ -39,9 +39,9 @@ def test_noise_free_recovery_any_shape_all_quadrants(shape, quadrant_azimuth):
     """Ideal loop, no errors: omega_d and A0 recovered to 1e-9 relative (issue 5)."""
     for k_m, h in ((1e-4, 0.05), (5e-3, 0.3)):
         s = stab(shape, torquer_gain=k_m, angular_momentum=h)
-        out = run_procedure(s, math.radians(55.0), math.radians(quadrant_azimuth), 0.1 * DEG_H, -0.3 * DEG_H)
-        assert out.drift_x[0] == pytest.approx(0.1 * DEG_H, rel=1e-9)
-        assert out.drift_y[0] == pytest.approx(-0.3 * DEG_H, rel=1e-9)
+        out = run_procedure(s, math.radians(55.0), math.radians(quadrant_azimuth), 0.1 * DEG_PER_HOUR, -0.3 * DEG_PER_HOUR)
+        assert out.drift_x[0] == pytest.approx(0.1 * DEG_PER_HOUR, rel=1e-9)
+        assert out.drift_y[0] == pytest.approx(-0.3 * DEG_PER_HOUR, rel=1e-9)
         assert math.degrees(out.azimuth[0]) == pytest.approx(quadrant_azimuth, rel=1e-9)
 
 
@@ -107,7 +107,7 @@ def test_leaky_integrator_initial_angle():
 def test_180_degree_separation_formulas():
     """(15)/(16) separate own drift and apparent drift from the two readings."""
     s = stab(triangular())
-    d, w0 = 0.2 * DEG_H, 4.0 * DEG_H
+    d, w0 = 0.2 * DEG_PER_HOUR, 4.0 * DEG_PER_HOUR
     r1 = simulate_cycle(s, d + w0).reading[0]
     r2 = simulate_cycle(s, d - w0).reading[0]
     drift, earth = separate_drift(r1, r2, s.k1, s.tau)
@@ -117,7 +117,7 @@ def test_180_degree_separation_formulas():
 @pytest.mark.parametrize("azimuth", [30.0, 120.0, 210.0, 300.0])
 def test_round_trip_against_3d_plant(azimuth):
     """The sign chain: first-principles plant readings -> (15)/(16) -> atan2 give back drift and A0."""
-    latitude, dx, dy = math.radians(62.0), 0.3 * DEG_H, -0.2 * DEG_H
+    latitude, dx, dy = math.radians(62.0), 0.3 * DEG_PER_HOUR, -0.2 * DEG_PER_HOUR
     readings = {}
     for channel, own in (("x", dx), ("y", dy)):
         readings[channel] = [plant_reading(latitude, math.radians(azimuth) + turn, own_drift=own, channel=channel,
@@ -132,14 +132,14 @@ def test_round_trip_against_3d_plant(azimuth):
 
 def test_plant_levelling_residual_matches_first_order_coupling():
     """Spec: a 10 arcsec tilt at 70 deg couples ~7e-4 deg/h; the plant agrees with -Omega sin(phi) e."""
-    latitude, tilt = math.radians(70.0), math.radians(10.0 / 3600.0)
+    latitude, tilt = math.radians(70.0), 10.0 * ARCSEC
     level = plant_reading(latitude, 0.3, own_drift=0.0, channel="x", k1=1.0, tau=5.0, pulse_rate=1e-4,
                           shape=rectangular())
     tilted = plant_reading(latitude, 0.3, own_drift=0.0, channel="x", k1=1.0, tau=5.0, pulse_rate=1e-4,
                            shape=rectangular(), pitch=-tilt)
     coupling = rate_from_reading(tilted - level, 1.0, 5.0)
-    assert abs(coupling) / DEG_H == pytest.approx(EARTH_RATE * math.sin(latitude) * tilt / DEG_H, rel=1e-4)
-    assert abs(coupling) / DEG_H == pytest.approx(6.9e-4, rel=0.02)
+    assert abs(coupling) / DEG_PER_HOUR == pytest.approx(EARTH_RATE * math.sin(latitude) * tilt / DEG_PER_HOUR, rel=1e-4)
+    assert abs(coupling) / DEG_PER_HOUR == pytest.approx(6.9e-4, rel=0.02)
 
 
 def test_asin_ambiguity_and_conditioning():
@@ -153,12 +153,12 @@ def test_asin_ambiguity_and_conditioning():
     errors = {}
     for azimuth in (10.0, 80.0, 89.0):
         wx, wy, _ = apparent_drift(latitude, math.radians(azimuth))
-        a1, _, _ = azimuth_from_single_channel(wx + 1e-3 * DEG_H, latitude)
-        a3 = azimuth_from_channels(wx + 1e-3 * DEG_H, wy)
+        a1, _, _ = azimuth_from_single_channel(wx + 1e-3 * DEG_PER_HOUR, latitude)
+        a3 = azimuth_from_channels(wx + 1e-3 * DEG_PER_HOUR, wy)
         errors[azimuth] = (abs(a1 - math.radians(azimuth)), abs(a3 - math.radians(azimuth)))
         if azimuth < 85.0:  # beyond, the asin is nonlinear (even saturates): no first-order estimate
             assert errors[azimuth][0] == pytest.approx(
-                1e-3 * DEG_H * azimuth_sensitivity(math.radians(azimuth), latitude, "single-axis"), rel=0.05)
+                1e-3 * DEG_PER_HOUR * azimuth_sensitivity(math.radians(azimuth), latitude, "single-axis"), rel=0.05)
     assert errors[89.0][0] > 20 * errors[10.0][0]
     assert errors[89.0][1] < 1.01 * errors[10.0][1] / abs(math.cos(math.radians(10.0))) + 1e-12
 
@@ -166,8 +166,8 @@ def test_asin_ambiguity_and_conditioning():
 def test_latitude_error_affects_only_single_axis():
     s = stab()
     budget = TYPICAL.only("latitude_error")
-    three = monte_carlo(s, math.radians(70), math.radians(80), DEG_H, budget=budget, trials=200)
-    single = monte_carlo(s, math.radians(70), math.radians(80), DEG_H, budget=budget, trials=200,
+    three = monte_carlo(s, math.radians(70), math.radians(80), DEG_PER_HOUR, budget=budget, trials=200)
+    single = monte_carlo(s, math.radians(70), math.radians(80), DEG_PER_HOUR, budget=budget, trials=200,
                          mode="single-axis")
     assert three.rms_azimuth_error == 0.0
     # dA = tan(phi) tan(A0) dphi
@@ -182,7 +182,7 @@ def test_monte_carlo_sensor_noise_matches_closed_form_and_converges():
     expected = 1e-6 * math.sqrt(2 * s.tau) / s.tau**2 / math.sqrt(2)
     deviations = []
     for trials in (250, 4000):
-        mc = monte_carlo(s, math.radians(70), math.radians(80), DEG_H, budget=budget, trials=trials, seed=3)
+        mc = monte_carlo(s, math.radians(70), math.radians(80), DEG_PER_HOUR, budget=budget, trials=trials, seed=3)
         deviations.append(abs(mc.rms_drift_error / expected - 1))
         assert abs(mc.rms_drift_error / expected - 1) < 4.0 / math.sqrt(2 * trials * 2)
     assert deviations[1] < 0.05
@@ -191,27 +191,27 @@ def test_monte_carlo_sensor_noise_matches_closed_form_and_converges():
 def test_multi_position_reduces_error():
     s = stab()
     budget = TYPICAL.only("angle_random_walk")
-    rms = [monte_carlo(s, math.radians(70), math.radians(80), DEG_H, budget=budget, trials=600, positions=n,
+    rms = [monte_carlo(s, math.radians(70), math.radians(80), DEG_PER_HOUR, budget=budget, trials=600, positions=n,
                        seed=1).rms_azimuth_error for n in (2, 8)]
     assert rms[1] == pytest.approx(rms[0] / 2.0, rel=0.2)  # 1/sqrt(N) for independent cycle noise
 
 
 def test_multi_position_single_axis_resolves_ambiguity():
-    out = run_procedure(stab(), math.radians(50), math.radians(130), DEG_H, mode="single-axis", positions=4)
+    out = run_procedure(stab(), math.radians(50), math.radians(130), DEG_PER_HOUR, mode="single-axis", positions=4)
     assert math.degrees(out.azimuth[0]) == pytest.approx(130.0, rel=1e-9)
 
 
 def test_cycles_averaging_reduces_noise():
     s = stab()
     budget = TYPICAL.only("angle_random_walk")
-    one = monte_carlo(s, math.radians(70), math.radians(80), DEG_H, budget=budget, trials=600, seed=2)
-    four = monte_carlo(s, math.radians(70), math.radians(80), DEG_H, budget=budget, trials=600, cycles=4, seed=2)
+    one = monte_carlo(s, math.radians(70), math.radians(80), DEG_PER_HOUR, budget=budget, trials=600, seed=2)
+    four = monte_carlo(s, math.radians(70), math.radians(80), DEG_PER_HOUR, budget=budget, trials=600, cycles=4, seed=2)
     assert four.rms_azimuth_error == pytest.approx(one.rms_azimuth_error / 2.0, rel=0.2)
 
 
 def test_pole_and_bad_parameters_raise():
     with pytest.raises(NotObservable):
-        run_procedure(stab(), math.pi / 2, 0.0, DEG_H)
+        run_procedure(stab(), math.pi / 2, 0.0, DEG_PER_HOUR)
     with pytest.raises(InvalidParameter):
         stab(k1=0.0)
     with pytest.raises(InvalidParameter):
@@ -287,7 +287,7 @@ def test_sweep_vectorised_matches_run():
 
     values = {p.name: np.full(4, p.parse(p.default)) for p in PARAMETERS if p.default is not None}
     values.update(latitude=np.radians([10.0, 40.0, 70.0, -60.0]), azimuth=np.radians([5.0, 95.0, 185.0, 275.0]),
-                  drift=np.array([1, 2, 3, 4]) * DEG_H)
+                  drift=np.array([1, 2, 3, 4]) * DEG_PER_HOUR)
     for name in ("sensor_noise", "sensor_scale_error", "amplitude_mismatch", "duration_mismatch",
                  "pulse_asymmetry", "integrator_offset", "lag_compensation_error", "sway_amplitude",
                  "angle_random_walk", "turn_angle_error", "levelling_residual", "initial_angle", "latitude_error"):
