@@ -22,8 +22,8 @@ axes: e.g. a platform whose y axis points at azimuth A and whose z is up has
 
 Examples
 --------
->>> round(ARCSEC * 206264.806, 9)
-1.0
+>>> round(1.0 / ARCSEC)   # arcseconds in a radian
+206265
 >>> x, y, z = level_frame_earth_rate(0.0, np.pi / 2)   # x east on the equator
 >>> [round(float(c / EARTH_RATE), 12) + 0.0 for c in (x, y, z)]
 [0.0, -1.0, 0.0]

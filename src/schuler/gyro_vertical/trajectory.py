@@ -51,7 +51,6 @@ def check_finite(name: str, value) -> float:
     return value
 
 
-
 @dataclass(frozen=True)
 class SpeedProfile:
     """Speed along the path, piecewise linear between knots, held after the last one.
