@@ -25,14 +25,14 @@ from schuler.exceptions import InvalidParameter
 from schuler.gyro_vertical import friction as friction_model
 from schuler.gyro_vertical import plots
 from schuler.gyro_vertical.model import GyroVertical, forcing
+from schuler.gyro_vertical.quasi_steady import Analysis, analyse, split_schuler_frequencies, steady_errors
+from schuler.gyro_vertical.reproduction import SOURCE, reproduce
 from schuler.gyro_vertical.trajectory import (
     GreatCircleTrajectory,
     SpeedProfile,
     start_kinematics,
     transport_coriolis_acceleration,
 )
-from schuler.gyro_vertical.quasi_steady import Analysis, analyse, split_schuler_frequencies, steady_errors
-from schuler.gyro_vertical.reproduction import SOURCE, reproduce
 from schuler.io import save_figure_formats, write_dataframe_csv
 from schuler.params import Parameter
 from schuler.registry import FigureRef, ReportSection, ReproductionRow, System
