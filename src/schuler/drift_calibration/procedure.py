@@ -368,7 +368,8 @@ def run_procedure(
                 compensated = outcome.reading + lag_known * (2.0 * samples[:, 1] - samples[:, 0] - samples[:, 2])
                 readings[:, c, k, m] = compensated
             rates[:, c, k] = rate_from_reading(readings[:, c, k, :].mean(axis=-1), stabilizer.k1, stabilizer.tau)
-    assumed_latitude = latitude + systematic.get("latitude_error", 0.0)
+    # the latitude the computing unit assumes; an error cannot carry it past the pole
+    assumed_latitude = np.clip(latitude + systematic.get("latitude_error", 0.0), -np.pi / 2, np.pi / 2)
     return _recover(rates, mode, positions, azimuth, assumed_latitude, earth_rate, readings)
 
 
