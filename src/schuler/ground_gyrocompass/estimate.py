@@ -202,7 +202,7 @@ def identify(
     observed : ndarray
         Observed coordinate, rad (alpha - alpha0 for ``reading="relative"``).
     unknowns : {2, 3, 4, 5}
-        Parameters to identify (:data:`UNKNOWN_SETS`).
+        Parameters to identify (:data:`~.problem.UNKNOWN_SETS`).
     decay_rate : float
         lambda, 1/s: known (2 unknowns) or nominal start / grid centre.
     hm : float
