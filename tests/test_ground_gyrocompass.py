@@ -11,8 +11,7 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 from scipy.special import j0, y0
 
-from schuler.core.geometry import ARCSEC, horizontal_earth_rate
-from schuler.core.geometry import time_grid as sample_times
+from schuler.core.geometry import ARCSEC, horizontal_earth_rate, time_grid
 from schuler.exceptions import IdentificationError, InvalidParameter, NotObservable
 from schuler.ground_gyrocompass import grid, motion
 from schuler.ground_gyrocompass.estimate import identify
@@ -149,7 +148,7 @@ def test_initial_estimate_is_close_without_grid(record):
 
 
 def test_absolute_reading_with_offset_and_torque():
-    t = sample_times(300.0, 0.5)
+    t = time_grid(300.0, 0.5)
     torque = 5e-7  # specific torque m, rad/s^2
     alpha = motion.closed_form(t, -0.03, 2e-4, LAM, B, torque)
     observed = observe(alpha, -0.03, reading="absolute", offset=0.4)
@@ -187,7 +186,7 @@ def test_standard_errors_agree_with_monte_carlo():
     assert np.all(study.converged_fraction == 1.0)
     np.testing.assert_allclose(study.std_error_arcsec, study.predicted_std_arcsec, rtol=0.2)
     # the standard error reported by a single fit (residual-based) also matches the scatter
-    t = sample_times(300.0, 1.0)
+    t = time_grid(300.0, 1.0)
     clean = motion.closed_form(t, TRUE["alpha0"], TRUE["alpha0_dot"], LAM, B) - TRUE["alpha0"]
     noisy = clean + 5 * ARCSEC * np.random.default_rng(5).standard_normal(t.size)
     est = identify(t, noisy, 4, decay_rate=LAM, **INSTRUMENT)
@@ -204,7 +203,7 @@ def test_two_unknown_standard_error_matches_monte_carlo():
 @pytest.mark.parametrize("unknowns", [2, 4])
 def test_batched_fits_equal_what_identify_gives(unknowns):
     # the Monte Carlo's batch entry runs the estimator users run: per record, identify()'s numbers
-    t = sample_times(200.0, 1.0)
+    t = time_grid(200.0, 1.0)
     clean = motion.closed_form(t, TRUE["alpha0"], TRUE["alpha0_dot"], LAM, B) - TRUE["alpha0"]
     noisy = clean + 10 * ARCSEC * np.random.default_rng(9).standard_normal((3, t.size))
     batch = fit_records(t, noisy, unknowns, LAM, B)
@@ -221,7 +220,7 @@ def test_trial_steps_far_out_are_rejected_quietly(record_index):
     # 60 s, 10 arcsec: the regression start is far off for a few records and MINPACK tries lambda ~ 1e4 1/s,
     # where z underflows and Y0(0) = -inf. Formerly record 43 warned (invalid value) and record 248 raised
     # OverflowError; a non-finite trial is now a rejected step (and RuntimeWarnings fail this suite).
-    t = sample_times(60.0, 1.0)
+    t = time_grid(60.0, 1.0)
     clean = motion.closed_form(t, TRUE["alpha0"], TRUE["alpha0_dot"], LAM, B) - TRUE["alpha0"]
     noisy = clean + 10 * ARCSEC * np.random.default_rng(1).standard_normal((record_index + 1, t.size))[-1]
     fit = fit_least_squares(t, noisy, 4, LAM, B)
@@ -321,7 +320,7 @@ def test_source_b():
 
 
 def test_record_round_trip(tmp_path):
-    t = sample_times(10.0, 0.5)
+    t = time_grid(10.0, 0.5)
     path = write_record(tmp_path / "rec.csv", t, np.sin(t))
     time, observed = read_record(path)
     np.testing.assert_array_equal(time, t)
@@ -348,10 +347,10 @@ def test_bad_record_names_the_line(tmp_path, body, line, text):
 
 def test_sample_times_rejects_bad_window():
     with pytest.raises(InvalidParameter, match="step"):
-        sample_times(10.0, 0.0)
+        time_grid(10.0, 0.0)
 
 
 def test_sample_times_follow_the_core_grid_rule():
     # records end on the window: a last, shorter step when the window is not a whole number of steps
-    np.testing.assert_array_equal(sample_times(2.0, 0.5), [0.0, 0.5, 1.0, 1.5, 2.0])
-    np.testing.assert_array_equal(sample_times(2.2, 0.5), [0.0, 0.5, 1.0, 1.5, 2.0, 2.2])
+    np.testing.assert_array_equal(time_grid(2.0, 0.5), [0.0, 0.5, 1.0, 1.5, 2.0])
+    np.testing.assert_array_equal(time_grid(2.2, 0.5), [0.0, 0.5, 1.0, 1.5, 2.0, 2.2])
