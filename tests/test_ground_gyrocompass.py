@@ -13,7 +13,7 @@ from scipy.special import j0, y0
 
 from schuler.core.geometry import ARCSEC, horizontal_earth_rate, time_grid
 from schuler.exceptions import IdentificationError, InvalidParameter, NotObservable
-from schuler.ground_gyrocompass import grid, motion
+from schuler.ground_gyrocompass import grid, motion, varpro
 from schuler.ground_gyrocompass.estimate import identify
 from schuler.ground_gyrocompass.monte_carlo import monte_carlo, predicted_errors
 from schuler.ground_gyrocompass.observations import observe, read_record, write_record
@@ -228,6 +228,22 @@ def test_trial_steps_far_out_are_rejected_quietly(record_index):
     sigma = predicted_errors({k: np.array([v]) for k, v in TRUE.items()}, np.array([60.0]), np.array([1.0]),
                              np.array([10 * ARCSEC]), unknowns=4)["alpha0_std"][0]
     assert abs(fit.values["alpha0"] - TRUE["alpha0"]) < 5 * sigma
+
+
+@pytest.mark.parametrize(
+    ("unknowns", "far"),
+    [(u, (d, 0.0)) for u in (3, 4, 5) for d in (-800.0, -50.0, 800.0)]
+    + [(u, (0.0, d)) for u in (4, 5) for d in (-800.0, -60.0)],
+)
+def test_residual_far_out_is_a_step_to_reject(unknowns, far):
+    # MINPACK's callback: where the model overflows or its columns vanish (singular design), a residual
+    # longer than any projected one (whose norm is at most |observed|), never an exception or a NaN
+    t = time_grid(60.0, 1.0)
+    observed = motion.closed_form(t, 0.02, 4e-4, LAM, B) - 0.02
+    problem = varpro._Projected(t, observed, unknowns, "relative", LAM, B)
+    x = (np.log([LAM, B]) + np.array(far))[: len(problem.free)]
+    residual = problem.residual(x)
+    assert np.all(np.isfinite(residual)) and np.linalg.norm(residual) > np.linalg.norm(observed)
 
 
 def test_monte_carlo_counts_the_estimators_refusals_and_off_nominal_starts():

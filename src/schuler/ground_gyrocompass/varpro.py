@@ -186,12 +186,18 @@ class _Projected:
         return result
 
     def residual(self, x):
-        """The projected residual for MINPACK; where the model is not finite, one longer than any finite one.
+        """The projected residual for MINPACK; one longer than any projected residual where there is none.
 
-        MINPACK rejects a trial step whose residual grows and shrinks its trust
-        region, so such a step is retried closer in, and never accepted.
+        Far out (lambda or B underflowing or overflowing) the model is not finite,
+        or its columns vanish and the linear parameters are undetermined. MINPACK
+        rejects a trial step whose residual grows and shrinks its trust region, so
+        such a step is retried closer in and never accepted. The start, checked
+        before the descent, and the accepted points are evaluated as they are.
         """
-        residual = self.evaluate(x)[0]
+        try:
+            residual = self.evaluate(x)[0]
+        except IdentificationError:
+            return self._outside
         return residual if np.all(np.isfinite(residual)) else self._outside
 
     def jacobian(self, x):
