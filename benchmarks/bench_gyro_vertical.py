@@ -27,7 +27,8 @@ from scipy.integrate import solve_ivp
 
 from schuler.core.earth import DROZDOVICH
 from schuler.gyro_vertical.friction import simulate_friction
-from schuler.gyro_vertical.model import ATOL_TILT, ATOL_VELOCITY, RTOL, GreatCircleTrajectory, GyroVertical
+from schuler.gyro_vertical.model import ATOL_TILT, ATOL_VELOCITY, RTOL, GyroVertical
+from schuler.gyro_vertical.trajectory import GreatCircleTrajectory
 
 HOURS = 48.0
 BASELINE_HOURS = 6.0

@@ -11,15 +11,7 @@ from hypothesis import strategies as st
 
 from schuler.core.earth import DROZDOVICH
 from schuler.exceptions import InvalidParameter
-from schuler.gyro_vertical.model import (
-    GreatCircleTrajectory,
-    GyroVertical,
-    SpeedProfile,
-    absolute_acceleration,
-    error_state_space,
-    forcing,
-    transport_coriolis_acceleration,
-)
+from schuler.gyro_vertical.model import GyroVertical, error_state_space, forcing
 from schuler.gyro_vertical.quasi_steady import (
     analyse,
     fit_modes,
@@ -30,6 +22,12 @@ from schuler.gyro_vertical.quasi_steady import (
     tilt_oscillation,
 )
 from schuler.gyro_vertical.reproduction import reproduce, worked_example
+from schuler.gyro_vertical.trajectory import (
+    GreatCircleTrajectory,
+    SpeedProfile,
+    absolute_acceleration,
+    transport_coriolis_acceleration,
+)
 
 R, G, OMEGA = DROZDOVICH.radius, DROZDOVICH.gravity, DROZDOVICH.rate
 LAT60 = math.radians(60.0)

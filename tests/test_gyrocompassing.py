@@ -303,7 +303,8 @@ def test_monte_carlo_spread_matches_analytic_sigma():
 def test_near_the_pole():
     with pytest.raises(NotObservable, match="beyond the gyrocompassing limit"):
         study.run_case(study.AlignmentCase(latitude=math.radians(86)))
-    with pytest.raises(InvalidParameter, match="not observable"):
+    # one horizontal Earth rate for every system (issue 12): NotObservable at the pole, naming the latitude
+    with pytest.raises(NotObservable, match="latitude: 90 deg.*not observable"):
         analytic.steady_state(math.pi / 2, 0.05, 20.0)
     with pytest.warns(study.DegradedAccuracyWarning, match="degrades"):
         run_ = study.run_case(study.AlignmentCase(latitude=math.radians(89.5), max_latitude=math.radians(89.9),

@@ -32,9 +32,8 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
+from schuler.core.geometry import ARCMIN, ARCSEC
 from schuler.exceptions import InvalidParameter
-
-ARCSEC = math.pi / 180.0 / 3600.0
 
 
 @dataclass(frozen=True)
@@ -131,7 +130,7 @@ TYPICAL = ErrorBudget(
     lag_compensation_error=0.02,
     sway_amplitude=0.2 * ARCSEC,
     sway_frequency=0.7,
-    angle_random_walk=0.001 * math.radians(1.0) / 60.0,
+    angle_random_walk=0.001 * ARCMIN,  # 0.001 deg/sqrt(h) = 0.001 arcmin/sqrt(s)
     turn_angle_error=5.0 * ARCSEC,
     levelling_residual=10.0 * ARCSEC,
     initial_angle=10.0 * ARCSEC,

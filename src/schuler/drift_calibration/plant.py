@@ -44,6 +44,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from schuler.core.earth import EARTH_RATE
+from schuler.core.geometry import earth_rate_north_up
 from schuler.core.rotation import skew
 from schuler.drift_calibration.pulses import PulseShape
 from schuler.exceptions import SimulationError
@@ -112,7 +113,8 @@ def plant_reading(
         Omega, rad/s.
     """
     axis = 0 if channel == "x" else 1
-    earth = earth_rate * np.array([0.0, math.cos(latitude), math.sin(latitude)])
+    north, up = earth_rate_north_up(latitude, earth_rate)
+    earth = np.array([0.0, north, up])  # ENU
     attitude = initial_attitude(azimuth, pitch, roll)
 
     def gimbal_angle(c: np.ndarray) -> float:

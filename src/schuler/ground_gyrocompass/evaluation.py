@@ -36,16 +36,18 @@ of Gyroscopic Systems, no. 40, 2020, doi:10.20535/0203-3771402020249107
 from __future__ import annotations
 
 import math
+import sys
 from typing import Any
 
 import numpy as np
 
 from schuler.contract import Cases, Output
+from schuler.core.geometry import grid_points, horizontal_earth_rate, time_grid
 from schuler.exceptions import IdentificationError, InvalidParameter
 from schuler.ground_gyrocompass import motion
-from schuler.ground_gyrocompass.identification import NorthEstimate, identify
+from schuler.ground_gyrocompass.estimate import NorthEstimate, identify
 from schuler.ground_gyrocompass.monte_carlo import predicted_errors
-from schuler.ground_gyrocompass.observations import observe, sample_times
+from schuler.ground_gyrocompass.observations import observe
 from schuler.ground_gyrocompass.results import NorthRun
 from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
@@ -150,9 +152,9 @@ BATCH_BYTES = 64 * 2**20
 """Records made at once in a batch are limited to this many bytes."""
 
 
-def sample_count(duration: float, step: float) -> int:
-    """Samples of a record of ``duration`` every ``step`` (the rule of :func:`~.observations.sample_times`)."""
-    return math.floor(duration / step * (1.0 + 1e-12)) + 1
+def sample_count(duration: float, step: float) -> float:
+    """Samples of a record of ``duration`` every ``step`` (the rule of :func:`~schuler.core.geometry.time_grid`)."""
+    return grid_points(duration, step, names=("duration", "output_step"))
 
 
 def fit_bytes(samples: int, method: str, unknowns: int) -> int:
@@ -183,7 +185,7 @@ def omega_h_of(cases: Cases) -> np.ndarray:
         raise InvalidParameter("latitude", "cannot be combined with omega_h; give one of them")
     values = np.where(omega_h, cases.value_or("omega_h", 0.0), motion.SOURCE_OMEGA_H)
     if np.any(latitude):
-        values[latitude] = motion.horizontal_earth_rate(cases.float("latitude")[latitude])
+        values[latitude] = horizontal_earth_rate(cases.float("latitude")[latitude])
     return values
 
 
@@ -220,7 +222,7 @@ def record_window(cases: Cases, bytes_per_sample: int) -> np.ndarray:
     if step > duration:
         raise InvalidParameter("output_step", f"{step:g} s is longer than the duration {duration:g} s")
     require(sample_count(duration, step) * bytes_per_sample, "this run", "--duration or --output-step")
-    return sample_times(duration, step)
+    return time_grid(duration, step, names=("duration", "output_step"), max_points=sys.maxsize)
 
 
 def true_motion(time: np.ndarray, truth: dict[str, np.ndarray], fidelity: str) -> np.ndarray:
@@ -362,7 +364,7 @@ def _evaluate_batch(time, cases: Cases, fidelity: str, strict: bool):
 
 
 def identify_north(time, observed, unknowns: int, **known) -> NorthEstimate:
-    """The production estimator (:func:`~.identification.identify`, keywords as there), quietly.
+    """The production estimator (:func:`~.estimate.identify`, keywords as there), quietly.
 
     Levenberg-Marquardt's trial steps may probe a decay rate at which the Bessel
     basis overflows; the fit rejects such steps, so numpy's floating-point warnings

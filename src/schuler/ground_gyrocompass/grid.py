@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from schuler.exceptions import InvalidParameter
-from schuler.ground_gyrocompass.identification import (
+from schuler.ground_gyrocompass.motion import basis, simulate
+from schuler.ground_gyrocompass.problem import (
     UNKNOWN_SETS,
     Fit,
     check_record,
@@ -31,7 +32,6 @@ from schuler.ground_gyrocompass.identification import (
     full_jacobian,
     parameter_order,
 )
-from schuler.ground_gyrocompass.motion import basis, simulate
 
 AXES = ("alpha0", "alpha0_dot", "decay_rate", "coefficient")
 

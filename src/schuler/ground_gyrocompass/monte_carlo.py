@@ -1,13 +1,15 @@
-"""Accuracy against observation time: predicted standard errors and Monte Carlo, vectorised.
+"""Accuracy against observation time: predicted standard errors, and a Monte Carlo of the estimator.
 
 For a true motion and white read-out noise of standard deviation sigma (plus the
 uniform quantisation error, variance q^2/12), the least-squares estimate of
 alpha0 (hence of north, -alpha0) has the covariance sigma_eff^2 (J^T J)^-1, J being
-the Jacobian of the model w.r.t. the identified parameters (see
-:mod:`.identification`). :func:`predicted_errors` evaluates it for many cases at
-once (each with its own window, sampling step, noise and parameters), and
-:func:`monte_carlo` checks it by fitting many noisy records simultaneously
-(a batched Gauss-Newton iteration of the same least-squares problem).
+the Jacobian of the model w.r.t. the identified parameters (see :mod:`.problem`).
+:func:`predicted_errors` evaluates it for many cases at once (each with its own
+window, sampling step, noise and parameters). :func:`monte_carlo` checks it with
+the estimator users run, ``schuler north identify``'s variable-projection least
+squares from its default start (:func:`~.varpro.fit_records`), on records made by
+the same observation model as ``schuler north run`` (:func:`~.observations.observe`):
+its failures are the users' failures.
 """
 
 from __future__ import annotations
@@ -18,17 +20,18 @@ from typing import ClassVar
 
 import numpy as np
 
+from schuler.core.geometry import ARCSEC, time_grid, time_grids
 from schuler.exceptions import InvalidParameter
-from schuler.ground_gyrocompass.identification import UNKNOWN_SETS
-from schuler.ground_gyrocompass.motion import basis
+from schuler.ground_gyrocompass.motion import basis, closed_form
+from schuler.ground_gyrocompass.observations import observe
+from schuler.ground_gyrocompass.problem import Fit, linear_names, nonlinear_names
+from schuler.ground_gyrocompass.varpro import fit_records
 from schuler.results import Result
 
-ARCSEC = math.pi / (180.0 * 3600.0)
-
-
-def _linear_names(unknowns, reading):
-    names = ["alpha0", "alpha0_dot"] + (["specific_torque"] if unknowns == 5 else [])
-    return names + (["offset"] if reading == "absolute" else [])
+GROSS_ERROR = 5.0
+"""A converged fit whose north error exceeds this many predicted standard errors
+counts as a gross error (a wrong minimum): Gaussian scatter exceeds 5 sigma once
+in 1.7 million fits."""
 
 
 def batched_model(time, values, unknowns, reading="relative"):
@@ -64,9 +67,9 @@ def batched_model(time, values, unknowns, reading="relative"):
     if reading == "absolute":
         model = model + np.asarray(values["offset"], dtype=float)[:, None]
         columns.append(np.ones_like(first))
-    for name, derivative in (("decay_rate", b.d_decay_rate), ("coefficient", b.d_coefficient)):
-        if name in UNKNOWN_SETS[unknowns]:
-            columns.append(a0 * derivative[0] + a0d * derivative[1] + m * derivative[2])
+    for name in nonlinear_names(unknowns):
+        derivative = b.d_decay_rate if name == "decay_rate" else b.d_coefficient
+        columns.append(a0 * derivative[0] + a0d * derivative[1] + m * derivative[2])
     return model, np.stack(columns, axis=-1)
 
 
@@ -85,7 +88,8 @@ def predicted_errors(values, duration, step, noise, quantisation=0.0, unknowns=4
         True alpha0 (rad), alpha0_dot (rad/s), decay_rate (1/s), coefficient (1/s^2),
         specific_torque (rad/s^2), offset (rad).
     duration, step : ndarray (n,)
-        Observation window and sampling step, s.
+        Observation window and sampling step, s; each case is sampled on the core's
+        time grid (:func:`~schuler.core.geometry.time_grid`, as the records are).
     noise, quantisation : ndarray (n,)
         Read-out noise standard deviation and resolution, rad.
     unknowns : int
@@ -104,57 +108,28 @@ def predicted_errors(values, duration, step, noise, quantisation=0.0, unknowns=4
     >>> bool(1e-7 < e["alpha0_std"][0] < 1e-6)
     True
     """
-    duration, step, noise, quantisation = (
-        np.atleast_1d(np.asarray(x, dtype=float)) for x in (duration, step, noise, quantisation)
-    )
-    n_max = int(np.max(np.floor(duration / step * (1.0 + 1e-12)))) + 1
-    k = np.arange(n_max)
-    time = step[:, None] * k[None, :]
-    mask = time <= duration[:, None] * (1.0 + 1e-12)
-    _, jacobian = batched_model(np.where(mask, time, 0.0), values, unknowns, reading)
-    jacobian = jacobian * mask[..., None]
-    if np.any(mask.sum(axis=1) < jacobian.shape[-1]):
+    noise, quantisation = (np.atleast_1d(np.asarray(x, dtype=float)) for x in (noise, quantisation))
+    time, valid = time_grids(duration, step)
+    _, jacobian = batched_model(time, values, unknowns, reading)
+    jacobian = jacobian * valid[..., None]
+    if np.any(valid.sum(axis=1) < jacobian.shape[-1]):
         raise InvalidParameter("duration", "fewer samples than unknowns in some case")
     covariance = _scaled_inverse(np.swapaxes(jacobian, -1, -2) @ jacobian)
     variance = noise**2 + quantisation**2 / 12.0
-    names = _linear_names(unknowns, reading) + [n for n in ("decay_rate", "coefficient") if n in UNKNOWN_SETS[unknowns]]
+    names = linear_names(unknowns, reading) + nonlinear_names(unknowns)
     diagonal = np.einsum("...ii->...i", covariance)
     return {f"{name}_std": np.sqrt(variance * diagonal[:, i]) for i, name in enumerate(names)}
-
-
-def fit_batch(time, observed, start, unknowns, reading="relative", iterations=12):
-    """Gauss-Newton fit of many records at once (same times), from ``start`` values.
-
-    lambda and B are iterated as logarithms (they stay positive). Returns the
-    final values (dict of arrays) and a boolean array of members that converged.
-    """
-    current = {k: np.array(v, dtype=float, copy=True) for k, v in start.items()}
-    linear = _linear_names(unknowns, reading)
-    nonlinear = [n for n in ("decay_rate", "coefficient") if n in UNKNOWN_SETS[unknowns]]
-    converged = np.zeros(observed.shape[0], dtype=bool)
-    for _ in range(iterations):
-        model, jacobian = batched_model(time, current, unknowns, reading)
-        for i, name in enumerate(nonlinear):
-            jacobian[..., len(linear) + i] *= current[name][:, None]
-        residual = observed - model
-        normal = np.swapaxes(jacobian, -1, -2) @ jacobian
-        delta = (_scaled_inverse(normal) @ (np.swapaxes(jacobian, -1, -2) @ residual[..., None]))[..., 0]
-        for i, name in enumerate(linear):
-            current[name] = current[name] + delta[:, i]
-        for i, name in enumerate(nonlinear):
-            current[name] = current[name] * np.exp(np.clip(delta[:, len(linear) + i], -0.5, 0.5))
-        converged = np.abs(delta[:, len(linear):]).max(axis=1, initial=0.0) < 1e-10
-        small = np.abs(delta[:, 0]) < 1e-13
-        if np.all(converged & small):
-            break
-    return current, converged
 
 
 @dataclass
 class NorthErrorStudy(Result):
     """North error against observation time and noise (Monte Carlo and predicted).
 
-    Arrays are indexed [duration, noise]; errors in arcsec.
+    Arrays are indexed [duration, noise]; errors in arcsec, over the records whose
+    fit converged. ``converged_fraction`` is the share of records the estimator
+    fitted (it raised on, or did not converge for, the rest);
+    ``gross_error_fraction`` the share of converged fits off by more than
+    :data:`GROSS_ERROR` predicted standard errors.
     """
 
     unknowns: int
@@ -168,6 +143,7 @@ class NorthErrorStudy(Result):
     mean_error_arcsec: np.ndarray
     predicted_std_arcsec: np.ndarray
     converged_fraction: np.ndarray
+    gross_error_fraction: np.ndarray
     seed: int
 
     units: ClassVar[dict] = {}
@@ -188,8 +164,16 @@ class NorthErrorStudy(Result):
         return table
 
 
+def _north_errors(fits, alpha0):
+    """alpha0 errors (rad) of the fits that converged, and the mask of those fits."""
+    ok = np.array([isinstance(fit, Fit) and fit.converged for fit in fits])
+    estimates = np.array([fit.values["alpha0"] for fit, good in zip(fits, ok) if good])
+    return estimates - alpha0, ok
+
+
 def monte_carlo(
-    truth, durations, noises, members=200, unknowns=4, step=1.0, quantisation=0.0, reading="relative", seed=0
+    truth, durations, noises, members=200, unknowns=4, step=1.0, quantisation=0.0, reading="relative", seed=0,
+    nominal=None,
 ) -> NorthErrorStudy:
     """Monte Carlo of the north error (arcsec) versus observation time and read-out noise.
 
@@ -203,56 +187,59 @@ def monte_carlo(
     noises : sequence of float
         Read-out noise standard deviations, rad.
     members : int
-        Noisy records per case (all fitted at once).
+        Noisy records per case.
     unknowns, step, quantisation, reading, seed
         Fit set, sampling step (s), read-out resolution (rad), reading, random seed.
+    nominal : dict, optional
+        The instrument's nominal ``decay_rate`` (1/s) and ``coefficient`` (1/s^2)
+        handed to the estimator, as ``--lambda`` and ``--hm`` are: the known values
+        for fewer unknowns, and its second start. Default: the true ones.
+
+    Returns
+    -------
+    NorthErrorStudy
 
     Notes
     -----
-    Each record is fitted by Gauss-Newton started at the true values: the study
-    measures the scatter of the least-squares estimator itself, not the reach of a
-    start procedure (which :func:`~.identification.fit_least_squares` handles).
+    Each record is fitted by the estimator users run, from its default start
+    (:func:`~.varpro.fit_records`): the study measures the scatter and the
+    failures of the estimator as used, not of an idealised one started at the
+    truth. Records are sampled on the core's time grid and read out by
+    :func:`~.observations.observe` (noise, then quantisation).
     """
     if members < 2:
         raise InvalidParameter("members", "need at least 2 Monte Carlo runs")
     rng = np.random.default_rng(seed)
     durations = np.asarray(durations, dtype=float)
     noises = np.asarray(noises, dtype=float)
-    shape = (durations.size, noises.size)
-    rms, std, mean, predicted, ok = (np.zeros(shape) for _ in range(5))
     full = {"specific_torque": 0.0, "offset": 0.0, **truth}
-    batch = members * noises.size
-    start = {k: np.full(batch, float(v)) for k, v in full.items()}
+    nominal = {"decay_rate": full["decay_rate"], "coefficient": full["coefficient"], **(nominal or {})}
+    cases = noises.size
+    predicted = np.stack([
+        predicted_errors({k: np.full(cases, float(v)) for k, v in full.items()}, np.full(cases, duration),
+                         np.full(cases, step), noises, np.full(cases, quantisation), unknowns, reading)["alpha0_std"]
+        for duration in durations
+    ]) / ARCSEC
+    shape = (durations.size, cases)
+    rms, std, mean, converged, gross = (np.full(shape, math.nan) for _ in range(5))
     for i, duration in enumerate(durations):
-        time = step * np.arange(int(math.floor(duration / step * (1.0 + 1e-12))) + 1)
-        # the noise-free observed coordinate (the torque, if any, always included)
-        clean, _ = batched_model(time, {k: v[:1] for k, v in start.items()}, 5, reading)
-        sigma = np.repeat(noises, members)[:, None]
-        noisy = clean + sigma * rng.standard_normal((batch, time.size))
-        if quantisation > 0.0:
-            noisy = quantisation * np.round(noisy / quantisation)
-        values, converged = fit_batch(time, noisy, start, unknowns, reading)
-        error = (values["alpha0"] - full["alpha0"]).reshape(noises.size, members) / ARCSEC
-        good = converged.reshape(noises.size, members)
-        for j in range(noises.size):
-            e = error[j][good[j]]
-            rms[i, j] = math.sqrt(float(np.mean(e**2))) if e.size else math.nan
-            std[i, j] = float(np.std(e, ddof=1)) if e.size > 1 else math.nan
-            mean[i, j] = float(np.mean(e)) if e.size else math.nan
-            ok[i, j] = good[j].mean()
-        cases = noises.size
-        predicted[i] = (
-            predicted_errors(
-                {k: np.full(cases, float(v)) for k, v in full.items()},
-                np.full(cases, duration),
-                np.full(cases, step),
-                noises,
-                np.full(cases, quantisation),
-                unknowns,
-                reading,
-            )["alpha0_std"]
-            / ARCSEC
-        )
+        time = time_grid(duration, step)
+        angle = closed_form(time, full["alpha0"], full["alpha0_dot"], full["decay_rate"], full["coefficient"],
+                            full["specific_torque"])
+        for j, noise in enumerate(noises):
+            records = observe(np.broadcast_to(angle, (members, time.size)), full["alpha0"], noise, quantisation,
+                              reading, full["offset"], rng)
+            fits = fit_records(time, records, unknowns, nominal["decay_rate"], nominal["coefficient"], reading)
+            error, ok = _north_errors(fits, full["alpha0"])
+            error /= ARCSEC
+            converged[i, j] = ok.mean()
+            if error.size:
+                rms[i, j] = math.sqrt(float(np.mean(error**2)))
+                mean[i, j] = float(np.mean(error))
+                # a micro-arcsecond floor: the rounding of a noise-free fit
+                gross[i, j] = float(np.mean(np.abs(error) > GROSS_ERROR * predicted[i, j] + 1e-6))
+            if error.size > 1:
+                std[i, j] = float(np.std(error, ddof=1))
     return NorthErrorStudy(
         unknowns=unknowns,
         members=members,
@@ -264,6 +251,7 @@ def monte_carlo(
         std_error_arcsec=std,
         mean_error_arcsec=mean,
         predicted_std_arcsec=predicted,
-        converged_fraction=ok,
+        converged_fraction=converged,
+        gross_error_fraction=gross,
         seed=seed,
     )

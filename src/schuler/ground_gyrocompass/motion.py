@@ -44,8 +44,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.special import it2j0y0, j0, j1, y0, y1
 
-from schuler.core.earth import EARTH_RATE
-from schuler.exceptions import InvalidParameter, NotObservable, SimulationError
+from schuler.exceptions import InvalidParameter, SimulationError
 
 # The source's machine experiment (source 004, text before Table 1).
 SOURCE_INERTIA = 1.1607e-3  # J, kg m^2
@@ -77,35 +76,6 @@ def check_positive(value, name: str, unit: str) -> None:
         raise InvalidParameter(name, f"{bad:g} {unit}: must be > 0")
 
 
-def horizontal_earth_rate(latitude, earth_rate: float = EARTH_RATE):
-    """Horizontal component Omega_h = Omega cos(latitude) of the Earth's rate, rad/s.
-
-    Parameters
-    ----------
-    latitude : float or ndarray
-        Latitude of the site, rad.
-    earth_rate : float
-        Earth rotation rate Omega, rad/s.
-
-    Raises
-    ------
-    NotObservable
-        At a pole (|latitude| = 90 deg): no horizontal Earth rate, north is undefined.
-
-    Examples
-    --------
-    >>> round(horizontal_earth_rate(math.radians(60.0)) * 1e5, 4)
-    3.6461
-    """
-    latitude = np.asarray(latitude, dtype=float)
-    if np.any(np.abs(latitude) > math.pi / 2 + 1e-12) or not np.all(np.isfinite(latitude)):
-        raise InvalidParameter("latitude", "must lie in [-90, 90] deg")
-    omega_h = earth_rate * np.cos(latitude)
-    if np.any(omega_h < 1e-9 * earth_rate):
-        raise NotObservable("latitude: ±90 deg: no horizontal Earth rate, north is not observable")
-    return float(omega_h) if omega_h.ndim == 0 else omega_h
-
-
 def directive_coefficient(hm, omega_h, inertia):
     """B = H_m Omega_h / J (source 004, eq. (3)), 1/s^2.
 
@@ -114,7 +84,8 @@ def directive_coefficient(hm, omega_h, inertia):
     hm : float or ndarray
         Initial rotor angular momentum H_m, N m s.
     omega_h : float or ndarray
-        Horizontal Earth rate Omega_h, rad/s.
+        Horizontal Earth rate Omega_h, rad/s (from the latitude:
+        :func:`~schuler.core.geometry.horizontal_earth_rate`).
     inertia : float or ndarray
         Moment of inertia J of the sensitive element about the suspension axis, kg m^2.
 

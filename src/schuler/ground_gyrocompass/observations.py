@@ -2,7 +2,8 @@
 
 A record holds sample times ``t_s`` (s, since the rotor's release) and the observed
 coordinate ``alpha_rad`` (rad): alpha - alpha0 for the source's relative reading
-(eq. (10)), or alpha + c for absolute readings with an unknown offset c.
+(eq. (10)), or alpha + c for absolute readings with an unknown offset c. Simulated
+records are sampled on the core's time grid (:func:`~schuler.core.geometry.time_grid`).
 """
 
 from __future__ import annotations
@@ -16,20 +17,6 @@ import numpy as np
 from schuler.exceptions import InvalidParameter
 
 COLUMNS = ("t_s", "alpha_rad")
-
-
-def sample_times(duration: float, step: float) -> np.ndarray:
-    """Sample times 0, step, ..., duration (the last one included when it falls on a step), s.
-
-    >>> sample_times(2.0, 0.5)
-    array([0. , 0.5, 1. , 1.5, 2. ])
-    """
-    if not (math.isfinite(duration) and duration > 0.0):
-        raise InvalidParameter("duration", f"{duration:g} s: must be > 0")
-    if not (math.isfinite(step) and 0.0 < step <= duration):
-        raise InvalidParameter("step", f"{step:g} s: must be > 0 and at most the duration")
-    count = int(math.floor(duration / step * (1.0 + 1e-12))) + 1
-    return step * np.arange(count)
 
 
 def observe(angle, alpha0, noise=0.0, quantisation=0.0, reading="relative", offset=0.0, rng=None):

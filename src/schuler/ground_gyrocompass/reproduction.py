@@ -30,8 +30,8 @@ from schuler.ground_gyrocompass.grid import (
     run_stage,
     source_boxes,
 )
-from schuler.ground_gyrocompass.identification import NorthEstimate, identify
-from schuler.ground_gyrocompass.observations import sample_times
+from schuler.ground_gyrocompass.estimate import NorthEstimate, identify
+from schuler.core.geometry import time_grid
 from schuler.ground_gyrocompass.results import NorthIdentification, ReproductionFigures
 from schuler.params import Parameter, ParameterSet
 from schuler.references import FEDOROV_2020
@@ -133,7 +133,7 @@ READINGS = {
 
 def source_record():
     """The source's simulator output: times (s) and the observed alpha - alpha0 (rad)."""
-    time = sample_times(motion.SOURCE_DURATION, motion.SOURCE_STEP)
+    time = time_grid(motion.SOURCE_DURATION, motion.SOURCE_STEP)
     angle = motion.simulate(time, motion.SOURCE_ALPHA0, motion.SOURCE_ALPHA0_DOT, motion.SOURCE_LAMBDA, source_b())
     return time, angle - motion.SOURCE_ALPHA0
 

@@ -54,14 +54,7 @@ import numpy as np
 from schuler.contract import Cases, Output
 from schuler.core.earth import PRESETS
 from schuler.exceptions import InvalidParameter
-from schuler.gyro_vertical.model import (
-    GreatCircleTrajectory,
-    GyroVertical,
-    SpeedProfile,
-    forcing,
-    start_kinematics,
-    transport_coriolis_acceleration,
-)
+from schuler.gyro_vertical.model import GyroVertical, forcing
 from schuler.gyro_vertical.quasi_steady import (
     analyse,
     quasi_steady_response,
@@ -69,6 +62,12 @@ from schuler.gyro_vertical.quasi_steady import (
     steady_errors,
 )
 from schuler.gyro_vertical.results import VerticalResult
+from schuler.gyro_vertical.trajectory import (
+    GreatCircleTrajectory,
+    SpeedProfile,
+    start_kinematics,
+    transport_coriolis_acceleration,
+)
 from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
 from schuler.units import parse_quantity

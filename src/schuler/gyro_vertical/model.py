@@ -8,21 +8,12 @@ the integrator outputs are the components of the vehicle's velocity.
 
 Frames and signs
 ----------------
-* Horizontal frame ``o x0 y0 z0``: z0 up, x0 along the outer gimbal axis, y0 = z0 x x0.
-  The frame moves with the vehicle along a great circle on the rotating Earth and
-  keeps a constant angle to the velocity.
-* theta: azimuth of x0, measured from north toward east, so that the north unit
-  vector is (cos theta, sin theta) in (x0, y0). It is the source's psi + gamma
-  and is used everywhere psi appears (torques (8), accelerations (19), (21)).
-* gamma: the angle from x0 to the velocity, positive toward y0, so that
-  (v_x, v_y) = v (cos gamma, sin gamma); constant along the path. The velocity
-  course (from north toward east) is theta - gamma. The source's worked example is
-  theta = 0 (x0 north, y0 west) and gamma = 90 deg (v along +y0: due west).
+* The horizontal frame ``o x0 y0 z0`` (z0 up), its azimuth theta, the velocity
+  angle gamma and the Earth and transport rates in it are those of the path
+  (:mod:`schuler.gyro_vertical.trajectory`).
 * Tilts: alpha about x (outer gimbal), beta about y (inner gimbal). To first order
   the spin axis is (beta, -alpha, 1) in (x0, y0, z0); the accelerometer on x reads
   W_x - g beta and the one on y reads W_y + g alpha (the integrands of (6)).
-* Earth rate in the frame: omega_1 cos theta along x0, omega_1 sin theta along y0,
-  omega_2 = Omega sin phi along z0; transport rate (-v_y / R, v_x / R, 0) (eq. (2)).
 
 Equations (source numbering), nutation neglected (5): H omega_y = M_x,
 -H omega_x = M_y with the linearised housing rates (2'), torques (6) with
@@ -46,23 +37,30 @@ the model is time-varying and is integrated by :func:`scipy.integrate.solve_ivp`
 Examples
 --------
 >>> from schuler.core.earth import DROZDOVICH
->>> path = GreatCircleTrajectory.from_source(latitude=np.radians(60), speed=10.0)
->>> k = path.kinematics(0.0)
->>> round(float(transport_coriolis_acceleration(k, DROZDOVICH.radius)[0]), 5)
-0.0135
+>>> frozen = GreatCircleTrajectory.from_source(latitude=np.radians(60), speed=10.0, frozen=True)
+>>> moving = GreatCircleTrajectory.from_source(latitude=np.radians(60), speed=10.0)
+>>> t = np.linspace(0.0, 3600.0, 3)
+>>> [GyroVertical(path, DROZDOVICH.gravity).simulate(t).method for path in (frozen, moving)]
+['exact', 'DOP853']
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from schuler.core.earth import EARTH_RATE, MEAN_RADIUS, STANDARD_GRAVITY
+from schuler.core.earth import STANDARD_GRAVITY
 from schuler.core.lti import StateSpace, simulate
 from schuler.exceptions import InvalidParameter, SimulationError
+from schuler.gyro_vertical.trajectory import (
+    GreatCircleTrajectory,
+    Kinematics,
+    check_finite,
+    transport_coriolis_acceleration,
+)
 
 # Tolerances of the time-varying solve (DOP853). Tilts are ~1e-3 rad and velocity
 # errors ~1 m/s; a tilt error of 1e-12 rad excites a velocity oscillation of only
@@ -75,290 +73,6 @@ ATOL_VELOCITY = 1e-9
 
 STATE_NAMES = ("alpha", "beta", "velocity_error_x", "velocity_error_y")
 STATE_UNITS = ("rad", "rad", "m/s", "m/s")
-
-
-def _check_finite(name: str, value) -> float:
-    value = float(value)
-    if not math.isfinite(value):
-        raise InvalidParameter(name, f"must be a finite number, got {value}")
-    return value
-
-
-@dataclass(frozen=True)
-class SpeedProfile:
-    """Speed along the path, piecewise linear between knots, held after the last one.
-
-    Parameters
-    ----------
-    times : array_like
-        Knot times, s, strictly increasing, the first at 0.
-    speeds : array_like
-        Speed at each knot, m/s (>= 0).
-
-    Examples
-    --------
-    >>> p = SpeedProfile([0.0, 100.0], [0.0, 10.0])
-    >>> float(p.speed(50.0)), float(p.distance(100.0)), float(p.acceleration(50.0))
-    (5.0, 500.0, 0.1)
-    """
-
-    times: np.ndarray
-    speeds: np.ndarray
-
-    def __post_init__(self):
-        times = np.atleast_1d(np.asarray(self.times, dtype=float))
-        speeds = np.atleast_1d(np.asarray(self.speeds, dtype=float))
-        if times.shape != speeds.shape or times.ndim != 1:
-            raise InvalidParameter("speed_profile", "needs one speed per knot time")
-        if not (np.all(np.isfinite(times)) and np.all(np.isfinite(speeds))):
-            raise InvalidParameter("speed_profile", "contains NaN or infinite values")
-        if times[0] != 0.0 or np.any(np.diff(times) <= 0):
-            raise InvalidParameter("speed_profile", "knot times must start at 0 and increase")
-        if np.any(speeds < 0):
-            raise InvalidParameter("speed", "must not be negative")
-        object.__setattr__(self, "times", times)
-        object.__setattr__(self, "speeds", speeds)
-        slopes = np.diff(speeds) / np.diff(times) if times.size > 1 else np.zeros(0)
-        object.__setattr__(self, "_slopes", np.append(slopes, 0.0))
-        steps = np.diff(times) * (speeds[:-1] + speeds[1:]) / 2.0
-        object.__setattr__(self, "_distances", np.concatenate([[0.0], np.cumsum(steps)]))
-
-    @classmethod
-    def constant(cls, speed: float) -> SpeedProfile:
-        """A constant speed, m/s."""
-        return cls([0.0], [speed])
-
-    def _piece(self, t):
-        return np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, self.times.size - 1)
-
-    def piece(self, index: int) -> tuple[float, float, float, float]:
-        """Start time (s), distance (m), speed (m/s) and acceleration (m/s^2) of piece ``index``."""
-        return (float(self.times[index]), float(self._distances[index]), float(self.speeds[index]),
-                float(self._slopes[index]))
-
-    def speed(self, t):
-        """Speed at time ``t`` (s), m/s."""
-        k = self._piece(t)
-        return self.speeds[k] + self._slopes[k] * (np.asarray(t) - self.times[k])
-
-    def acceleration(self, t):
-        """Along-path acceleration at ``t`` (s), m/s^2 (right-continuous at knots)."""
-        return self._slopes[self._piece(t)]
-
-    def distance(self, t):
-        """Distance travelled at ``t`` (s), m."""
-        k = self._piece(t)
-        dt = np.asarray(t) - self.times[k]
-        return self._distances[k] + self.speeds[k] * dt + 0.5 * self._slopes[k] * dt**2
-
-    @property
-    def max_speed(self) -> float:
-        return float(self.speeds.max())
-
-    @property
-    def is_constant(self) -> bool:
-        return bool(np.all(self.speeds == self.speeds[0]))
-
-
-@dataclass(frozen=True)
-class Kinematics:
-    """Trajectory quantities in the horizontal frame (arrays over time, SI).
-
-    Attributes
-    ----------
-    latitude : phi, rad.
-    omega_1x, omega_1y : omega_1 cos theta and omega_1 sin theta, horizontal Earth
-        rate along x0 and y0, rad/s.
-    omega_2 : Omega sin phi, vertical Earth rate, rad/s.
-    v_x, v_y : velocity relative to the Earth along x0, y0, m/s.
-    a_x, a_y : relative acceleration v_x', v_y', m/s^2.
-    """
-
-    latitude: np.ndarray
-    omega_1x: np.ndarray
-    omega_1y: np.ndarray
-    omega_2: np.ndarray
-    v_x: np.ndarray
-    v_y: np.ndarray
-    a_x: np.ndarray
-    a_y: np.ndarray
-
-
-@dataclass(frozen=True)
-class GreatCircleTrajectory:
-    """A vehicle moving along a great circle on the rotating spherical Earth.
-
-    Parameters
-    ----------
-    latitude : float
-        Start latitude phi_0, rad, in [-pi/2, pi/2].
-    azimuth : float
-        theta_0: azimuth of x0 at the start, rad, from north toward east.
-    velocity_angle : float
-        gamma: angle from x0 to the velocity, rad, positive toward y0 (constant).
-    speed : SpeedProfile
-        Speed along the path.
-    radius : float
-        R, m.
-    rate : float
-        Earth rotation rate Omega, rad/s.
-    frozen : bool
-        Keep latitude, azimuth and speed at their start values (the source's
-        slowly-varying assumption); the model is then time-invariant.
-
-    Notes
-    -----
-    The position moves along the great circle through the start point with
-    initial course chi_0 = theta_0 - gamma by the angle sigma = s(t) / R. With
-    k the Earth's axis, r the position and t the direction of motion (unit
-    vectors), k.r = sin phi, k.(r x t) = cos phi_0 sin chi_0 (Clairaut's
-    constant), and the frame axes are x0 = t cos gamma - (r x t) sin gamma,
-    y0 = r x x0, so that omega_1 cos theta = Omega k.x0 and omega_1 sin theta =
-    Omega k.y0 hold without any singularity at the poles.
-    """
-
-    latitude: float
-    azimuth: float = 0.0
-    velocity_angle: float = math.pi / 2
-    speed: SpeedProfile = field(default_factory=lambda: SpeedProfile.constant(0.0))
-    radius: float = MEAN_RADIUS
-    rate: float = EARTH_RATE
-    frozen: bool = False
-
-    def __post_init__(self):
-        lat = _check_finite("latitude", self.latitude)
-        if abs(lat) > math.pi / 2 + 1e-12:
-            raise InvalidParameter("latitude", f"{math.degrees(lat):g} deg is outside [-90, 90] deg")
-        _check_finite("azimuth", self.azimuth)
-        _check_finite("velocity_angle", self.velocity_angle)
-        if not (self.radius > 0 and math.isfinite(self.radius)):
-            raise InvalidParameter("radius", "must be positive")
-        orbital = math.sqrt(STANDARD_GRAVITY * self.radius)
-        if self.speed.max_speed >= orbital:
-            raise InvalidParameter(
-                "speed", f"{self.speed.max_speed:g} m/s is not below the orbital speed sqrt(g R) = {orbital:.0f} m/s"
-            )
-
-    @classmethod
-    def from_source(cls, latitude: float, speed: float, radius: float = 6.4e6, rate: float = 7.3e-5,
-                    **kwargs) -> GreatCircleTrajectory:
-        """The worked example's geometry (theta = 0, v along +y0) with the source's constants."""
-        return cls(latitude, 0.0, math.pi / 2, SpeedProfile.constant(speed), radius, rate, **kwargs)
-
-    @property
-    def course(self) -> float:
-        """Initial course of the velocity chi_0 = theta_0 - gamma, rad (from north toward east)."""
-        return self.azimuth - self.velocity_angle
-
-    def _geometry(self, sigma):
-        phi0, chi0 = self.latitude, self.course
-        kr = math.sin(phi0) * np.cos(sigma) + math.cos(phi0) * math.cos(chi0) * np.sin(sigma)
-        kt = -math.sin(phi0) * np.sin(sigma) + math.cos(phi0) * math.cos(chi0) * np.cos(sigma)
-        pole = math.cos(phi0) * math.sin(chi0)
-        cg, sg = math.cos(self.velocity_angle), math.sin(self.velocity_angle)
-        return kr, kt * cg - pole * sg, pole * cg + kt * sg
-
-    def kinematics(self, t) -> Kinematics:
-        """Latitude, Earth-rate components, velocity and acceleration at times ``t`` (s)."""
-        t = np.asarray(t, dtype=float)
-        if self.frozen:
-            t0 = np.zeros_like(t)
-            sigma, speed, accel = t0, self.speed.speed(t0), np.zeros_like(t)
-        else:
-            sigma = self.speed.distance(t) / self.radius
-            speed, accel = self.speed.speed(t), self.speed.acceleration(t)
-        kr, kx, ky = self._geometry(sigma)
-        cg, sg = math.cos(self.velocity_angle), math.sin(self.velocity_angle)
-        return Kinematics(
-            latitude=np.arcsin(np.clip(kr, -1.0, 1.0)),
-            omega_1x=self.rate * kx,
-            omega_1y=self.rate * ky,
-            omega_2=self.rate * kr,
-            v_x=speed * cg,
-            v_y=speed * sg,
-            a_x=accel * cg,
-            a_y=accel * sg,
-        )
-
-    @property
-    def is_stationary(self) -> bool:
-        """True when the frame's Earth rates and the velocity never change (time-invariant model)."""
-        if self.frozen or self.speed.max_speed == 0.0:
-            return True
-        # along the equator due east or west the latitude stays zero and theta stays fixed
-        on_equator = self.latitude == 0.0 and math.isclose(abs(math.sin(self.course)), 1.0, rel_tol=0, abs_tol=1e-15)
-        return on_equator and self.speed.is_constant
-
-
-def transport_coriolis_acceleration(kinematics: Kinematics, radius: float):
-    """Transport (centripetal) plus Coriolis horizontal acceleration W*, eq. (21), m/s^2.
-
-    W*_x = R omega_1 omega_2 cos(psi + gamma) - 2 omega_2 v_y,
-    W*_y = R omega_1 omega_2 sin(psi + gamma) + 2 omega_2 v_x,
-    with psi + gamma = theta (the azimuth of x0).
-
-    Parameters
-    ----------
-    kinematics : Kinematics
-    radius : float
-        R, m.
-
-    Returns
-    -------
-    W_star_x, W_star_y : ndarray
-        m/s^2.
-    """
-    k = kinematics
-    return (radius * k.omega_1x * k.omega_2 - 2.0 * k.omega_2 * k.v_y,
-            radius * k.omega_1y * k.omega_2 + 2.0 * k.omega_2 * k.v_x)
-
-
-@dataclass(frozen=True)
-class AbsoluteAcceleration:
-    """Absolute acceleration of the vehicle in the horizontal frame, eqs. (15)-(19), m/s^2.
-
-    Each part has components (x, y, z) along (x0, y0, z0).
-    """
-
-    transport: tuple
-    relative: tuple
-    coriolis: tuple
-
-    @property
-    def total(self) -> tuple:
-        return tuple(a + b + c for a, b, c in zip(self.transport, self.relative, self.coriolis))
-
-
-def absolute_acceleration(kinematics: Kinematics, radius: float) -> AbsoluteAcceleration:
-    """Transport (15), relative (16) and Coriolis (18) accelerations; their sum is (19).
-
-    Parameters
-    ----------
-    kinematics : Kinematics
-    radius : float
-        R, m.
-
-    Notes
-    -----
-    Transport: Omega x (Omega x r) = (R omega_1 omega_2 cos theta,
-    R omega_1 omega_2 sin theta, -R omega_1^2); relative along the great circle:
-    (v_x', v_y', -v^2 / R); Coriolis 2 Omega x v = (-2 omega_2 v_y, 2 omega_2 v_x,
-    2 (omega_1x v_y - omega_1y v_x)). The source writes the last as
-    2 omega_1 v sin psi with its own angle convention.
-
-    Examples
-    --------
-    >>> path = GreatCircleTrajectory.from_source(latitude=0.0, speed=0.0)
-    >>> acc = absolute_acceleration(path.kinematics(0.0), 6.4e6)
-    >>> round(float(acc.total[2]), 5)   # -R Omega^2 at the equator
-    -0.03411
-    """
-    k, R = kinematics, radius
-    omega_1_sq = k.omega_1x**2 + k.omega_1y**2
-    transport = (R * k.omega_1x * k.omega_2, R * k.omega_1y * k.omega_2, -R * omega_1_sq)
-    relative = (k.a_x, k.a_y, -(k.v_x**2 + k.v_y**2) / R)
-    coriolis = (-2.0 * k.omega_2 * k.v_y, 2.0 * k.omega_2 * k.v_x, 2.0 * (k.omega_1x * k.v_y - k.omega_1y * k.v_x))
-    return AbsoluteAcceleration(transport, relative, coriolis)
 
 
 def error_state_space(omega_2, gravity: float, radius: float, schuler_tuning: float = 1.0) -> StateSpace:
@@ -449,31 +163,6 @@ def forcing(kinematics: Kinematics, radius, schuler_tuning=1.0, earth_rate_compe
     e_x = gyro_drift[0] - leak * k.omega_1x - mistuning * k.v_y
     e_y = gyro_drift[1] - leak * k.omega_1y + mistuning * k.v_x
     return np.broadcast_arrays(f_x, f_y, e_x, e_y)
-
-
-def start_kinematics(latitude, azimuth, velocity_angle, speed, rate) -> Kinematics:
-    """Kinematics at the start of many paths at once (arrays of equal length, SI).
-
-    Parameters
-    ----------
-    latitude, azimuth, velocity_angle : ndarray
-        phi_0, theta_0, gamma, rad.
-    speed : ndarray
-        m/s.
-    rate : ndarray or float
-        Omega, rad/s.
-
-    Examples
-    --------
-    >>> k = start_kinematics(np.radians([0.0, 90.0]), 0.0, np.pi / 2, 10.0, 7.3e-5)
-    >>> k.omega_2.round(7).tolist(), k.v_y.tolist()
-    ([0.0, 7.3e-05], [10.0, 10.0])
-    """
-    latitude, azimuth, velocity_angle, speed = np.broadcast_arrays(latitude, azimuth, velocity_angle, speed)
-    omega_1 = rate * np.cos(latitude)
-    zero = np.zeros_like(speed)
-    return Kinematics(latitude, omega_1 * np.cos(azimuth), omega_1 * np.sin(azimuth), rate * np.sin(latitude),
-                      speed * np.cos(velocity_angle), speed * np.sin(velocity_angle), zero, zero)
 
 
 @dataclass(frozen=True)
@@ -572,7 +261,7 @@ class GyroVertical:
         for name, pair in (("accelerometer_bias", self.accelerometer_bias), ("gyro_drift", self.gyro_drift),
                            ("initial_tilt", self.initial_tilt)):
             for value in pair:
-                _check_finite(name, value)
+                check_finite(name, value)
 
     @property
     def radius(self) -> float:
@@ -669,25 +358,6 @@ class GyroVertical:
         return VerticalResponse(t, s[:, 0], s[:, 1], v_x + s[:, 2], v_y + s[:, 3], v_x, v_y,
                                 np.broadcast_to(k.latitude, t.shape), "exact", 0, t.size - 1)
 
-    def _piece_kinematics(self, index: int):
-        """Scalar kinematics on one piece of the speed profile, where it is a quadratic in time."""
-        path = self.trajectory
-        start, s0, v0, accel = path.speed.piece(index)
-        if path.frozen:
-            start, s0, accel = 0.0, 0.0, 0.0
-        cg, sg = math.cos(path.velocity_angle), math.sin(path.velocity_angle)
-        R, rate, moving = path.radius, path.rate, not path.frozen
-
-        def kinematics(t: float) -> Kinematics:
-            tau = t - start
-            speed = v0 + accel * tau
-            sigma = (s0 + v0 * tau + 0.5 * accel * tau * tau) / R if moving else 0.0
-            kr, kx, ky = path._geometry(sigma)
-            return Kinematics(math.asin(max(-1.0, min(1.0, kr))), rate * kx, rate * ky, rate * kr,
-                              speed * cg, speed * sg, accel * cg, accel * sg)
-
-        return kinematics
-
     def _simulate_ode(self, t: np.ndarray, state: np.ndarray) -> VerticalResponse:
         path = self.trajectory
         knots = np.zeros(1) if path.frozen else path.speed.times
@@ -699,7 +369,7 @@ class GyroVertical:
         # integrate piece by piece between the speed profile's knots, where the
         # acceleration jumps, so that the solver never steps across a discontinuity
         for index, (start, stop) in enumerate(zip(edges[:-1], edges[1:])):
-            kinematics = self._piece_kinematics(index)
+            kinematics = path.piece_kinematics(index)
 
             def rhs(time, x, kinematics=kinematics):
                 return self.derivative(time, x, kinematics(time))

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-ARCMIN = np.pi / 180 / 60
+from schuler.core.geometry import ARCMIN
+
 HOUR = 3600.0
 
 

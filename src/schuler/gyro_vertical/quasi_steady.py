@@ -39,8 +39,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from schuler.core.geometry import uniform_step
 from schuler.exceptions import InvalidParameter
-from schuler.gyro_vertical.model import GyroVertical, transport_coriolis_acceleration
+from schuler.gyro_vertical.model import GyroVertical, error_state_space
+from schuler.gyro_vertical.trajectory import transport_coriolis_acceleration
 
 
 def steady_errors(W_star_x, W_star_y, omega_2, gravity, radius, accelerometer_bias=(0.0, 0.0),
@@ -226,7 +228,7 @@ def quasi_steady_response(vertical: GyroVertical, time) -> QuasiSteady:
 
     Examples
     --------
-    >>> from schuler.gyro_vertical.model import GreatCircleTrajectory
+    >>> from schuler.gyro_vertical.trajectory import GreatCircleTrajectory
     >>> path = GreatCircleTrajectory.from_source(np.radians(60), 10.0, frozen=True)
     >>> q = quasi_steady_response(GyroVertical(path, 9.81), np.linspace(0, 3600, 5))
     >>> round(float(q.dv_y[0]), 3), round(float(q.beta_r[0]), 6)
@@ -286,15 +288,15 @@ def velocity_error_spectrum(time, dv_x, dv_y, padding: int = 8) -> Spectrum:
         Zero-padding factor (interpolates the spectrum).
     """
     t = np.asarray(time, dtype=float)
-    step = np.diff(t)
-    if t.size < 8 or not np.allclose(step, step[0], rtol=1e-9, atol=0):
+    step = uniform_step(t)
+    if t.size < 8 or step is None:
         raise InvalidParameter("time", "the spectrum needs at least 8 uniformly spaced samples")
     u = np.asarray(dv_x) - 1j * np.asarray(dv_y)
     u = u - u.mean()
     window = np.hanning(t.size)
     n_fft = padding * t.size
     values = np.fft.fftshift(np.fft.fft(u * window, n_fft))
-    frequency = np.fft.fftshift(np.fft.fftfreq(n_fft, step[0]))
+    frequency = np.fft.fftshift(np.fft.fftfreq(n_fft, step))
     return Spectrum(frequency, np.abs(values) / window.sum())
 
 
@@ -409,8 +411,6 @@ def analyse(vertical: GyroVertical, time, method: str = "auto") -> Analysis:
     :func:`fit_modes` (with records under six Schuler periods the model's
     eigenfrequencies seed it instead, the FFT being too coarse).
     """
-    from schuler.gyro_vertical.model import error_state_space
-
     response = vertical.simulate(time, method=method)
     t = response.time
     q = quasi_steady_response(vertical, t)
@@ -419,7 +419,7 @@ def analyse(vertical: GyroVertical, time, method: str = "auto") -> Analysis:
     eigen = mode_frequencies(system)
     periods = 2 * np.pi / eigen
     ox, oy = Analysis(response, q, None, None, periods).oscillation
-    uniform = np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0)
+    uniform = uniform_step(t) is not None
     # the modes are seen only in a record of two slow periods sampled below half the fast one (no aliasing)
     resolved = t.size >= 8 and np.max(np.diff(t)) < periods[0] / 2 and t[-1] >= 2 * periods[-1]
     spectrum = velocity_error_spectrum(t, ox, oy) if uniform and resolved else None

@@ -25,7 +25,7 @@ from schuler.core.earth import DROZDOVICH, EarthModel
 from schuler.gyro_vertical.actions import friction
 from schuler.gyro_vertical.evaluation import PARAMETERS, run_case
 from schuler.gyro_vertical.friction import friction_from_velocity_error
-from schuler.gyro_vertical.model import GreatCircleTrajectory, transport_coriolis_acceleration
+from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, transport_coriolis_acceleration
 from schuler.gyro_vertical.quasi_steady import steady_errors
 from schuler.gyro_vertical.results import write_files
 from schuler.references import DROZDOVICH_1959

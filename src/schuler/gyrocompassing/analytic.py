@@ -3,7 +3,9 @@
 All functions take SI floats or arrays (broadcast together) and return arrays:
 angles in rad, rates in rad/s, gains c_gamma and c_a in 1/s, times in s.
 Symbols follow the source: c_gamma (c_Gamma), c_a, U_eta = U cos(phi),
-h = c_gamma / 2, omega0^2 = c_a U_eta.
+h = c_gamma / 2, omega0^2 = c_a U_eta. U_eta is the core's
+:func:`~schuler.core.geometry.horizontal_earth_rate`: every closed form here
+raises :class:`~schuler.exceptions.NotObservable` at the poles, where it vanishes.
 """
 
 from __future__ import annotations
@@ -11,38 +13,11 @@ from __future__ import annotations
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.geometry import earth_rate_north_up, horizontal_earth_rate
 from schuler.exceptions import InvalidParameter
 
 SETTLING_DECREMENTS = 5.0
 """Settling time = 5 time constants of the slowest mode (source 003: t = 5 / h)."""
-
-
-def horizontal_earth_rate(latitude, earth_rate=EARTH_RATE) -> np.ndarray:
-    """U_eta = U cos(phi), rad/s; raises at the poles where it vanishes.
-
-    Parameters
-    ----------
-    latitude : float or ndarray
-        Latitude phi, rad, strictly inside (-pi/2, pi/2).
-    earth_rate : float
-        U, rad/s.
-
-    Raises
-    ------
-    InvalidParameter
-        At |phi| >= 90 deg (no horizontal Earth rate: azimuth is not observable).
-
-    Examples
-    --------
-    >>> round(float(horizontal_earth_rate(np.radians(60))), 12)
-    3.6460575e-05
-    """
-    phi = np.asarray(latitude, dtype=float)
-    if not np.all(np.isfinite(phi)):
-        raise InvalidParameter("latitude", "must be a finite number")
-    if np.any(np.abs(phi) >= np.pi / 2):
-        raise InvalidParameter("latitude", "90 deg: no horizontal Earth rate, azimuth is not observable")
-    return earth_rate * np.cos(phi)
 
 
 def gains_from_design(time_constant, damping, latitude, earth_rate=EARTH_RATE):
@@ -213,9 +188,8 @@ def full_steady_state(latitude, c_gamma, c_a, drift_east=0.0, drift_north=0.0, d
     >>> round(float(np.degrees(d) * 3600), 1)
     24.6
     """
-    phi = np.asarray(latitude, dtype=float)
-    U_eta = horizontal_earth_rate(phi, earth_rate)
-    U_z = earth_rate * np.sin(phi)
+    U_eta = horizontal_earth_rate(latitude, earth_rate)
+    _, U_z = earth_rate_north_up(latitude, earth_rate)
     c_gamma = np.asarray(c_gamma, dtype=float)
     c_a = np.asarray(c_a, dtype=float)
     dphi = np.asarray(latitude_error, dtype=float)

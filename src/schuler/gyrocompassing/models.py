@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.geometry import earth_rate_north_up, level_frame_earth_rate
 from schuler.core.lti import StateSpace
 
 INPUTS = ("drift_x", "drift_y", "drift_z", "latitude_error", "accel_error_x", "accel_error_y")
@@ -70,14 +71,22 @@ def earth_rate_components(latitude, azimuth, earth_rate=EARTH_RATE):
     latitude : float or ndarray
         Latitude phi, rad.
     azimuth : float or ndarray
-        Azimuth A of the platform's x_g axis, rad.
+        Azimuth A of the platform's y_g axis from north towards east, rad
+        (x_g points to A + 90 deg).
     earth_rate : float
         Earth rotation rate U, rad/s.
 
     Returns
     -------
     dict of ndarray
-        ``U_eta``, ``U_z`` (= U_zeta) and the platform-axis ``U_x``, ``U_y``, rad/s.
+        ``U_eta`` = U cos(phi), ``U_z`` (= U_zeta = U sin(phi)) and the
+        platform-axis ``U_x`` = -U cos(phi) sin A, ``U_y`` = U cos(phi) cos A, rad/s.
+
+    Notes
+    -----
+    The platform's (y, x, -z) axes form the core's level frame at azimuth A
+    (:func:`~schuler.core.geometry.level_frame_earth_rate`). No pole check: the
+    models hold at any latitude; the closed forms refuse the poles.
 
     Examples
     --------
@@ -86,13 +95,9 @@ def earth_rate_components(latitude, azimuth, earth_rate=EARTH_RATE):
     (True, -1.0)
     """
     phi, A = _broadcast(latitude, azimuth)
-    U_eta = earth_rate * np.cos(phi)
-    return {
-        "U_eta": U_eta,
-        "U_z": earth_rate * np.sin(phi),
-        "U_x": -U_eta * np.sin(A),
-        "U_y": U_eta * np.cos(A),
-    }
+    U_y, U_x, down = level_frame_earth_rate(phi, A, earth_rate)
+    U_eta, _ = earth_rate_north_up(phi, earth_rate)
+    return {"U_eta": U_eta, "U_z": -down, "U_x": U_x, "U_y": U_y}
 
 
 def full_mu_nu_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_RATE, gravity=STANDARD_GRAVITY) -> StateSpace:
@@ -157,7 +162,7 @@ def _mu_nu_model(latitude, azimuth, c_gamma, c_a, earth_rate, gravity, printed):
     U = earth_rate_components(phi, A, earth_rate)
     U_x, U_y, U_z = U["U_x"], U["U_y"], U["U_z"]
     sin_A, cos_A = np.sin(A), np.cos(A)
-    U_sin, U_cos = earth_rate * np.sin(phi), earth_rate * np.cos(phi)
+    U_sin, U_cos = U_z, U["U_eta"]
     zero = np.zeros(shape)
     if printed:
         delta_row = [-ca * cos_A + U_x, -ca * sin_A - U_y, zero]
@@ -231,7 +236,7 @@ def full_alpha_beta_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_R
     zero = np.zeros(shape)
     sin_A, cos_A = np.sin(A), np.cos(A)
     A_matrix = _assemble([[-cg, U_z, U_eta], [-U_z, -cg, zero], [-ca - U_eta, zero, zero]], shape)
-    rows = _level_input_rows(A, cg, ca, earth_rate * np.sin(phi), earth_rate * np.cos(phi), gravity, zero)
+    rows = _level_input_rows(A, cg, ca, U_z, U_eta, gravity, zero)
     B_matrix = _assemble(rows, shape)
     # outputs: delta, beta, alpha, mu = beta sin A + alpha cos A, nu = beta cos A - alpha sin A, delta'
     C_matrix = _assemble(
@@ -270,10 +275,10 @@ def simplified_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_RATE, 
     """
     phi, A, cg, ca = _broadcast(latitude, azimuth, c_gamma, c_a)
     shape = phi.shape
-    U_eta = earth_rate * np.cos(phi)
+    U_eta, U_z = earth_rate_north_up(phi, earth_rate)
     zero = np.zeros(shape)
     A_matrix = _assemble([[-cg, U_eta], [-ca, zero]], shape)
-    beta_row, _, delta_row = _level_input_rows(A, cg, ca, earth_rate * np.sin(phi), U_eta, gravity, zero)
+    beta_row, _, delta_row = _level_input_rows(A, cg, ca, U_z, U_eta, gravity, zero)
     B_matrix = _assemble([beta_row, delta_row], shape)
     C_matrix = _assemble([[zero, 1.0], [1.0, zero], [-ca, zero]], shape)
     D_matrix = np.zeros((*shape, 3, 6))
