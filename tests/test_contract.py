@@ -34,7 +34,7 @@ LIGHT = {
     "vertical": {"duration": 3 * 3600.0, "output_step": 60.0},
     "calibrate": {},
     "align": {"duration": 600.0},
-    "north": {"duration": 600.0},
+    "north": {"duration": 600.0, "readout_noise": math.radians(1 / 3600)},
 }
 """SI values that keep a system's default case quick (short durations)."""
 
@@ -155,7 +155,7 @@ def test_sweep_draws_do_not_depend_on_chunking_or_executor(name, tmp_path):
     numeric = next(p for p in system.parameters if p.kind == "quantity" and p.name not in LIGHT[name]
                    and p.default is not None and p.name != "latitude")
     lines = [f'system = "{name}"', "[parameters]"]
-    lines += [f"{key} = {value!r}" if not isinstance(value, str) else f'{key} = "{value}"'
+    lines += [f'{key} = "{value!r} {system.parameters[key].si_unit}"'
               for key, value in LIGHT[name].items() if key in system.parameters and key not in ("duration",)]
     lines += ["[monte_carlo]", "seed = 3", "[monte_carlo.uniform]", f"{numeric.name} = [{_range(numeric)}]"]
     scenario = parse_scenario("\n".join(lines) + "\n")
@@ -208,7 +208,8 @@ def test_json_carries_units_for_every_number(name, action, run_cli):
     args = [name, action, "--json"]
     if action == "run":
         for key, value in light(name).items():
-            args += [get_system(name).parameters[key].option, f"{value} s"]
+            parameter = get_system(name).parameters[key]
+            args += [parameter.option, f"{value!r} {parameter.si_unit}" if parameter.si_unit != "1" else repr(value)]
     out = run_cli(*args)
     assert out.code == 0, out.stderr
     data = out.json()

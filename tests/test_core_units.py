@@ -119,7 +119,7 @@ def test_parameter_range_and_messages():
         MODE.parse("two-axis")
     with pytest.raises(InvalidParameter, match="whole number"):
         COUNT.parse("1.5")
-    assert "[deg; range [-90, 90] deg]" in LATITUDE.help_text()
+    assert LATITUDE.help_text() == "Latitude. Range [-90, 90] deg. [default: 50 deg]"
 
 
 def test_parse_parameters_defaults_and_unknown_names():

@@ -191,9 +191,11 @@ def test_parameters_renamed_exclusive_and_suggested():
         SYSTEM.run(latitud=0.5)
     with pytest.raises(InvalidParameter, match="did you mean 'decay_rate'"):
         SYSTEM.run(decay_rat=2e-3)
-    for old in ("lambda", "step", "noise", "seed"):
-        with pytest.raises(InvalidParameter, match=f"{old}: unknown parameter of north"):
+    for old, new in (("lambda", "decay_rate"), ("step", "output_step"), ("noise", "readout_noise")):
+        with pytest.raises(InvalidParameter, match=f"{old}: renamed to '{new}'"):
             SYSTEM.case(**{old: 1.0})
+    with pytest.raises(InvalidParameter, match="seed: unknown parameter of north"):
+        SYSTEM.case(seed=1)
     with pytest.raises(InvalidParameter, match="readout_noise"):
         SYSTEM.run(readout_noise=-1e-6)
 

@@ -150,8 +150,8 @@ def test_unknown_and_former_names_are_refused_with_a_suggestion():
         SYSTEM.run(latitud=0.17)
     with pytest.raises(InvalidParameter, match="did you mean 'output_step'"):
         SYSTEM.run(output_stp=1.0)
-    for former in ("accelerometer_bias_x", "gyro_drift_x", "step"):
-        with pytest.raises(InvalidParameter, match=f"{former}: unknown parameter of vertical"):
+    for former, new in (("accelerometer_bias_x", "accel_bias_x"), ("gyro_drift_x", "drift_x"), ("step", "output_step")):
+        with pytest.raises(InvalidParameter, match=f"{former}: renamed to '{new}'"):
             SYSTEM.run(**{former: 0.0})
 
 

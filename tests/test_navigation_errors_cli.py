@@ -128,10 +128,9 @@ def test_run_refuses_a_grid_beyond_the_memory_budget(run_cli, monkeypatch):
     assert "memory budget" in out.stderr and "--output-step" in out.stderr
 
 
-def test_run_monte_carlo_is_reported(run_cli):
-    data = run_cli("errors", "run", "--monte-carlo", "3", "--json").json()
-    assert data["monte_carlo"]["members"] == 3
-    assert data["monte_carlo"]["statistics"]["final_spherical_m"]["std"] == 0.0  # no random terms of its own
+def test_run_monte_carlo_without_random_terms_is_refused(run_cli):
+    out = run_cli("errors", "run", "--monte-carlo", "3", "--json")
+    assert out.code == 2 and "--monte-carlo: errors has no random terms" in out.stderr
 
 
 @pytest.mark.slow

@@ -38,10 +38,12 @@ def test_misspelt_magnitude_is_refused_with_a_suggestion():
     assert error.value.name == "magnitud"
 
 
-def test_renamed_step_is_refused_listing_output_step():
-    # "step" is too far from "output_step" for a suggestion (difflib ratio 0.53): the allowed names show it
-    with pytest.raises(InvalidParameter, match="unknown parameter of errors; allowed: .*output_step"):
+def test_renamed_step_is_refused_naming_output_step(run_cli):
+    # "step" is too far from "output_step" for a suggestion (difflib ratio 0.53): the rename map names it
+    with pytest.raises(InvalidParameter, match="step: renamed to 'output_step'"):
         SYSTEM.run(step=10.0)
+    out = run_cli("errors", "run", "--step", "10")
+    assert out.code == 2 and out.stderr.strip() == "schuler: error: --step: renamed to '--output-step' (see CHANGELOG.md)"
 
 
 def test_magnitude_takes_si_numbers_and_text_in_the_source_unit():
@@ -215,10 +217,15 @@ def test_monte_carlo_over_a_drawn_duration_is_independent_of_chunking():
     assert mean == pytest.approx(10_258.5, rel=0.01)
 
 
-def test_nominal_monte_carlo_of_a_system_without_random_terms_is_constant():
-    result = SYSTEM.run(monte_carlo=5, seed=1, source="tilt")
-    stats = result.monte_carlo.statistics["max_spherical_m"]
-    assert stats["std"] == 0.0 and stats["mean"] == pytest.approx(result.max_spherical_m, rel=1e-15)
+def test_a_monte_carlo_needs_random_terms_or_drawn_parameters():
+    # errors has no random terms of its own: N nominal members would be N copies, so it is refused ...
+    with pytest.raises(InvalidParameter, match="monte_carlo: errors has no random terms"):
+        SYSTEM.run(monte_carlo=5, seed=1, source="tilt")
+    # ... unless parameters are drawn per member (a scenario's [monte_carlo] tables)
+    result = SYSTEM.run(monte_carlo=5, seed=1, source="tilt",
+                        draw=lambda members: {"duration": 3600.0 + 60.0 * members.astype(float)})
+    stats = result.monte_carlo.statistics["final_spherical_m"]
+    assert stats["count"] == 5 and stats["std"] > 0
 
 
 def test_memory_is_refused_before_allocating(monkeypatch):

@@ -46,10 +46,13 @@ def test_example_runs_like_the_system_command(path, run_cli, tmp_path):
     assert out.code == 0, out.stderr
     data = out.json()
     scenario = load_scenario(path)
-    expected = json.loads(json.dumps(scenario.run().to_dict()))
+    expected = json.loads(json.dumps(scenario.definition().run(fidelity=scenario.fidelity, **scenario.given()).to_dict()))
     scalars = {k: v for k, v in expected.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
     assert scalars, "the result has no scalar to compare"
     assert {k: data[k] for k in scalars} == pytest.approx(scalars, rel=1e-9)
+    table = scenario.monte_carlo
+    if table is not None and table.cases:  # the scenario's members: its distributions drawn per member
+        assert data["monte_carlo"]["members"] == table.cases
     assert any((tmp_path / "out").iterdir())  # --out reaches the system's command
 
 

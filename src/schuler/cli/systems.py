@@ -50,7 +50,7 @@ def _given(case) -> dict:
 def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fidelity: str | None,
                 out_dir: Path | None, as_json: bool, draw=None) -> None:
     """What ``schuler NAME run`` and ``schuler run SCENARIO`` do with a parsed case."""
-    with options_named(system.parameters), progress_reporter(f"{system.name} Monte Carlo", enabled=not as_json) \
+    with options_named(system.parameters + RUN_OPTIONS), progress_reporter(f"{system.name} Monte Carlo", enabled=not as_json) \
             as progress:
         result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
                             **_given(case))

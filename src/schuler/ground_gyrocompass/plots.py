@@ -80,7 +80,7 @@ def plot_error_vs_time(durations, series, stem, title, formats=("png", "svg")):
     ax.set_ylabel("north standard error, arcsec")
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
-    ax.legend(loc="upper right", fontsize="small")
+    ax.legend(loc="upper right")
     fig.tight_layout()
     return save_figure_formats(fig, stem, formats)
 
@@ -122,7 +122,7 @@ def plot_error_histogram(errors_arcsec, predicted_std_arcsec, stem, title, forma
     ax.set_xlabel("north error (identified - true), arcsec")
     ax.set_ylabel("probability density, 1/arcsec")
     ax.set_title(title)
-    ax.legend(loc="upper right", fontsize="small")
+    ax.legend(loc="upper right")
     ax.grid(alpha=0.3)
     fig.tight_layout()
     return save_figure_formats(fig, stem, formats)

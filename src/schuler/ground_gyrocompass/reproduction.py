@@ -435,6 +435,16 @@ def reproduce(unknowns: int = 4, method: str = "lsq") -> Reproduction:
             "four_unknowns_first_stage_in_source_units": honest,
             "identification": _identification(estimate),
         },
+        details_units={
+            **{key: "1" for key in ("unknowns", "stage", "cells", "best_scale", "max_deviation")},
+            **{key: "the grid's coordinates as printed: alpha0 and alpha0_dot in the source's steps, lambda in "
+                    "1e-3 1/s, H_m in N m s" for key in ("printed_best", "computed_best", "half_steps", "minimum_cell",
+                                                           "first_stage_best", "refined_best")},
+            **{key: "rad^2 (the misfit F, sum of squared residuals)" for key in (
+                "computed_misfit", "misfit_at_printed_best", "at_printed_minimum", "at_k0_m0", "printed_best_misfit",
+                "first_stage_misfit", "refined_misfit")},
+            **NorthIdentification.units,
+        },
         data=ReproductionFigures(estimate, first_stage, table1),
     )
 

@@ -186,6 +186,7 @@ def reproduce() -> Reproduction:
             "Schuler loop in resonance and the velocity-error amplitudes grow by 2 q_i sqrt(g R)/pi per second "
             "(4 R q_i per Schuler period).",
         ],
+        details_units={"compensation_ratio": "1"},
         details={
             "W_star_x_m_s2": example["W_star_x"], "beta_r_rad": example["beta_r"], "dv_y_m_s": example["dv_y"],
             "source_chain_dv_y_m_s": example["source_chain_dv_y"], "schuler_period_s": schuler,
