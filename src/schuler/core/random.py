@@ -44,8 +44,9 @@ from scipy.special import ndtri
 
 from schuler.exceptions import InvalidParameter
 
-BLOCK = 65_536
-"""Samples per Philox block of :meth:`RandomStreams.normal_series`."""
+BLOCK = 4096
+"""Samples per Philox block of :meth:`RandomStreams.normal_series` (small, so that a window starting
+inside a block regenerates little; one generator is re-keyed per block)."""
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
@@ -106,14 +107,25 @@ class RandomStreams:
         if start < 0 or stop < start:
             raise InvalidParameter("samples", f"window [{start}, {stop}) must satisfy 0 <= start <= stop")
         out = np.empty((members.size, stop - start))
+        if stop == start:
+            return out
         key = _stream_key(self.seed, stream)
-        first, last = start // BLOCK, (stop - 1) // BLOCK if stop > start else start // BLOCK - 1
+        first, last = start // BLOCK, (stop - 1) // BLOCK
+        bits = np.random.Philox(key=np.array([key, 0], dtype=np.uint64))
+        generator = np.random.Generator(bits)
+        state = bits.state
+        scratch = np.empty(BLOCK)
         for row, member in enumerate(members):
+            state["state"]["key"] = np.array([key, int(member) & _MASK64], dtype=np.uint64)
             for block in range(first, last + 1):
-                generator = np.random.Generator(
-                    np.random.Philox(key=np.array([key, int(member) & _MASK64], dtype=np.uint64),
-                                     counter=np.array([0, 0, block, 0], dtype=np.uint64)))
+                # re-keying one generator is cheaper than building one per block
+                state["state"]["counter"] = np.array([0, 0, block, 0], dtype=np.uint64)
+                state["buffer_pos"], state["has_uint32"], state["uinteger"] = 4, 0, 0
+                bits.state = state
                 lo, hi = max(start, block * BLOCK), min(stop, (block + 1) * BLOCK)
-                values = generator.standard_normal(hi - block * BLOCK)
-                out[row, lo - start:hi - start] = values[lo - block * BLOCK:]
+                if lo == block * BLOCK:
+                    generator.standard_normal(out=out[row, lo - start:hi - start])
+                else:
+                    generator.standard_normal(out=scratch[:hi - block * BLOCK])
+                    out[row, lo - start:hi - start] = scratch[lo - block * BLOCK:hi - block * BLOCK]
         return out
