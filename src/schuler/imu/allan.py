@@ -183,9 +183,11 @@ class AllanAccumulator:
             self._tails[c] = phase[-min(phase.size, self._span + 1):].copy()
         self.samples += chunk.shape[0]
 
-    def curves(self, with_confidence: bool = True) -> list[AllanCurve]:
-        """One :class:`AllanCurve` per channel, over the lags that had at least one second difference."""
+    def curves(self, with_confidence: bool = True, max_lag: int | None = None) -> list[AllanCurve]:
+        """One :class:`AllanCurve` per channel, over the lags (up to ``max_lag``) with at least one second difference."""
         valid = self._counts[0] > 0
+        if max_lag is not None:
+            valid &= self.lags <= max(1, int(max_lag))
         lags = self.lags[valid]
         tau = lags * self.dt
         out = []
