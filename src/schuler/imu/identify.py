@@ -12,6 +12,12 @@ the measured values would favour points that happen to fall low). The
 covariance of the active coefficients is (A^T W A)^-1; a term's standard
 uncertainty follows by the delta method, u(N) = u(N^2) / (2 N).
 
+When chi^2 per point exceeds 2 the five terms do not describe the curve (a
+vehicle's sway, periodic disturbances); a relative uncertainty ``model_floor``
+is then added to every point, the smallest that brings chi^2 per point to 1
+(an extra-variance, Birge-ratio treatment), and the terms are to be read as a
+description of the curve, not of the sensor.
+
 The overlapping estimates at neighbouring tau are correlated (they share
 data), which the weights ignore: the uncertainties are therefore too small by
 a factor of about 1.5 to 2 at two lags per octave (measured over seeds in
@@ -82,6 +88,11 @@ class NoiseTerms:
     resolved : dict of bool
     dominant_tau_s : dict
         (first, last) tau where the term makes >= 1/4 of the model variance, or None.
+    chi2_per_point : float
+        Mean squared normalised residual of the plain weighted fit (about 1 when the terms describe the curve).
+    model_floor : float
+        Relative uncertainty added to every point when they do not (chi2_per_point > 2): the smallest
+        that brings chi^2 per point to 1, so that no short-tau point with a huge edf rules the fit.
     """
 
     values: dict[str, float]
@@ -90,6 +101,7 @@ class NoiseTerms:
     resolved: dict[str, bool]
     dominant_tau_s: dict[str, tuple[float, float] | None]
     chi2_per_point: float
+    model_floor: float = 0.0
 
     def model_adev(self, tau) -> np.ndarray:
         """The fitted model's Allan deviation at ``tau``."""
@@ -127,17 +139,14 @@ def identify_terms(curve: AllanCurve, terms=TERMS, passes: int = 4) -> NoiseTerm
         raise IdentificationError(f"unknown term {sorted(unknown)[0]!r}; terms are {', '.join(TERMS)}")
     chosen = np.array([t in terms for t in TERMS])
     basis = term_basis(tau)[:, chosen]
-    scale = np.sqrt(np.mean(basis**2, axis=0)) / np.sqrt(np.mean(avar**2))  # columns of comparable size
-    model = avar.copy()
-    for _ in range(max(1, passes)):
-        spread = model * np.sqrt(2.0 / edf)
-        weighted = basis / scale / spread[:, None]
-        solution, _ = nnls(weighted, avar / spread, maxiter=50 * basis.shape[1])
-        coefficients = solution / scale
-        fitted = basis @ coefficients
-        model = np.where(fitted > 0, fitted, avar)
-    spread = model * np.sqrt(2.0 / edf)
-    residual = (avar - fitted) / spread
+    floor = 0.0
+    coefficients, fitted, spread, chi2 = _weighted_fit(basis, avar, edf, floor, passes)
+    plain_chi2 = chi2
+    if chi2 > 2.0:  # the five terms do not describe the curve (motion, periodic disturbances)
+        for floor in np.geomspace(1e-3, 3.0, 36):
+            coefficients, fitted, spread, chi2 = _weighted_fit(basis, avar, edf, floor, passes)
+            if chi2 <= 1.0:
+                break
     information = (basis / spread[:, None]).T @ (basis / spread[:, None])
     active = coefficients > 0
     covariance = np.full(information.shape, np.nan)
@@ -163,4 +172,23 @@ def identify_terms(curve: AllanCurve, terms=TERMS, passes: int = 4) -> NoiseTerm
         resolved[term] = bool(c > 0 and c >= 2.0 * c_sigma)
         index += 1
     return NoiseTerms(values=values, sigma=sigma, upper_bound=upper, resolved=resolved, dominant_tau_s=dominant,
-                      chi2_per_point=float(np.mean(residual**2)))
+                      chi2_per_point=plain_chi2,
+                      model_floor=float(floor))
+
+
+def _weighted_fit(basis, avar, edf, floor: float, passes: int):
+    """NNLS with weights 1 / (model sigma^2 sqrt(2/edf + floor^2)), reweighted ``passes`` times.
+
+    Returns coefficients, fitted variance, point spreads and chi^2 per point.
+    """
+    scale = np.sqrt(np.mean(basis**2, axis=0)) / np.sqrt(np.mean(avar**2))  # columns of comparable size
+    relative = np.sqrt(2.0 / edf + floor**2)
+    model = avar.copy()
+    for _ in range(max(1, passes)):
+        spread = model * relative
+        solution, _ = nnls(basis / scale / spread[:, None], avar / spread, maxiter=50 * basis.shape[1])
+        coefficients = solution / scale
+        fitted = basis @ coefficients
+        model = np.where(fitted > 0, fitted, avar)
+    spread = model * relative
+    return coefficients, fitted, spread, float(np.mean(((avar - fitted) / spread) ** 2))
