@@ -235,3 +235,29 @@ def reproduce_psins(path) -> PsinsReproduction:
         horizontal_earth_rate_ratio=float(math.hypot(gyro[0], gyro[1]) / (EARTH_RATE * math.cos(latitude))),
         vertical_earth_rate_ratio=float(gyro[2] / (-EARTH_RATE * math.sin(latitude))),
         specific_force_z_m_s2=float(info.mean_accel_m_s2[2]), grade=analysis.grade, notes=notes)
+
+
+def model_from_analysis(result: AllanResult, name: str | None = None) -> ErrorModel:
+    """An :class:`~schuler.imu.error_model.ErrorModel` of the identified noise terms (for simulation and mapping).
+
+    N, K and Q become random walk, rate random walk and quantisation; B becomes
+    flicker over the record's tau range (the Gauss-Markov sum of
+    :func:`~schuler.imu.error_model.flicker_terms`). Unresolved terms are left at
+    zero; R has no counterpart (a rate ramp is a trend, not noise). Constant
+    biases, scale factors and misalignments cannot be seen in an Allan curve and
+    stay zero.
+    """
+    def triad(sensor: str) -> SensorErrors:
+        values = {term: np.zeros(3) for term in ("Q", "N", "B", "K")}
+        low, high = math.inf, 0.0
+        for axis, letter in enumerate("xyz"):
+            channel = result.noise[f"{sensor}_{letter}"]
+            low, high = min(low, channel.curve.tau_s[0]), max(high, channel.curve.tau_s[-1])
+            for term in values:
+                if channel.terms.resolved[term]:
+                    values[term][axis] = channel.terms.values[term]
+        return SensorErrors(quantization=values["Q"], random_walk=values["N"], bias_instability=values["B"],
+                            rate_random_walk=values["K"], flicker_tau_range_s=(low, high))
+
+    return ErrorModel(gyro=triad("gyro"), accel=triad("accel"), name=name or f"identified from {result.source}",
+                      source=f"Allan analysis of {result.source}")

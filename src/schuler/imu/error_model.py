@@ -19,6 +19,11 @@ force), body axes, as simulated by :mod:`~schuler.imu.simulate`::
 * quantisation: the accumulated increment is output in steps q = sqrt(12) Q
   (white angle noise of standard deviation Q, IEEE Std 952's Q).
 
+The white noise is the mean over each sample interval; the Gauss-Markov terms
+and the rate random walk are point samples held over it, so at the shortest
+lags their Allan variance exceeds the continuous formulas below by the
+point-sampling factor (1 + 1 / (2 m^2)) at tau = m dt (1.5 at m = 1, < 2 % from m = 5).
+
 Allan variance of the rate (IEEE Std 952-1997, Annex C; El-Sheimy et al. 2008)::
 
     sigma^2(tau) = 3 Q^2 / tau^2 + N^2 / tau + (2 ln 2 / pi) B^2 + K^2 tau / 3 + R^2 tau^2 / 2
