@@ -20,8 +20,9 @@ Confidence intervals: chi-square with Greenhall's equivalent degrees of freedom
 (``allantools.edf_greenhall``; C. A. Greenhall, W. J. Riley, "Uncertainty of
 stability variances based on finite differences", PTTI 2003) for the power-law
 noise type alpha read from the local slope of the curve: sigma^2 ~ tau^mu with
-alpha = -mu - 1 rounded into [-2, 2] (white angle noise: mu = -2, alpha = 2;
-angle random walk: alpha = 0; flicker: -1; rate random walk: -2).
+alpha = -mu - 1 rounded into [-2, 0] (angle random walk: alpha = 0; flicker: -1;
+rate random walk: -2), and alpha = 2 (white angle noise, quantisation) where
+mu < -1.5.
 """
 
 from __future__ import annotations
@@ -103,7 +104,8 @@ def noise_types(tau, avar) -> np.ndarray:
         if near.sum() < 2:
             near = np.abs(np.arange(log_tau.size) - i) <= 1
         slope = np.polyfit(log_tau[near], log_avar[near], 1)[0] if near.sum() >= 2 else -1.0
-        alpha[i] = int(np.clip(round(-slope - 1.0), -2, 2))
+        # mu = -2 is white (or flicker) angle noise: quantisation, alpha = 2
+        alpha[i] = 2 if slope < -1.5 else int(np.clip(round(-slope - 1.0), -2, 0))
     return alpha
 
 

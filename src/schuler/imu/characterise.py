@@ -22,7 +22,7 @@ from schuler.exceptions import InvalidParameter
 from schuler.imu.allan import DEFAULT_MAX_FRACTION, AllanAccumulator, AllanCurve, allan_lags
 from schuler.imu.error_model import ErrorModel, SensorErrors
 from schuler.imu.files import open_record, read_record
-from schuler.imu.identify import TERMS, identify_terms
+from schuler.imu.identify import TERMS, identify_terms, no_terms
 from schuler.imu.readers import RecordSource
 from schuler.imu.record import ImuRecord, record_info
 from schuler.imu.results import (
@@ -37,14 +37,13 @@ from schuler.imu.results import (
 from schuler.imu.simulate import simulate_record
 from schuler.imu.spec import GRADES, preset
 
-TOLERANCE_FACTORS = {"Q": 5.0, "N": 5.0, "B": 5.0, "K": 5.0, "R": 5.0}
-"""Round-trip tolerance of each term in units of its fitted standard uncertainty.
+TOLERANCE_FACTORS = {"Q": 3.0, "N": 3.0, "B": 3.0, "K": 3.0, "R": 3.0}
+"""Round-trip tolerance of each term in units of its standard uncertainty (3 sigma).
 
-The fit's sigma neglects the correlation of overlapping estimates at
-neighbouring tau (a factor ~1.5-2, tests/test_imu_identify.py); 5 sigma of the
-fit is therefore about 3 true sigma. The sigma itself is what makes N and Q tight
-(~0.1-1 %: many short-tau points with huge edf) and B and K loose (10-50 %: the
-few long-tau points with edf of a few)."""
+The sigma (:mod:`~schuler.imu.identify`, inflated for the correlation of
+overlapping estimates) is what makes N and Q tight (~0.1-1 %: many short-tau
+points with huge edf) and B and K loose (10-50 %: the few long-tau points with
+edf of a few)."""
 
 GRADE_CONFIDENCE = 0.99
 """Confidence of the upper bound of a measured Allan deviation that a grade's model must stay below."""
@@ -106,7 +105,8 @@ def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, k
     if accumulator.samples < 16:
         raise InvalidParameter("samples", f"an Allan analysis needs at least 16 samples, got {accumulator.samples}")
     curves = accumulator.curves(max_lag=int(accumulator.samples * max_fraction))
-    noise = {name: ChannelNoise(curve=curve, terms=identify_terms(curve)) for name, curve in zip(CHANNELS, curves)}
+    noise = {name: ChannelNoise(curve=curve, terms=identify_terms(curve) if np.any(curve.adev > 0) else no_terms())
+             for name, curve in zip(CHANNELS, curves)}
     grade, margins = classify_grade(noise)
     return AllanResult(source=source, samples=accumulator.samples, sample_interval_s=dt,
                        duration_s=accumulator.samples * dt, noise=noise, grade=grade, grade_margin=margins)
