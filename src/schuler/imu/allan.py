@@ -132,6 +132,11 @@ class AllanAccumulator:
         Lags m (samples); see :func:`allan_lags`.
     channels : int
         Columns of each chunk.
+    offsets : array_like, optional
+        The constant c per channel removed before integrating (default: the
+        mean of the first chunk). Any constant gives the same Allan variance in
+        exact arithmetic; the whole record's mean, when known, gives allantools'
+        phase bit for bit.
 
     Examples
     --------
@@ -145,7 +150,7 @@ class AllanAccumulator:
     True
     """
 
-    def __init__(self, sample_interval_s: float, lags, channels: int = 6):
+    def __init__(self, sample_interval_s: float, lags, channels: int = 6, offsets=None):
         self.dt = float(sample_interval_s)
         if not (math.isfinite(self.dt) and self.dt > 0):
             raise InvalidParameter("sample_interval_s", f"must be finite and > 0, got {sample_interval_s!r}")
@@ -157,7 +162,7 @@ class AllanAccumulator:
         self._span = 2 * int(self.lags.max())
         self._tails = [np.zeros(1) for _ in range(self.channels)]  # theta_0 = 0
         self._totals = np.zeros(self.channels)
-        self._offsets: np.ndarray | None = None
+        self._offsets = None if offsets is None else np.asarray(offsets, dtype=float).reshape(self.channels)
         self._sums = np.zeros((self.channels, self.lags.size))
         self._counts = np.zeros((self.channels, self.lags.size), dtype=np.int64)
 
@@ -223,7 +228,7 @@ def allan_deviation(rates, sample_interval_s: float, lags=None, chunk: int = 1 <
     """
     rates = np.asarray(rates, dtype=float).reshape(-1)
     lags = allan_lags(rates.size) if lags is None else lags
-    accumulator = AllanAccumulator(sample_interval_s, lags, channels=1)
+    accumulator = AllanAccumulator(sample_interval_s, lags, channels=1, offsets=[np.mean(rates)])
     for start in range(0, rates.size, chunk):
         accumulator.update(rates[start:start + chunk])
     return accumulator.curves()[0]
