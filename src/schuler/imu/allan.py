@@ -42,8 +42,8 @@ DEFAULT_MAX_FRACTION = 0.125
 def allan_lags(samples: int, per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION) -> np.ndarray:
     """Lags m (in samples), ``per_octave`` per octave from 1 up to ``max_fraction`` x samples.
 
-    >>> allan_lags(100, per_octave=1)
-    array([ 1,  2,  4,  8])
+    >>> allan_lags(100, per_octave=1).tolist()
+    [1, 2, 4, 8]
     """
     if samples < 4:
         raise InvalidParameter("samples", f"an Allan deviation needs at least 4 samples, got {samples}")

@@ -118,7 +118,7 @@ def analyse_record(record: ImuRecord, per_octave: int = 2, max_fraction: float =
     >>> from schuler.imu.spec import preset
     >>> record = simulate_record(preset("consumer"), duration_s=60.0, sample_interval_s=0.01, seed=2)
     >>> result = analyse_record(record)
-    >>> round(result.noise["gyro_x"].terms.values["N"] / preset("consumer").gyro.random_walk[0], 1)
+    >>> round(float(result.noise["gyro_x"].terms.values["N"] / preset("consumer").gyro.random_walk[0]), 1)
     1.0
     """
     chunks = [(record.time_s, record.gyro_rate_rad_s, record.accel_m_s2)]
