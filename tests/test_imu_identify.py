@@ -62,7 +62,8 @@ def test_fast_round_trip_tactical():
     assert result.all_within
     n_checks = [c for c in result.checks if c.term == "N"]
     assert len(n_checks) == 6
-    assert all(abs(c.identified / c.true - 1) < 0.02 for c in n_checks)   # N is tight: < 2 %
+    # N is tight: < 3 % (the accelerometers carry ~2 % of method bias: their flicker sum is not flat below 1 s)
+    assert all(abs(c.identified / c.true - 1) < 0.03 for c in n_checks)
     assert "Round trip" in str(result) and result.to_dict()["checks"]
 
 

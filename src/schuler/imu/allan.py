@@ -22,7 +22,8 @@ stability variances based on finite differences", PTTI 2003) for the power-law
 noise type alpha read from the local slope of the curve: sigma^2 ~ tau^mu with
 alpha = -mu - 1 rounded into [-2, 0] (angle random walk: alpha = 0; flicker: -1;
 rate random walk: -2), and alpha = 2 (white angle noise, quantisation) where
-mu < -1.5.
+mu < -1.5; alpha may only decrease with tau (the dominant noise gets redder), so
+that a steep stretch of a noisy long-tau tail does not get white-noise edf.
 """
 
 from __future__ import annotations
@@ -96,7 +97,7 @@ class AllanCurve:
 
 
 def noise_types(tau, avar) -> np.ndarray:
-    """alpha per tau from the local log-log slope of the Allan variance over about +/- one octave."""
+    """alpha per tau from the local log-log slope of the Allan variance over about +/- one octave, non-increasing."""
     log_tau, log_avar = np.log(np.asarray(tau, float)), np.log(np.maximum(np.asarray(avar, float), 1e-300))
     alpha = np.zeros(log_tau.size, dtype=int)
     for i in range(log_tau.size):
@@ -106,7 +107,9 @@ def noise_types(tau, avar) -> np.ndarray:
         slope = np.polyfit(log_tau[near], log_avar[near], 1)[0] if near.sum() >= 2 else -1.0
         # mu = -2 is white (or flicker) angle noise: quantisation, alpha = 2
         alpha[i] = 2 if slope < -1.5 else int(np.clip(round(-slope - 1.0), -2, 0))
-    return alpha
+    # noise gets redder with tau: a steep stretch of a noisy long-tau tail is not white angle noise,
+    # whose edf would be far larger (a point with a false huge edf would rule the term fit)
+    return np.minimum.accumulate(alpha)
 
 
 def confidence(adev, alpha, lags, phase_points: int, confidence_level: float = 0.6826894921370859):

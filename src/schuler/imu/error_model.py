@@ -151,7 +151,7 @@ def flicker_terms(bias_instability: float, tau_range: tuple[float, float],
     -------
     sigmas, correlation_times : ndarray
         Equal variances sigma_j^2 = B^2 ln(r) / pi for ratio r = 10^(1/per_decade)
-        between neighbouring T_j, which spread from tau_lo / 30 to 3 tau_hi.
+        between neighbouring T_j, which spread from tau_lo / 15 to 3 tau_hi.
 
     Notes
     -----
@@ -159,14 +159,14 @@ def flicker_terms(bias_instability: float, tau_range: tuple[float, float],
     sum with log-uniform T and equal variances integrates to sigma^2 / (2 f ln r),
     equal to flicker's B^2 / (2 pi f) (IEEE 952 C.1) for sigma^2 = B^2 ln r / pi.
     The terms extend half a decade and more beyond the range so that its edges
-    do not roll off: the Allan deviation stays within 4 % of 0.6643 B inside ``tau_range``
+    do not roll off: the Allan deviation stays within 3 % of 0.6643 B inside ``tau_range``
     (tests/test_imu_error_model.py).
     """
     low, high = (float(v) for v in tau_range)
     if not (0 < low < high and math.isfinite(high)):
         raise InvalidParameter("flicker_tau_range", f"({low:g}, {high:g}) s must satisfy 0 < low < high")
     ratio = 10.0 ** (1.0 / per_decade)
-    first, last = math.log10(low / 30.0), math.log10(high * 3.0)
+    first, last = math.log10(low / 15.0), math.log10(high * 3.0)
     count = max(2, int(math.ceil((last - first) * per_decade)) + 1)
     times = np.logspace(first, first + (count - 1) / per_decade, count)
     sigma = bias_instability * math.sqrt(math.log(ratio) / math.pi)

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE, normal_gravity
-from schuler.core.random import RandomStreams
+from schuler.core.random import BLOCK, RandomStreams
 from schuler.exceptions import InvalidParameter
 from schuler.imu import _kernels
 from schuler.imu.error_model import ErrorModel, SensorErrors, flicker_terms
@@ -131,6 +131,7 @@ class _MemberState:
     next_sample: int = 0
     coarse: dict = field(default_factory=dict)  # stream -> (last index, value before, value at last)
     residual: dict = field(default_factory=dict)  # channel -> quantiser residual
+    blocks: dict = field(default_factory=dict)  # stream -> (block number, its BLOCK normals), see _normals
 
 
 class ImuSimulator:
@@ -216,7 +217,7 @@ class ImuSimulator:
         index, before, value = state.coarse[process.stream]
         new = np.empty(max(0, last - index))
         if new.size:
-            normals = self.streams.normal_series(process.stream, [member], index + 1, last + 1)[0]
+            normals = self._normals(member, state, process.stream, index + 1, last + 1)
             _kernels.recurse(process.phi, process.drive, normals, value, new)
         known = np.array([before, value]) if index == first + 1 else np.array([value])
         coarse = np.concatenate([known, new])
@@ -225,6 +226,31 @@ class ImuSimulator:
             state.coarse[process.stream] = (last, new[-2], new[-1])
         elif new.size == 1:
             state.coarse[process.stream] = (last, value, new[-1])
+
+    def _normals(self, member: int, state: _MemberState, stream: str, lo: int, hi: int) -> np.ndarray:
+        """Normals lo .. hi-1 of a coarse stream, drawn by whole blocks with the last block kept for the next window.
+
+        A coarse window is short and starts inside a block; drawing whole blocks
+        and keeping the last one avoids regenerating its start every window. The
+        numbers are those of :meth:`~schuler.core.random.RandomStreams.normal_series`.
+        """
+        parts, k = [], lo
+        cached = state.blocks.get(stream)
+        if cached is not None and cached[0] * BLOCK <= k < (cached[0] + 1) * BLOCK:
+            end = min(hi, (cached[0] + 1) * BLOCK)
+            parts.append(cached[1][k - cached[0] * BLOCK:end - cached[0] * BLOCK])
+            k = end
+        if k < hi:
+            first, stop = (k // BLOCK) * BLOCK, -(-hi // BLOCK) * BLOCK
+            fresh = self.streams.normal_series(stream, [member], first, stop)[0]
+            parts.append(fresh[k - first:hi - first])
+            state.blocks[stream] = (stop // BLOCK - 1, fresh[-BLOCK:])
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+    def forget(self, members) -> None:
+        """Drop the carried state of ``members`` (their next window replays from sample 0)."""
+        for member in np.asarray(members, dtype=np.int64).reshape(-1):
+            self._states.pop(int(member), None)
 
     def _member_window(self, member: int, start: int, stop: int, constants: dict, row: int) -> np.ndarray:
         state = self._states.get(member)
@@ -325,6 +351,7 @@ def iter_simulation(simulator: ImuSimulator, members, samples: int, window: int 
             stop = min(samples, start + window)
             gyro, accel = simulator.window(group, start, stop)
             yield group, start, gyro, accel
+        simulator.forget(group)
 
 
 def simulate_members(model: ErrorModel, *, samples: int, sample_interval_s: float, members=1, seed: int = 0,
