@@ -46,11 +46,13 @@ def add_interpolated(target: np.ndarray, coarse: np.ndarray, first_coarse: int, 
 def quantize(increments: np.ndarray, quantum: float, residual: float) -> float:
     """Replace increments by whole quanta of the accumulated sum (in place); return the carried residual.
 
-    The residual stays in [0, quantum): out_k = quantum floor((residual + increment_k) / quantum).
+    out_k = quantum floor((residual + increment_k) / quantum); the residual stays in [0, quantum) up to
+    the rounding of the reciprocal.
     """
+    inverse = 1.0 / quantum
     for k in range(increments.size):
         total = residual + increments[k]
-        count = math.floor(total / quantum)
+        count = math.floor(total * inverse)
         increments[k] = count * quantum
         residual = total - count * quantum
     return residual
