@@ -136,7 +136,7 @@ def test_a_least_squares_fit_of_a_gauss_markov_bump_is_not_the_peak_read_off():
     assert curve.adev.max() / FLICKER_FLOOR == pytest.approx(0.9294, rel=0.01)
 
 
-@pytest.mark.parametrize("grade", ["tactical", "consumer"])
+@pytest.mark.parametrize("grade", ["tactical", "industrial", "consumer"])
 def test_a_clean_record_of_a_grade_is_classified_as_it(grade):
     record = simulate_record(preset(grade), duration_s=1200.0, sample_interval_s=0.01, seed=6)
     assert analyse_record(record).grade == grade

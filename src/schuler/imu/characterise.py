@@ -54,15 +54,18 @@ the bound is within 1 % of the measured curve, closer than a model and its simul
 
 
 def classify_grade(noise: dict) -> tuple[str | None, dict[str, float]]:
-    """The noisiest grade preset whose gyro Allan deviation stays below the measured one at every tau.
+    """The grade preset whose gyro Allan deviation stays below the measured one at every tau and comes closest.
 
     A record's Allan deviation is the sensor's plus whatever else moved it
     (vibration, sway), so a grade is consistent with the record when its model
     curve (:meth:`~schuler.imu.error_model.SensorErrors.allan_variance`: Q, N,
     flicker B, K) lies below the upper 99 % confidence bound of every gyro
-    channel (with :data:`GRADE_ALLOWANCE`); the noisiest consistent grade is the record's. A clean record of a
-    grade therefore returns that grade, and a record dominated by motion still
-    gets the grade its noise floor allows.
+    channel (with :data:`GRADE_ALLOWANCE`); of the consistent grades, the one
+    whose curve comes closest to the record's (the largest margin) is the
+    record's. The presets are not nested (the consumer part's noise density is
+    below the industrial module's), so "closest" rather than "noisiest". A clean
+    record of a grade therefore returns that grade, and a record dominated by
+    motion still gets the grade its noise floor allows.
 
     Parameters
     ----------
@@ -90,7 +93,7 @@ def classify_grade(noise: dict) -> tuple[str | None, dict[str, float]]:
             worst = max(worst, float(np.max(expected / upper)))
         margins[grade] = worst
     consistent = [grade for grade in GRADES if margins[grade] <= GRADE_ALLOWANCE]
-    return (consistent[-1] if consistent else None), margins
+    return (max(consistent, key=margins.get) if consistent else None), margins
 
 
 def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, kind: str = "rate",

@@ -73,8 +73,8 @@ def _term_text(channel: str, term: str, value: float, resolved: bool, upper: flo
 class AllanResult(Result):
     """Allan deviation and IEEE 952 terms of the six channels of a record.
 
-    ``noise`` maps channel -> :class:`ChannelNoise`; ``grade`` is the noisiest
-    preset whose gyro Allan deviation stays below the record's
+    ``noise`` maps channel -> :class:`ChannelNoise`; ``grade`` is the preset
+    whose gyro Allan deviation stays below the record's and comes closest
     (:func:`~schuler.imu.characterise.classify_grade`), ``grade_margin`` the
     largest ratio of each preset's curve to the record's upper bound.
     """
@@ -123,7 +123,7 @@ class AllanResult(Result):
                 table.add_row(name, *(_term_text(name, term, t.values[term], t.resolved[term], t.upper_bound[term])
                                       for term in "NBKQR"), f"{t.chi2_per_point:.3g}")
         if self.grade:
-            table.caption = (f"grade: {self.grade} (the noisiest preset below the gyro curves); '< x': not "
+            table.caption = (f"grade: {self.grade} (the closest preset below the gyro curves); '< x': not "
                              "resolved in this record, about 2-sigma upper bound")
         return table
 
