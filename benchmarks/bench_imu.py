@@ -107,29 +107,29 @@ def bench_simulation() -> float:
     seconds = simulate(2, members, length)
     rate = members * length / seconds
     # the share of random-number generation, from a single-threaded run with the generator timed
-    spent = [0.0]
+    spent, drawn = [0.0], [0]
     original = addressed_random.RandomStreams.normal_series
 
     def timed(self, *args, **kwargs):
         begin = time.perf_counter()
-        try:
-            return original(self, *args, **kwargs)
-        finally:
-            spent[0] += time.perf_counter() - begin
+        values = original(self, *args, **kwargs)
+        spent[0] += time.perf_counter() - begin
+        drawn[0] += values.size
+        return values
 
     addressed_random.RandomStreams.normal_series = timed
     try:
         single = simulate(1, 2, length)
     finally:
         addressed_random.RandomStreams.normal_series = original
-    generator, block = np.random.Generator(np.random.Philox(3)), np.empty(length)
+    streams = addressed_random.RandomStreams(3)
     begin = time.perf_counter()
-    for _ in range(4):
-        generator.standard_normal(out=block)
+    streams.normal_series("bench", [0], 0, 4 * length)
     normals = 4 * length / (time.perf_counter() - begin)
+    per_sample = drawn[0] / (2 * length)
     print(f"simulation: {every_term_model().name}, {members} members x {length:,} samples x 6 axes at 100 Hz")
-    print(f"  numpy Philox normals, 1 thread: {normals / 1e6:6.1f} M/s: at least 6 per six-axis sample bound one "
-          f"thread to {normals / 6e6:.2f} M six-axis samples/s")
+    print(f"  addressed normals, 1 thread  : {normals / 1e6:6.1f} M/s; the simulation draws {per_sample:.1f} per "
+          f"six-axis sample, which bounds one thread to {normals / per_sample / 1e6:.2f} M six-axis samples/s")
     print(f"  2 workers                    : {seconds:8.2f} s = {rate / 1e6:6.2f} M six-axis samples/s "
           f"(target >= 2)")
     print(f"  1 worker                     : {2 * length / single / 1e6:6.2f} M six-axis samples/s; random numbers "
