@@ -22,10 +22,13 @@ demo: $(VENV)/.installed
 	$(BIN)/schuler report --out $(OUT)
 	@echo "Open $(OUT)/index.html in a browser."
 
+# the PSINS laser-gyro recording beside the checkout (not part of the project): its tests skip without it
+PSINS_IMU ?= $(abspath $(wildcard ../shared/data/psins/lasergyro.imu))
+
 # one BLAS thread per test process: the models' matrices are small, and two
 # processes already use both cores
 test: $(VENV)/.installed-test
-	OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2 -q
+	SCHULER_PSINS_IMU="$(PSINS_IMU)" OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2 -q
 
 bench: $(VENV)/.installed-test
 	for b in benchmarks/bench_*.py; do OPENBLAS_NUM_THREADS=1 $(BIN)/python $$b || exit 1; done

@@ -11,6 +11,8 @@ Two traps of the units library are closed here:
   ``mg``, ``ug``/``µg``) means standard gravity g0 = 9.80665 m/s^2, as the field
   writes it ("1e-4 g"). The explicit spellings ``g0`` and ``gee`` mean standard
   gravity everywhere.
+* **Spec sheets write square roots**: "deg/sqrt(h)", "ug/√Hz". pint knows
+  neither spelling (it silently drops "√"), so both become ``**0.5`` first.
 * **Radians are dimensionless in pint**, so "0.01 Hz" would pass as an angular
   rate and "95 percent" as an angle. Every option whose display unit carries an
   angle (deg, deg/h, arcmin ...) requires the value to carry an angle unit too,
@@ -54,6 +56,10 @@ _ANGLE_RATE_UNITS = frozenset({"revolutions_per_minute", "revolutions_per_second
 _G_TOKEN = re.compile(r"(?<![A-Za-z_])(m|u|µ|micro|milli)?g(?![A-Za-z_0-9])")
 _G_PREFIX = {None: "", "m": "milli", "milli": "milli", "u": "micro", "µ": "micro", "micro": "micro"}
 
+# sqrt(X) and √X / √(X) as spec sheets write them
+_SQRT_CALL = re.compile(r"(?:sqrt|√)\s*\(([^()]*)\)")
+_SQRT_SIGN = re.compile(r"√\s*([A-Za-zµ_][A-Za-z0-9µ_]*)")
+
 _KIND_NAMES = {
     "[length]": "a length",
     "[length] / [time]": "a speed",
@@ -82,7 +88,12 @@ def _display_unit(unit: str) -> pint.Unit:
 
 
 def _standard_gravity_spelling(text: str) -> str:
-    return _G_TOKEN.sub(lambda m: f"{_G_PREFIX[m.group(1)]}g0", text)
+    return _G_TOKEN.sub(lambda m: f"{_G_PREFIX[m.group(1)]}g0", _square_roots(text))
+
+
+def _square_roots(text: str) -> str:
+    """"deg/sqrt(h)", "ug/√Hz" -> "deg/(h)**0.5", "ug/Hz**0.5"."""
+    return _SQRT_SIGN.sub(r"\1**0.5", _SQRT_CALL.sub(r"(\1)**0.5", text))
 
 
 def _describe(unit: pint.Unit) -> str:
@@ -97,8 +108,11 @@ def _describe(unit: pint.Unit) -> str:
     return _KIND_NAMES.get(dims, f"a quantity in {unit:~P}")
 
 
-def _is_acceleration(unit: pint.Unit) -> bool:
-    return unit.dimensionality == ureg.Unit("m/s^2").dimensionality
+def _gravity_units_expected(unit: pint.Unit) -> bool:
+    """A bare g means standard gravity where the unit involves length and time but no mass
+    (an acceleration, a noise density in ug/sqrt(Hz), a g-sensitivity in deg/h/g)."""
+    dims = unit.dimensionality
+    return dims.get("[mass]", 0) == 0 and dims.get("[length]", 0) != 0 and dims.get("[time]", 0) != 0
 
 
 def parse_quantity(value, unit: str, *, name: str) -> float:
@@ -140,7 +154,7 @@ def parse_quantity(value, unit: str, *, name: str) -> float:
         try:
             quantity = ureg.Quantity(float(text), target)
         except ValueError:
-            spelled = _standard_gravity_spelling(text) if _is_acceleration(target) else text
+            spelled = _standard_gravity_spelling(text) if _gravity_units_expected(target) else _square_roots(text)
             try:
                 quantity = ureg.Quantity(spelled)
             except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError, KeyError):

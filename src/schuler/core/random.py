@@ -1,4 +1,4 @@
-"""Counter-based random numbers: a draw depends on (seed, stream, member, index), never on chunking.
+"""Addressed random numbers: a draw depends on (seed, stream, member, index), never on chunking.
 
 Monte Carlo members, sweep cases and long sensor records are evaluated in
 chunks whose size depends on memory, executor and resumption. So that results
@@ -17,10 +17,12 @@ Two generators serve two shapes of need:
   generators", OOPSLA 2014) of its address, fully vectorised.
 * :meth:`RandomStreams.normal_series`: long series per member (sensor noise).
   Samples are grouped in blocks of :data:`BLOCK` consecutive indices; block ``b``
-  of a member comes from numpy's Philox counter-based generator (Salmon et al.,
-  "Parallel random numbers: as easy as 1, 2, 3", SC 2011) keyed by
-  (seed, stream, member) with the block number in its counter. Any time window
-  ``[start, stop)`` therefore gets the same numbers whichever windows came before.
+  of a member comes from numpy's SFC64 generator seeded by ``SeedSequence`` with
+  the address (seed and stream key, member, b): SeedSequence hashes its entropy
+  so that neighbouring addresses give independent streams (numpy's recommended
+  way to make parallel streams; SFC64 draws normals about 1.5 times as fast as the
+  counter-based Philox on this kind of machine). Any time window ``[start, stop)``
+  therefore gets the same numbers whichever windows came before.
 
 Examples
 --------
@@ -45,7 +47,7 @@ from scipy.special import ndtri
 from schuler.exceptions import InvalidParameter
 
 BLOCK = 65_536
-"""Samples per Philox block of :meth:`RandomStreams.normal_series`."""
+"""Samples per generator block of :meth:`RandomStreams.normal_series`."""
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
@@ -106,14 +108,19 @@ class RandomStreams:
         if start < 0 or stop < start:
             raise InvalidParameter("samples", f"window [{start}, {stop}) must satisfy 0 <= start <= stop")
         out = np.empty((members.size, stop - start))
+        if stop == start:
+            return out
         key = _stream_key(self.seed, stream)
-        first, last = start // BLOCK, (stop - 1) // BLOCK if stop > start else start // BLOCK - 1
+        first, last = start // BLOCK, (stop - 1) // BLOCK
+        scratch = np.empty(BLOCK)
         for row, member in enumerate(members):
             for block in range(first, last + 1):
-                generator = np.random.Generator(
-                    np.random.Philox(key=np.array([key, int(member) & _MASK64], dtype=np.uint64),
-                                     counter=np.array([0, 0, block, 0], dtype=np.uint64)))
+                generator = np.random.Generator(np.random.SFC64(np.random.SeedSequence(
+                    [key, int(member) & _MASK64, block])))
                 lo, hi = max(start, block * BLOCK), min(stop, (block + 1) * BLOCK)
-                values = generator.standard_normal(hi - block * BLOCK)
-                out[row, lo - start:hi - start] = values[lo - block * BLOCK:]
+                if lo == block * BLOCK:
+                    generator.standard_normal(out=out[row, lo - start:hi - start])
+                else:  # a window starting inside the block: its start is drawn and dropped
+                    generator.standard_normal(out=scratch[:hi - block * BLOCK])
+                    out[row, lo - start:hi - start] = scratch[lo - block * BLOCK:hi - block * BLOCK]
         return out

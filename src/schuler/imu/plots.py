@@ -1,0 +1,81 @@
+"""Figures of the IMU layer: log-log Allan deviation with confidence bands, the fit, slope lines and values.
+
+Each function builds one matplotlib figure from SI results and shows gyros in
+deg/h and accelerometers in ug; :func:`write_figures` saves figures (PNG and
+SVG) through :mod:`schuler.io`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from schuler.imu.error_model import ErrorModel
+from schuler.imu.identify import SLOPES, term_allan_deviations
+from schuler.imu.results import DISPLAY_UNITS, AllanResult, sensor_of, shown_unit
+from schuler.io import save_figure_formats
+from schuler.units import to_unit
+
+_ADEV_UNITS = {"gyro": "deg/h", "accel": "ug"}
+
+
+def _figure(columns: int):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, columns, figsize=(5.2 * columns, 4.6), squeeze=False, sharey=True)
+    return fig, axes[0]
+
+
+def allan_figure(result: AllanResult, sensor: str = "gyro", true_model: ErrorModel | None = None):
+    """Allan deviation of the three axes of one sensor: data with 68 % band, fit, term slope lines.
+
+    Parameters
+    ----------
+    result : AllanResult
+    sensor : {"gyro", "accel"}
+    true_model : ErrorModel, optional
+        Draw the model's exact curve too (round trips).
+    """
+    unit = _ADEV_UNITS[sensor]
+    names = [name for name in result.noise if sensor_of(name) == sensor]
+    fig, axes = _figure(len(names))
+    for axis, name in zip(axes, names):
+        channel = result.noise[name]
+        curve, terms = channel.curve, channel.terms
+        tau = curve.tau_s
+        axis.fill_between(tau, to_unit(curve.adev_lower, unit), to_unit(curve.adev_upper, unit), alpha=0.25,
+                          color="C0", label="68 % confidence")
+        axis.loglog(tau, to_unit(curve.adev, unit), "o", ms=3.5, color="C0", label="overlapping ADEV")
+        axis.loglog(tau, to_unit(terms.model_adev(tau), unit), "-", color="k", lw=1.2, label="IEEE 952 fit")
+        lines = term_allan_deviations(terms.values, tau)
+        for index, term in enumerate(("Q", "N", "B", "K", "R")):
+            if not terms.resolved[term]:
+                continue
+            display = DISPLAY_UNITS[sensor][term]
+            axis.loglog(tau, to_unit(lines[term], unit), "--", lw=0.9, color=f"C{index + 1}",
+                        label=f"{term} = {to_unit(terms.values[term], display):.3g} {shown_unit(display)} "
+                              f"(slope {SLOPES[term]:+g})")
+        if true_model is not None:
+            errors = true_model.gyro if sensor == "gyro" else true_model.accel
+            exact = np.sqrt(errors.allan_variance(tau, "xyz".index(name[-1])))
+            axis.loglog(tau, to_unit(exact, unit), ":", color="C3", lw=1.5, label="true model")
+        axis.set_title(name)
+        axis.set_xlabel("averaging time tau [s]")
+        axis.grid(True, which="both", alpha=0.3)
+        axis.legend(loc="best", fontsize=6.5)
+    axes[0].set_ylabel(f"Allan deviation [{shown_unit(unit)}]")
+    fig.suptitle(f"{result.source}: {sensor} Allan deviation" + (f" (grade: {result.grade})" if result.grade else ""))
+    fig.tight_layout()
+    return fig
+
+
+def write_figures(figures: dict, outdir, formats=("png", "svg")) -> list[Path]:
+    """Save figures (stem -> Figure) into ``outdir`` in ``formats``; returns the paths."""
+    paths = []
+    for stem, fig in figures.items():
+        paths += save_figure_formats(fig, Path(outdir) / stem, formats)
+    return paths

@@ -1,0 +1,219 @@
+"""Typed results of the IMU layer: Allan characterisation, round trip, the PSINS reproduction.
+
+All fields SI; :meth:`render` shows display units (deg/sqrt(h), deg/h, ug ...).
+JSON (``to_dict``): ``noise.<channel>.<term>`` with channel ``gyro_x`` ..
+``accel_z`` and term N, B, K, Q, R in the units of :data:`TERM_UNITS`, plus
+``tau_s``, ``adev``, ``adev_lower``, ``adev_upper``, ``edf`` per channel.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from schuler.imu.allan import AllanCurve
+from schuler.imu.identify import TERMS, NoiseTerms
+from schuler.imu.record import ImuInfo
+from schuler.results import Footnotes, Result, json_safe
+
+CHANNELS = ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
+
+TERM_UNITS = {
+    "gyro": {"N": "rad/s^0.5", "B": "rad/s", "K": "rad/s^1.5", "Q": "rad", "R": "rad/s^2"},
+    "accel": {"N": "m/s^1.5", "B": "m/s^2", "K": "m/s^2.5", "Q": "m/s", "R": "m/s^3"},
+}
+"""SI unit of each IEEE 952 term for gyros and accelerometers."""
+
+DISPLAY_UNITS = {
+    "gyro": {"N": "deg/h^0.5", "B": "deg/h", "K": "deg/h^1.5", "Q": "arcsec", "R": "deg/h^2"},
+    "accel": {"N": "m/s/h^0.5", "B": "ug", "K": "ug/h^0.5", "Q": "mm/s", "R": "ug/h"},
+}
+"""Display unit of each term in tables and plots."""
+
+_SHOWN = {"deg/h^0.5": "deg/√h", "deg/h^1.5": "deg/h/√h", "m/s/h^0.5": "m/s/√h", "ug/h^0.5": "µg/√h", "ug": "µg",
+          "ug/h": "µg/h"}
+
+
+def shown_unit(unit: str) -> str:
+    """A display unit as people write it (deg/h^0.5 -> deg/√h)."""
+    return _SHOWN.get(unit, unit)
+
+
+def sensor_of(channel: str) -> str:
+    """'gyro' or 'accel'."""
+    return channel.split("_")[0]
+
+
+@dataclass
+class ChannelNoise:
+    """The Allan curve of one channel and the terms identified on it."""
+
+    curve: AllanCurve
+    terms: NoiseTerms
+
+    def to_dict(self) -> dict:
+        t = self.terms
+        return {**{term: t.values[term] for term in TERMS},
+                "sigma": dict(t.sigma), "upper_bound": dict(t.upper_bound), "resolved": dict(t.resolved),
+                "dominant_tau_s": dict(t.dominant_tau_s), "chi2_per_point": t.chi2_per_point,
+                "tau_s": self.curve.tau_s, "adev": self.curve.adev, "adev_lower": self.curve.adev_lower,
+                "adev_upper": self.curve.adev_upper, "edf": self.curve.edf}
+
+
+def _term_text(channel: str, term: str, value: float, resolved: bool, upper: float) -> str:
+    from schuler.units import to_unit
+
+    unit = DISPLAY_UNITS[sensor_of(channel)][term]
+    if resolved:
+        return f"{to_unit(value, unit):.3g}"
+    return f"< {to_unit(upper, unit):.2g}" if math.isfinite(upper) and upper > 0 else "-"
+
+
+@dataclass
+class AllanResult(Result):
+    """Allan deviation and IEEE 952 terms of the six channels of a record.
+
+    ``noise`` maps channel -> :class:`ChannelNoise`; ``grade`` is the preset
+    whose gyro Allan deviation stays below the record's and comes closest
+    (:func:`~schuler.imu.characterise.classify_grade`), ``grade_margin`` the
+    largest ratio of each preset's curve to the record's upper bound.
+    """
+
+    source: str
+    samples: int
+    sample_interval_s: float
+    duration_s: float
+    noise: dict[str, ChannelNoise] = field(repr=False)
+    grade: str | None = None
+    grade_margin: dict[str, float] = field(default_factory=dict)
+
+    units = {"noise.gyro_*.N": "rad/s^0.5", "noise.gyro_*.B": "rad/s", "noise.gyro_*.K": "rad/s^1.5",
+             "noise.gyro_*.Q": "rad", "noise.gyro_*.R": "rad/s^2", "noise.accel_*.N": "m/s^1.5",
+             "noise.accel_*.B": "m/s^2", "noise.accel_*.K": "m/s^2.5", "noise.accel_*.Q": "m/s",
+             "noise.accel_*.R": "m/s^3", "noise.*.tau_s": "s", "noise.gyro_*.adev": "rad/s",
+             "noise.accel_*.adev": "m/s^2"}
+
+    def to_dict(self) -> dict:
+        return {"source": self.source, "samples": self.samples, "sample_interval_s": self.sample_interval_s,
+                "duration_s": self.duration_s, "grade": self.grade, "grade_margin": json_safe(self.grade_margin),
+                "noise": {name: json_safe(channel.to_dict()) for name, channel in self.noise.items()},
+                "units": dict(self.units)}
+
+    def values(self, channel: str) -> dict[str, float]:
+        """Identified N, B, K, Q, R of a channel, SI."""
+        return dict(self.noise[channel].terms.values)
+
+    def render(self):
+        """Terms per channel in display units; unresolved terms as an upper bound."""
+        from rich.table import Table
+
+        table = Table(title=f"Allan analysis of {self.source}: {self.samples:,} samples, "
+                            f"{self.duration_s / 60:.4g} min at {1 / self.sample_interval_s:.6g} Hz")
+        table.add_column("channel")
+        for term in ("N", "B", "K", "Q", "R"):
+            table.add_column(term, justify="right")
+        table.add_column("fit chi2/point", justify="right")
+        for sensor in ("gyro", "accel"):
+            units = DISPLAY_UNITS[sensor]
+            table.add_row(f"[dim]{sensor} unit[/dim]", *(f"[dim]{shown_unit(units[t])}[/dim]" for t in "NBKQR"), "")
+            for name, channel in self.noise.items():
+                if sensor_of(name) != sensor:
+                    continue
+                t = channel.terms
+                table.add_row(name, *(_term_text(name, term, t.values[term], t.resolved[term], t.upper_bound[term])
+                                      for term in "NBKQR"), f"{t.chi2_per_point:.3g}")
+        if self.grade:
+            table.caption = (f"grade: {self.grade} (the closest preset below the gyro curves); '< x': not "
+                             "resolved in this record, about 2-sigma upper bound")
+        return table
+
+
+@dataclass
+class TermCheck:
+    """One identified term beside the value that went into the simulation."""
+
+    channel: str
+    term: str
+    true: float
+    identified: float
+    sigma: float
+    method_bias: float
+    tolerance: float
+    within: bool
+
+
+@dataclass
+class RoundTripResult(Result):
+    """A record simulated from known terms, characterised, and the identified terms beside the true ones.
+
+    ``tolerance`` of a term is ``factor x sigma + method_bias``: the factor of
+    :data:`~schuler.imu.characterise.TOLERANCE_FACTORS` (correlated overlapping
+    estimates make the fit's sigma optimistic) and the difference between the
+    true value and what the fit returns on the model's exact curve
+    (:func:`~schuler.imu.characterise.expected_terms`).
+    """
+
+    model: str
+    seed: int
+    duration_s: float
+    sample_interval_s: float
+    checks: list[TermCheck] = field(repr=False)
+    analysis: AllanResult = field(repr=False)
+    all_within: bool = True
+
+    def to_dict(self) -> dict:
+        return {"model": self.model, "seed": self.seed, "duration_s": self.duration_s,
+                "sample_interval_s": self.sample_interval_s, "all_within": self.all_within,
+                "checks": json_safe(self.checks), "noise": self.analysis.to_dict()["noise"],
+                "units": {"checks.*.true": "SI unit of the term (see noise units)"}}
+
+    def render(self):
+        from rich.table import Table
+
+        from schuler.units import to_unit
+
+        table = Table(title=f"Round trip: {self.model}, {self.duration_s / 3600:.3g} h at "
+                            f"{1 / self.sample_interval_s:.6g} Hz, seed {self.seed}")
+        for column in ("channel", "term", "true", "identified", "error", "tolerance", "unit", "ok"):
+            table.add_column(column, justify="left" if column in ("channel", "term", "unit") else "right")
+        for check in self.checks:
+            unit = DISPLAY_UNITS[sensor_of(check.channel)][check.term]
+            error = (check.identified - check.true) / check.true if check.true else math.nan
+            table.add_row(check.channel, check.term, f"{to_unit(check.true, unit):.4g}",
+                          f"{to_unit(check.identified, unit):.4g}", f"{100 * error:+.2f} %",
+                          f"{100 * check.tolerance / check.true:.2f} %" if check.true else "-",
+                          shown_unit(unit), "yes" if check.within else "NO")
+        return table
+
+
+@dataclass
+class PsinsReproduction(Result):
+    """What the PSINS laser-gyro recording shows: means (Earth rate, gravity), noise terms, grade."""
+
+    info: ImuInfo = field(repr=False)
+    analysis: AllanResult = field(repr=False)
+    horizontal_earth_rate_ratio: float = math.nan
+    vertical_earth_rate_ratio: float = math.nan
+    specific_force_z_m_s2: float = math.nan
+    grade: str | None = None
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return {"info": self.info.to_dict(), "horizontal_earth_rate_ratio": self.horizontal_earth_rate_ratio,
+                "vertical_earth_rate_ratio": self.vertical_earth_rate_ratio,
+                "specific_force_z_m_s2": self.specific_force_z_m_s2, "grade": self.grade, "notes": self.notes,
+                **{k: v for k, v in self.analysis.to_dict().items() if k in ("noise", "units")}}
+
+    def render(self):
+        from rich.console import Group
+        from rich.text import Text
+
+        notes = Footnotes()
+        marks = [notes.reference(note) for note in self.notes]
+        lines = [f"horizontal gyro mean / (Omega cos L): {self.horizontal_earth_rate_ratio:.4f}",
+                 f"down gyro mean / (-Omega sin L): {self.vertical_earth_rate_ratio:.4f}",
+                 f"specific force z (down): {self.specific_force_z_m_s2:.4f} m/s^2 (about -g)",
+                 f"grade: {self.grade} {' '.join(marks)}".rstrip()]
+        return Group(self.info.render(), Text("\n".join(lines)), self.analysis.render(),
+                     Text("\n".join(notes.lines())))
+

@@ -1,0 +1,419 @@
+"""Simulated IMU records from an error model: N members x T samples, in windows, independent of the cut.
+
+Every random number is addressed through :class:`~schuler.core.random.RandomStreams`
+by (seed, stream, member, index): stream ``"gyro_x/white"`` sample k of member m is
+the same number whichever windows of time and groups of members the work is cut
+into, and the recursive terms carry their state from window to window in the
+kernels of :mod:`~schuler.imu._kernels`, so a record simulated in pieces equals
+the record simulated at once, bit for bit.
+
+Slow processes on a coarse grid
+-------------------------------
+A Gauss-Markov bias with a correlation time of minutes, each term of the flicker
+sum and the rate random walk change little from one sample to the next; drawing
+a random number per sample for each would cost most of the time. Each such
+process is generated exactly (its exact discretisation) on a coarse grid of
+step D dt and interpolated linearly in between. The interpolation leaves out a
+Brownian-bridge part of variance q D dt / 6 (q the process's diffusion, 2 sigma^2 / T
+or K^2), which acts like white noise of PSD ~ q (D dt)^2 / 6; D is chosen so that this is
+below 1e-3 of the white-noise PSD N^2 (and D dt <= T / 2, two grid points per
+correlation time). With no white noise
+(N = 0) the grid is the sample grid (D = 1) and the simulation is exact.
+
+Examples
+--------
+>>> from schuler.imu.spec import preset
+>>> record = simulate_record(preset("tactical"), duration_s=10.0, sample_interval_s=0.01, seed=1,
+...                          latitude_rad=0.6)
+>>> record.samples, record.kind
+(1000, 'rate')
+>>> bool(abs(record.accel_m_s2[:, 2].mean() + 9.80) < 0.05)   # specific force z ~ -g (z down)
+True
+"""
+
+from __future__ import annotations
+
+import math
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from schuler.core.earth import EARTH_RATE, normal_gravity
+from schuler.core.random import BLOCK, RandomStreams
+from schuler.exceptions import InvalidParameter
+from schuler.imu import _kernels
+from schuler.imu.error_model import ErrorModel, SensorErrors, flicker_terms
+from schuler.imu.record import ImuRecord
+
+INTERPOLATION_TOLERANCE = 1e-3
+"""Largest share of the white-noise PSD the coarse-grid interpolation may leave out."""
+
+WINDOW = 1 << 18
+"""Samples per window when streaming."""
+
+DEFAULT_MAX_MEMORY_BYTES = 2 * 1024**3
+"""Largest in-memory simulation (members x samples x 6 x 8 bytes) built without being asked for more."""
+
+_AXES = "xyz"
+
+
+def static_truth(latitude_rad: float, heading_rad: float = 0.0, gravity_m_s2: float | None = None):
+    """True gyro and accelerometer inputs of a level IMU at rest, body x forward, y right, z down.
+
+    Parameters
+    ----------
+    latitude_rad : float
+        Geodetic latitude L, rad.
+    heading_rad : float
+        Heading psi of the x axis, clockwise from north, rad.
+    gravity_m_s2 : float, optional
+        g (default: WGS-84 normal gravity at L).
+
+    Returns
+    -------
+    gyro, accel : ndarray (3,)
+        omega_b = Omega [cos L cos psi, -cos L sin psi, -sin L] (rad/s) and f_b = [0, 0, -g] (m/s^2).
+    """
+    if not abs(latitude_rad) <= math.pi / 2:
+        raise InvalidParameter("latitude", f"{latitude_rad!r} rad must be within [-pi/2, pi/2]")
+    g = float(normal_gravity(latitude_rad)) if gravity_m_s2 is None else float(gravity_m_s2)
+    c, s = math.cos(latitude_rad), math.sin(latitude_rad)
+    gyro = EARTH_RATE * np.array([c * math.cos(heading_rad), -c * math.sin(heading_rad), -s])
+    return gyro, np.array([0.0, 0.0, -g])
+
+
+@dataclass(frozen=True)
+class _Process:
+    """A slow process on a coarse grid of step D samples: x_{j+1} = phi x_j + drive w_j, x_0 = initial w_0."""
+
+    stream: str
+    phi: float
+    drive: float
+    initial: float
+    step: int
+
+
+def _coarse_step(diffusion: float, white_density: float, dt: float, correlation_time: float | None) -> int:
+    if white_density <= 0 or diffusion <= 0:
+        return 1
+    step = white_density * math.sqrt(6.0 * INTERPOLATION_TOLERANCE / diffusion) / dt
+    if correlation_time is not None:
+        step = min(step, correlation_time / (2.0 * dt))
+    return max(1, min(int(step), 1 << 20))
+
+
+def _processes(errors: SensorErrors, axis: int, prefix: str, dt: float) -> list[_Process]:
+    white = errors.random_walk[axis]
+    terms = []
+    if errors.gm_sigma[axis] > 0:
+        terms.append(("gm", errors.gm_sigma[axis], errors.gm_correlation_time_s[axis]))
+    if errors.bias_instability[axis] > 0:
+        sigmas, times = flicker_terms(errors.bias_instability[axis], errors.flicker_tau_range_s)
+        terms += [(f"flicker{j}", sigma, time) for j, (sigma, time) in enumerate(zip(sigmas, times))]
+    processes = []
+    for name, sigma, time in terms:
+        step = _coarse_step(2 * sigma**2 / time, white, dt, time)
+        phi = math.exp(-step * dt / time)
+        processes.append(_Process(f"{prefix}/{name}", phi, sigma * math.sqrt(-math.expm1(-2 * step * dt / time)),
+                                  sigma, step))
+    k = errors.rate_random_walk[axis]
+    if k > 0:
+        step = _coarse_step(k**2, white, dt, None)
+        processes.append(_Process(f"{prefix}/rate_random_walk", 1.0, k * math.sqrt(step * dt), 0.0, step))
+    return processes
+
+
+@dataclass
+class _MemberState:
+    """Where one member's simulation stands: next sample, coarse values, quantiser residuals."""
+
+    next_sample: int = 0
+    coarse: dict = field(default_factory=dict)  # stream -> (last index, value before, value at last)
+    residual: dict = field(default_factory=dict)  # channel -> quantiser residual
+    blocks: dict = field(default_factory=dict)  # stream -> (block number, its BLOCK normals), see _normals
+
+
+class ImuSimulator:
+    """Simulates members of one error model; windows of each member must come in time order for speed.
+
+    Parameters
+    ----------
+    model : ErrorModel
+    sample_interval_s : float
+        dt, s.
+    true_gyro_rad_s, true_accel_m_s2 : ndarray, shape (3,) or (n, 3)
+        True inputs, body frame (constant, or one row per sample from sample 0).
+    seed : int
+        Study seed of the addressed random numbers.
+    workers : int
+        Threads over members (the random generator and the kernels release the GIL).
+
+    Notes
+    -----
+    Member m draws its constant errors (bias, scale factor, misalignment,
+    g-sensitivity) from streams ``"gyro/bias"`` ... at member index m, and its
+    noise from ``"gyro_x/white"``, ``"gyro_x/flicker3"`` ... at sample (or
+    coarse-grid) index k. A window that does not continue the member's last one
+    is recomputed from sample 0, so any cut gives the same numbers.
+    """
+
+    def __init__(self, model: ErrorModel, sample_interval_s: float, *, true_gyro_rad_s=(0.0, 0.0, 0.0),
+                 true_accel_m_s2=(0.0, 0.0, 0.0), seed: int = 0, workers: int = 1):
+        dt = float(sample_interval_s)
+        if not (math.isfinite(dt) and dt > 0):
+            raise InvalidParameter("sample_interval", f"must be finite and > 0 s, got {sample_interval_s!r}")
+        self.model, self.dt, self.workers = model, dt, max(1, int(workers))
+        self.streams = RandomStreams(seed)
+        self.true_gyro = self._truth(true_gyro_rad_s, "true_gyro_rad_s")
+        self.true_accel = self._truth(true_accel_m_s2, "true_accel_m_s2")
+        self._sensors = {"gyro": model.gyro, "accel": model.accel}
+        self._processes = {f"{s}_{a}": _processes(e, i, f"{s}_{a}", dt)
+                           for s, e in self._sensors.items() for i, a in enumerate(_AXES)}
+        self._states: dict[int, _MemberState] = {}
+
+    @staticmethod
+    def _truth(values, name: str) -> np.ndarray:
+        array = np.asarray(values, dtype=float)
+        if array.shape != (3,) and (array.ndim != 2 or array.shape[1] != 3):
+            raise InvalidParameter(name, f"shape {array.shape} must be (3,) or (n, 3)")
+        if not np.all(np.isfinite(array)):
+            raise InvalidParameter(name, "must be finite")
+        return array
+
+    def coarse_steps(self) -> dict[str, int]:
+        """Coarse-grid step D (in samples) of every slow process, by stream name."""
+        return {p.stream: p.step for processes in self._processes.values() for p in processes}
+
+    def constants(self, members) -> dict[str, np.ndarray]:
+        """Each member's constant errors: ``gyro_bias`` (m, 3), ``gyro_matrix`` (m, 3, 3) = I + S + M, ``gyro_g`` ..."""
+        members = np.asarray(members, dtype=np.int64).reshape(-1)
+        out = {}
+        for sensor, errors in self._sensors.items():
+            out[f"{sensor}_bias"] = self.streams.normal(f"{sensor}/bias", members, 3) * errors.bias
+            scale = self.streams.normal(f"{sensor}/scale_factor", members, 3) * errors.scale_factor
+            misalignment = self.streams.normal(f"{sensor}/misalignment", members, 9).reshape(-1, 3, 3)
+            matrix = np.eye(3) + misalignment * errors.misalignment
+            matrix[:, np.arange(3), np.arange(3)] = 1.0 + scale
+            out[f"{sensor}_matrix"] = matrix
+            g_entries = self.streams.normal(f"{sensor}/g_sensitivity", members, 9).reshape(-1, 3, 3)
+            out[f"{sensor}_g"] = g_entries * errors.g_sensitivity
+        return out
+
+    def _true_window(self, truth: np.ndarray, start: int, stop: int) -> np.ndarray:
+        if truth.ndim == 1:
+            return np.broadcast_to(truth, (stop - start, 3))
+        if stop > truth.shape[0]:
+            raise InvalidParameter("samples", f"the true inputs cover {truth.shape[0]:,} samples, asked up to {stop:,}")
+        return truth[start:stop]
+
+    def _slow(self, member: int, state: _MemberState, process: _Process, start: int, stop: int,
+              target: np.ndarray) -> None:
+        step = process.step
+        first, last = start // step, (stop - 1) // step + 1
+        if process.stream not in state.coarse:
+            w0 = self.streams.normal_series(process.stream, [member], 0, 1)[0, 0]
+            state.coarse[process.stream] = (0, math.nan, process.initial * w0)
+        index, before, value = state.coarse[process.stream]
+        new = np.empty(max(0, last - index))
+        if new.size:
+            normals = self._normals(member, state, process.stream, index + 1, last + 1)
+            _kernels.recurse(process.phi, process.drive, normals, value, new)
+        known = np.array([before, value]) if index == first + 1 else np.array([value])
+        coarse = np.concatenate([known, new])
+        _kernels.add_interpolated(target, coarse, first, step, start)
+        if new.size >= 2:
+            state.coarse[process.stream] = (last, new[-2], new[-1])
+        elif new.size == 1:
+            state.coarse[process.stream] = (last, value, new[-1])
+
+    def _normals(self, member: int, state: _MemberState, stream: str, lo: int, hi: int) -> np.ndarray:
+        """Normals lo .. hi-1 of a coarse stream, drawn by whole blocks with the last block kept for the next window.
+
+        A coarse window is short and starts inside a block; drawing whole blocks
+        and keeping the last one avoids regenerating its start every window. The
+        numbers are those of :meth:`~schuler.core.random.RandomStreams.normal_series`.
+        """
+        parts, k = [], lo
+        cached = state.blocks.get(stream)
+        if cached is not None and cached[0] * BLOCK <= k < (cached[0] + 1) * BLOCK:
+            end = min(hi, (cached[0] + 1) * BLOCK)
+            parts.append(cached[1][k - cached[0] * BLOCK:end - cached[0] * BLOCK])
+            k = end
+        if k < hi:
+            first, stop = (k // BLOCK) * BLOCK, -(-hi // BLOCK) * BLOCK
+            fresh = self.streams.normal_series(stream, [member], first, stop)[0]
+            parts.append(fresh[k - first:hi - first])
+            state.blocks[stream] = (stop // BLOCK - 1, fresh[-BLOCK:])
+        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+    def forget(self, members) -> None:
+        """Drop the carried state of ``members`` (their next window replays from sample 0)."""
+        for member in np.asarray(members, dtype=np.int64).reshape(-1):
+            self._states.pop(int(member), None)
+
+    def _member_window(self, member: int, start: int, stop: int, constants: dict, row: int) -> np.ndarray:
+        state = self._states.get(member)
+        if state is None or state.next_sample != start:
+            state = _MemberState()
+            for begin in range(0, start, WINDOW):  # replay from the start: results never depend on the cut
+                self._fill(member, state, begin, min(start, begin + WINDOW), constants, row)
+        out = self._fill(member, state, start, stop, constants, row)
+        self._states[member] = state
+        return out
+
+    def _deterministic(self, sensor: str, constants: dict, row: int, start: int, stop: int):
+        """(I + S + M) u + b (+ G f for gyros): a 3-vector for constant inputs, else (3, L)."""
+        truth = self.true_gyro if sensor == "gyro" else self.true_accel
+        matrix, bias = constants[f"{sensor}_matrix"][row], constants[f"{sensor}_bias"][row]
+        with_g = sensor == "gyro" and np.any(self.model.gyro.g_sensitivity)
+        if truth.ndim == 1 and self.true_accel.ndim == 1:
+            value = matrix @ truth + bias
+            return value + constants["gyro_g"][row] @ self.true_accel if with_g else value
+        value = matrix @ self._true_window(truth, start, stop).T + bias[:, None]
+        if with_g:
+            value = value + constants["gyro_g"][row] @ self._true_window(self.true_accel, start, stop).T
+        return value
+
+    def _fill(self, member: int, state: _MemberState, start: int, stop: int, constants: dict, row: int) -> np.ndarray:
+        length = stop - start
+        out = np.empty((6, length))
+        for s_index, (sensor, errors) in enumerate(self._sensors.items()):
+            deterministic = self._deterministic(sensor, constants, row, start, stop)
+            for axis in range(3):
+                channel = f"{sensor}_{_AXES[axis]}"
+                values = out[3 * s_index + axis]
+                density = errors.random_walk[axis]
+                if density > 0:
+                    values[:] = self.streams.normal_series(f"{channel}/white", [member], start, stop)[0]
+                    values *= density / math.sqrt(self.dt)
+                    values += deterministic[axis]
+                else:
+                    values[:] = deterministic[axis]
+                for process in self._processes[channel]:
+                    self._slow(member, state, process, start, stop, values)
+                quantum = errors.quantization[axis] * math.sqrt(12.0)
+                if quantum > 0:
+                    if channel not in state.residual:
+                        phase = self.streams.uniform(f"{channel}/quantization_phase", [member])[0]
+                        state.residual[channel] = phase * quantum
+                    values *= self.dt
+                    state.residual[channel] = _kernels.quantize(values, quantum, state.residual[channel])
+                    values /= self.dt
+        state.next_sample = stop
+        return out
+
+    def window(self, members, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
+        """Rates of ``members`` over samples ``start .. stop-1``: gyro (m, L, 3) rad/s, accel (m, L, 3) m/s^2.
+
+        Sample k is the mean over (k dt, (k + 1) dt]. With quantisation, rate = whole quanta / dt.
+        """
+        members = np.asarray(members, dtype=np.int64).reshape(-1)
+        start, stop = int(start), int(stop)
+        if start < 0 or stop <= start:
+            raise InvalidParameter("samples", f"window [{start}, {stop}) must satisfy 0 <= start < stop")
+        if members.size and members.min() < 0:
+            raise InvalidParameter("members", "member numbers must be >= 0")
+        constants = self.constants(members)
+        jobs = [(int(m), start, stop, constants, row) for row, m in enumerate(members)]
+        if self.workers > 1 and len(jobs) > 1:
+            with ThreadPoolExecutor(self.workers) as pool:
+                rows = list(pool.map(lambda job: self._member_window(*job), jobs))
+        else:
+            rows = [self._member_window(*job) for job in jobs]
+        stacked = np.stack(rows) if rows else np.empty((0, 6, stop - start))
+        return stacked[:, :3].transpose(0, 2, 1), stacked[:, 3:].transpose(0, 2, 1)
+
+
+def _check_size(members: int, samples: int, max_memory_bytes: int) -> None:
+    needed = members * samples * 6 * 8 * 2
+    if needed > max_memory_bytes:
+        raise InvalidParameter("samples", f"{members:,} members x {samples:,} samples need ~{needed / 1e9:.1f} GB, "
+                               f"above the {max_memory_bytes / 1e9:.1f} GB limit; stream with iter_simulation or "
+                               "write_simulation")
+
+
+def _sample_count(duration_s: float, dt: float) -> int:
+    if not (math.isfinite(duration_s) and duration_s > 0):
+        raise InvalidParameter("duration", f"must be finite and > 0 s, got {duration_s!r}")
+    samples = int(round(duration_s / dt))
+    if samples < 2:
+        raise InvalidParameter("duration", f"{duration_s:g} s at {dt:g} s per sample gives fewer than 2 samples")
+    return samples
+
+
+def iter_simulation(simulator: ImuSimulator, members, samples: int, window: int = WINDOW, member_chunk: int = 8):
+    """Yield ``(members, start, gyro, accel)`` windows covering ``samples`` samples of ``members``, bounded memory."""
+    members = np.asarray(members, dtype=np.int64).reshape(-1)
+    for first in range(0, members.size, member_chunk):
+        group = members[first:first + member_chunk]
+        for start in range(0, samples, window):
+            stop = min(samples, start + window)
+            gyro, accel = simulator.window(group, start, stop)
+            yield group, start, gyro, accel
+        simulator.forget(group)
+
+
+def simulate_members(model: ErrorModel, *, samples: int, sample_interval_s: float, members=1, seed: int = 0,
+                     true_gyro_rad_s=(0.0, 0.0, 0.0), true_accel_m_s2=(0.0, 0.0, 0.0), workers: int = 1,
+                     max_memory_bytes: int = DEFAULT_MAX_MEMORY_BYTES) -> tuple[np.ndarray, np.ndarray]:
+    """All samples of several members in memory: gyro and accel rates, each (members, samples, 3).
+
+    ``members`` is a count (members 0 .. n-1) or a sequence of member numbers.
+    """
+    ids = np.arange(members) if np.ndim(members) == 0 else np.asarray(members, dtype=np.int64)
+    _check_size(ids.size, int(samples), max_memory_bytes)
+    simulator = ImuSimulator(model, sample_interval_s, true_gyro_rad_s=true_gyro_rad_s,
+                             true_accel_m_s2=true_accel_m_s2, seed=seed, workers=workers)
+    gyro = np.empty((ids.size, int(samples), 3))
+    accel = np.empty_like(gyro)
+    for _, start, g, a in iter_simulation(simulator, ids, int(samples), member_chunk=max(1, ids.size)):
+        gyro[:, start:start + g.shape[1]] = g
+        accel[:, start:start + g.shape[1]] = a
+    return gyro, accel
+
+
+def simulate_record(model: ErrorModel, *, duration_s: float, sample_interval_s: float, seed: int = 0, member: int = 0,
+                    latitude_rad: float = math.radians(45.0), heading_rad: float = 0.0, kind: str = "rate",
+                    max_memory_bytes: int = DEFAULT_MAX_MEMORY_BYTES) -> ImuRecord:
+    """One member's record of a level IMU at rest (:func:`static_truth`), as an :class:`ImuRecord`.
+
+    Parameters
+    ----------
+    model : ErrorModel
+    duration_s, sample_interval_s : float
+        Length and dt, s.
+    seed, member : int
+        Address of the random numbers.
+    latitude_rad, heading_rad : float
+        Site latitude and heading of the x axis, rad.
+    kind : {"rate", "increment"}
+    """
+    dt = float(sample_interval_s)
+    samples = _sample_count(duration_s, dt)
+    gyro_true, accel_true = static_truth(latitude_rad, heading_rad)
+    gyro, accel = simulate_members(model, samples=samples, sample_interval_s=dt, members=[member], seed=seed,
+                                   true_gyro_rad_s=gyro_true, true_accel_m_s2=accel_true,
+                                   max_memory_bytes=max_memory_bytes)
+    scale = dt if kind == "increment" else 1.0
+    return ImuRecord(time_s=dt * np.arange(1, samples + 1), gyro=gyro[0] * scale, accel=accel[0] * scale, kind=kind,
+                     sample_interval_s=dt, latitude_rad=latitude_rad, initial_attitude_rad=(0.0, 0.0, heading_rad),
+                     source=f"simulated {model.name}, seed {seed}, member {member}")
+
+
+def write_simulation(path, model: ErrorModel, *, duration_s: float, sample_interval_s: float, seed: int = 0,
+                     member: int = 0, latitude_rad: float = math.radians(45.0), heading_rad: float = 0.0,
+                     workers: int = 1):
+    """Simulate one member at rest straight into a native (Parquet) file, window by window; returns the path."""
+    from schuler.imu.native import ParquetRecordWriter
+
+    dt = float(sample_interval_s)
+    samples = _sample_count(duration_s, dt)
+    gyro_true, accel_true = static_truth(latitude_rad, heading_rad)
+    simulator = ImuSimulator(model, dt, true_gyro_rad_s=gyro_true, true_accel_m_s2=accel_true, seed=seed,
+                             workers=workers)
+    with ParquetRecordWriter(path, "rate", dt, latitude_rad=latitude_rad, initial_attitude_rad=(0.0, 0.0, heading_rad),
+                             source=f"simulated {model.name}, seed {seed}, member {member}") as writer:
+        for _, start, gyro, accel in iter_simulation(simulator, [member], samples):
+            writer.write(dt * np.arange(start + 1, start + gyro.shape[1] + 1), gyro[0], accel[0])
+    return writer.path

@@ -1,0 +1,207 @@
+"""From an error model to the inputs of the other systems: one documented mapping, SI values.
+
+Conventions (spec 06, Groves 2013 ch. 14): sensor bias = measured - true, body
+axes x forward, y right, z down; NED navigation frame; a level platform with
+heading psi has C_b^n = R_z(psi). A **platform drift** is the rotation rate the
+gyro errors give the platform, epsilon = -C_b^n b_g, expressed here as
+east, north and up components (``drift_up`` = -epsilon_down).
+
+Which bias counts as **residual**: the error left after the system has measured
+what it can. Gyro turn-on biases are what drift calibration (``calibrate``)
+estimates, so the residual gyro drift of ``align`` and ``errors`` is the change
+of the bias between calibration and use: the standard deviation of the
+difference of two consecutive averages over ``window_s`` is sqrt(2) times the
+Allan deviation of the slow terms (flicker B, Gauss-Markov, K; white noise N and
+quantisation Q average out and enter separately as random walk). Accelerometer
+turn-on biases stay: at rest a bias is indistinguishable from a tilt, so nothing
+before navigation removes it.
+
+Values and sigmas: ``values`` is one representative case, every body-axis
+error at +1 sigma, resolved into the frames the system uses; ``sigmas`` are the
+1-sigma spreads for Monte Carlo draws (independent axes).
+
+Examples
+--------
+>>> from schuler.imu.spec import preset
+>>> inputs = calibrate_inputs(preset("tactical"))
+>>> round(inputs.values["drift_x"] / 4.84813681109536e-06, 6)   # 1 deg/h
+1.0
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.exceptions import InvalidParameter
+from schuler.imu.error_model import ErrorModel, SensorErrors
+from schuler.results import Result
+
+DEFAULT_WINDOW_S = 600.0
+"""Default time between calibration and use (and the averaging window), s."""
+
+
+@dataclass
+class SystemInputs(Result):
+    """Parameters for one system, SI, from an error model.
+
+    Attributes
+    ----------
+    system : str
+        ``align``, ``calibrate``, ``north`` or ``errors``.
+    model : str
+        The error model's name.
+    values : dict
+        Parameter name -> SI value (one representative +1-sigma case).
+    sigmas : dict
+        Parameter name -> 1-sigma for Monte Carlo (random quantities only).
+    parameter_units : dict
+        Parameter name -> SI unit.
+    notes : list of str
+        What each value means.
+    """
+
+    system: str
+    model: str
+    values: dict[str, float]
+    sigmas: dict[str, float] = field(default_factory=dict)
+    parameter_units: dict[str, str] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    def render(self):
+        from rich.table import Table
+
+        table = Table(title=f"{self.system} inputs from {self.model}")
+        for column in ("parameter", "value", "1-sigma", "unit"):
+            table.add_column(column, justify="right" if column in ("value", "1-sigma") else "left")
+        for name, value in self.values.items():
+            sigma = self.sigmas.get(name)
+            table.add_row(name, f"{value:.4g}", "" if sigma is None else f"{sigma:.4g}", self.parameter_units[name])
+        if self.notes:
+            table.caption = "; ".join(self.notes)
+        return table
+
+
+def _check_window(window_s: float) -> float:
+    if not (math.isfinite(window_s) and window_s > 0):
+        raise InvalidParameter("window", f"must be finite and > 0 s, got {window_s!r}")
+    return float(window_s)
+
+
+def _check_latitude(latitude_rad: float, limit: float = math.radians(89.0)) -> float:
+    if not (math.isfinite(latitude_rad) and abs(latitude_rad) <= limit):
+        raise InvalidParameter("latitude", f"{math.degrees(latitude_rad):g} deg must be within +/-"
+                               f"{math.degrees(limit):g} deg (azimuth is unobservable at the pole)")
+    return float(latitude_rad)
+
+
+def residual_bias(errors: SensorErrors, window_s: float, include_turn_on: bool) -> np.ndarray:
+    """1-sigma residual bias per body axis: sqrt(b^2 [if kept] + 2 sigma_A,slow^2(window)).
+
+    ``sigma_A,slow`` is the Allan deviation of the slow terms only (flicker,
+    Gauss-Markov, rate random walk).
+    """
+    window_s = _check_window(window_s)
+    slow = replace(errors, random_walk=np.zeros(3), quantization=np.zeros(3))
+    drift = np.array([2.0 * float(slow.allan_variance(np.array([window_s]), axis)[0]) for axis in range(3)])
+    if include_turn_on:
+        drift = drift + errors.bias**2
+    return np.sqrt(drift)
+
+
+def _level_rotation(heading_rad: float) -> np.ndarray:
+    c, s = math.cos(heading_rad), math.sin(heading_rad)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def align_inputs(model: ErrorModel, *, heading_rad: float = 0.0, window_s: float = DEFAULT_WINDOW_S,
+                 calibrated_gyros: bool = True) -> SystemInputs:
+    """``align`` (gyrocompassing) inputs: residual platform drifts and accelerometer biases.
+
+    Parameters
+    ----------
+    model : ErrorModel
+    heading_rad : float
+        Heading of the body x axis, rad (the platform is level).
+    window_s : float
+        Time between the gyro calibration and the alignment, s.
+    calibrated_gyros : bool
+        True: the gyro turn-on bias is removed (residual = its change over the window).
+
+    Returns
+    -------
+    SystemInputs
+        ``drift_east``, ``drift_north``, ``drift_up`` (rad/s), epsilon = -C_b^n b_g
+        for b_g = +1 sigma on each axis; ``accel_bias_x``, ``accel_bias_y`` (m/s^2,
+        platform axes = body x, y): turn-on bias and its change over the window.
+    """
+    gyro = residual_bias(model.gyro, window_s, include_turn_on=not calibrated_gyros)
+    accel = residual_bias(model.accel, window_s, include_turn_on=True)
+    rotation = _level_rotation(heading_rad)
+    drift_ned = -rotation @ gyro
+    spread_ned = np.sqrt((rotation**2) @ gyro**2)
+    values = {"drift_east": float(drift_ned[1]), "drift_north": float(drift_ned[0]), "drift_up": float(-drift_ned[2]),
+              "accel_bias_x": float(accel[0]), "accel_bias_y": float(accel[1])}
+    sigmas = {"drift_east": float(spread_ned[1]), "drift_north": float(spread_ned[0]), "drift_up": float(spread_ned[2]),
+              "accel_bias_x": float(accel[0]), "accel_bias_y": float(accel[1])}
+    units = {k: "rad/s" for k in ("drift_east", "drift_north", "drift_up")}
+    units.update(accel_bias_x="m/s^2", accel_bias_y="m/s^2")
+    notes = [f"drift = -C_b^n b_g with b_g at +1 sigma, heading {math.degrees(heading_rad):g} deg",
+             f"gyro turn-on bias {'removed by calibration' if calibrated_gyros else 'kept'}; change over "
+             f"{window_s:g} s = sqrt(2) x slow-term Allan deviation",
+             "accelerometer turn-on bias kept (indistinguishable from tilt at rest)"]
+    return SystemInputs("align", model.name, values, sigmas, units, notes)
+
+
+def calibrate_inputs(model: ErrorModel) -> SystemInputs:
+    """``calibrate`` (pulse drift calibration) inputs: the X gyro's drift to measure and its angle random walk.
+
+    ``drift_x`` (rad/s) is the 1-sigma turn-on bias of the x gyro (what the
+    procedure estimates); ``angle_random_walk`` (rad/sqrt(s)) is its N.
+    """
+    values = {"drift_x": float(model.gyro.bias[0]), "angle_random_walk": float(model.gyro.random_walk[0])}
+    return SystemInputs("calibrate", model.name, values, {"drift_x": float(model.gyro.bias[0])},
+                        {"drift_x": "rad/s", "angle_random_walk": "rad/s^0.5"},
+                        ["drift_x: 1-sigma turn-on bias of the x gyro (calibration estimates it)"])
+
+
+def north_inputs(model: ErrorModel, *, step_s: float) -> SystemInputs:
+    """``north`` (ground gyrocompass) input: the read-out noise of one azimuth observation, rad.
+
+    An angle obtained by integrating the rate over a sample step h carries the
+    angle random walk N sqrt(h) and the angle quantisation Q (IEEE 952, white
+    angle noise of standard deviation Q): noise = sqrt(Q^2 + N^2 h) (z gyro, the
+    azimuth axis).
+    """
+    step_s = _check_window(step_s)
+    q, n = model.gyro.quantization[2], model.gyro.random_walk[2]
+    noise = float(math.sqrt(q**2 + n**2 * step_s))
+    return SystemInputs("north", model.name, {"noise": noise}, {"noise": noise}, {"noise": "rad"},
+                        [f"sqrt(Q^2 + N^2 h) of the z gyro at h = {step_s:g} s"])
+
+
+def errors_inputs(model: ErrorModel, *, latitude_rad: float, window_s: float = DEFAULT_WINDOW_S) -> SystemInputs:
+    """``errors`` (Schuler-loop navigation errors) inputs: the five sources' 1-sigma magnitudes, SI.
+
+    * ``drift`` (rad/s): residual horizontal gyro drift (rms of x and y, see :func:`residual_bias`);
+    * ``accelerometer`` (m/s^2): horizontal accelerometer bias (rms of x and y, turn-on kept);
+    * ``tilt`` (rad): the levelling error that bias leaves, accelerometer / g;
+    * ``azimuth`` (rad): the gyrocompassing error sqrt((drift / (Omega cos L))^2 + (accelerometer tan L / g)^2)
+      (the static limit of spec 06, independent east components);
+    * ``velocity`` (m/s): 0, a start at rest knows its velocity.
+    """
+    latitude_rad = _check_latitude(latitude_rad)
+    gyro = residual_bias(model.gyro, window_s, include_turn_on=False)
+    accel = residual_bias(model.accel, window_s, include_turn_on=True)
+    drift = float(math.sqrt((gyro[0] ** 2 + gyro[1] ** 2) / 2.0))
+    bias = float(math.sqrt((accel[0] ** 2 + accel[1] ** 2) / 2.0))
+    azimuth = math.hypot(drift / (EARTH_RATE * math.cos(latitude_rad)), bias * math.tan(latitude_rad) / STANDARD_GRAVITY)
+    values = {"tilt": bias / STANDARD_GRAVITY, "velocity": 0.0, "accelerometer": bias, "drift": drift,
+              "azimuth": float(azimuth)}
+    units = {"tilt": "rad", "velocity": "m/s", "accelerometer": "m/s^2", "drift": "rad/s", "azimuth": "rad"}
+    return SystemInputs("errors", model.name, values, {k: v for k, v in values.items() if k != "velocity"}, units,
+                        [f"latitude {math.degrees(latitude_rad):g} deg, window {window_s:g} s",
+                         "velocity 0: the run starts at rest"])
