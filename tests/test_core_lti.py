@@ -72,7 +72,7 @@ def test_piecewise_constant_input_on_nonuniform_grid():
     system = StateSpace([[0.0]], [[1.0]])
     t = np.array([0.0, 0.5, 2.0, 2.25, 7.0])
     u = np.array([[1.0], [-2.0], [4.0], [0.5], [99.0]])
-    x = simulate(system, t, inputs=u)["x0"]
+    x = simulate(system, t, input_series=u)["x0"]
     np.testing.assert_allclose(x, np.concatenate([[0.0], np.cumsum(u[:-1, 0] * np.diff(t))]), atol=1e-15)
 
 
