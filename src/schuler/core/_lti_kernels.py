@@ -49,3 +49,81 @@ def propagate_steps(Ad: np.ndarray, Bd: np.ndarray, kind: np.ndarray, x0: np.nda
                 for j in range(m):
                     total += Bd[s, a, r, j] * u[w, c, j]
                 out[i, k + 1, r] = total
+
+
+@numba.njit(cache=True)
+def fill_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray, z0: np.ndarray, n_moving: int,
+                substeps: int, out: np.ndarray) -> None:
+    """Fill ``out[i, p, b L + j] = rows[p] Phi^j Psi^b z0[i]`` (Phi = step, Psi = block, L = substeps).
+
+    The samples of block b are the fine rows rows Phi^j (j < L) times the
+    block's start Psi^b z0. Only the first ``n_moving`` entries of a start
+    change from block to block (the states; the rest are constant inputs), so
+    the inputs' share of every sample is computed once per member and each
+    sample costs ``n_moving`` multiply-adds, the inner loop running over
+    contiguous samples. Fine rows are computed once for a shared model and
+    again for every member of a batch.
+
+    Parameters
+    ----------
+    step : ndarray, shape (1 or N, q, q)
+        Transition over one sample step.
+    block : ndarray, shape (1 or N, q, q)
+        Transition over one block of ``substeps`` steps.
+    rows : ndarray, shape (1 or N, r, q)
+        Rows wanted.
+    z0 : ndarray, shape (N, q)
+        Initial vectors.
+    n_moving : int
+        Entries of z that change in time (the rest stay at their initial value).
+    substeps : int
+        L, samples per block.
+    out : ndarray, shape (N, r, n_blocks L)
+        Samples (written).
+    """
+    members, r, capacity = out.shape
+    q = z0.shape[1]
+    L = substeps
+    gains = np.empty((r, q, L))
+    held = np.empty((r, L))  # the constant entries' share of sample j
+    start = np.empty(q)
+    following = np.empty(q)
+    for i in range(members):
+        a = 0 if step.shape[0] == 1 else i
+        g = 0 if rows.shape[0] == 1 else i
+        if i == 0 or step.shape[0] > 1 or rows.shape[0] > 1:
+            for p in range(r):
+                for c in range(q):
+                    gains[p, c, 0] = rows[g, p, c]
+            for j in range(1, L):
+                for p in range(r):
+                    for c in range(q):
+                        total = 0.0
+                        for k in range(q):
+                            total += gains[p, k, j - 1] * step[a, k, c]
+                        gains[p, c, j] = total
+        for p in range(r):
+            for j in range(L):
+                held[p, j] = 0.0
+            for c in range(n_moving, q):
+                s = z0[i, c]
+                for j in range(L):
+                    held[p, j] += s * gains[p, c, j]
+        for c in range(q):
+            start[c] = z0[i, c]
+        for base in range(0, capacity, L):
+            for p in range(r):
+                line = out[i, p, base : base + L]
+                for j in range(L):
+                    line[j] = held[p, j]
+                for c in range(n_moving):
+                    s = start[c]
+                    for j in range(L):
+                        line[j] += s * gains[p, c, j]
+            for c in range(n_moving):
+                total = 0.0
+                for k in range(q):
+                    total += block[a, c, k] * start[k]
+                following[c] = total
+            for c in range(n_moving):
+                start[c] = following[c]

@@ -64,11 +64,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from schuler.core.propagation import propagate_constant_input, propagate_steps_exact, zoh_discretize
+from schuler.core.propagation import Grid, propagate_constant_input, propagate_steps_exact, zoh_discretize
 from schuler.core.reducers import FinalOutputs, OutputStatistics, Reducer
 from schuler.core.response import Response
-from schuler.core.stats import StreamingStatistics
 from schuler.core.statespace import StateSpace
+from schuler.core.stats import StreamingStatistics
 from schuler.exceptions import InvalidParameter
 
 __all__ = [
@@ -79,8 +79,8 @@ __all__ = [
 
 MAX_RESULT_BYTES = 4 * 2**30
 """Largest history :func:`simulate` allocates (4 GiB); stream longer runs with :func:`simulate_reduce`."""
-CHUNK_BYTES = 64 * 2**20
-"""Default history per chunk of :func:`simulate_reduce` (64 MiB)."""
+CHUNK_BYTES = 16 * 2**20
+"""Default history per chunk of :func:`simulate_reduce` (16 MiB: a few chunks fit in cache)."""
 RESERVOIR_BYTES = 64 * 2**20
 """Default memory of the members :func:`simulate_statistics` keeps for percentiles (64 MiB)."""
 
@@ -165,7 +165,7 @@ class _Simulation:
     """
 
     def __init__(self, system: StateSpace, t: np.ndarray, drive: _Drive, rows: list[int], with_states: bool):
-        self.system, self.t, self.drive, self.rows, self.with_states = system, t, drive, rows, with_states
+        self.system, self.grid, self.drive, self.rows, self.with_states = system, Grid.of(t), drive, rows, with_states
         C, D = system.C, system.D
         self.outputs_are_states = (
             with_states and C.ndim == 2 and np.array_equal(C, np.eye(system.n_states)) and not np.any(D)
@@ -173,8 +173,10 @@ class _Simulation:
         )
         self.stepped = drive.series is not None
         n, p = system.n_states, len(rows)
-        q = n + system.n_inputs + 1
-        self.floats_per_member = t.size * (n + p + (q if self.stepped else 0))
+        rows_computed = (n if with_states else 0) + (0 if self.outputs_are_states else p)
+        # stepping keeps the states beside the outputs; a batch of models on a non-uniform grid steps [x; 1]
+        workspace = n + system.n_inputs + 1 if self.stepped or self.grid.n_uniform == 0 else 0
+        self.floats_per_member = t.size * (rows_computed + workspace)
         self.shared = None
         if not self.stepped and system.batch_size is None:
             self.shared = self._constant(system, drive)
@@ -215,7 +217,7 @@ class _Simulation:
             M[:, :n, :n], M[:, :n, n] = A, Bu
             z0, input_rows = np.concatenate([x0, np.ones((drive.count, 1))], axis=1), _times(D, u)[..., None]
         state_rows = np.eye(n)
-        return propagate_constant_input(M, self._row_matrix(system, state_rows, input_rows), self.t), z0
+        return propagate_constant_input(M, self._row_matrix(system, state_rows, input_rows), self.grid, n), z0
 
     def chunk(self, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
         """States (k, T, n or 0) and outputs (k, T, len(rows)) of members start:stop."""
@@ -223,7 +225,7 @@ class _Simulation:
         n = system.n_states
         if self.stepped:
             series = drive.series if drive.inputs is None else drive.series + drive.inputs[:, None, :]
-            states = propagate_steps_exact(_batched(system.A), _batched(system.B), self.t,
+            states = propagate_steps_exact(_batched(system.A), _batched(system.B), self.grid,
                                            np.broadcast_to(drive.x0, (drive.count, n)), series)
             outputs = states if self.outputs_are_states else self._outputs(system, states, series)
         else:

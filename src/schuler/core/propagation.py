@@ -38,11 +38,12 @@ distinct step, run by the compiled kernel of :mod:`schuler.core._lti_kernels`.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
 
-from schuler.core._lti_kernels import propagate_steps
+from schuler.core._lti_kernels import fill_blocks, propagate_steps
 
 POINT_EXPONENTIALS = 200_000
 """Most matrix exponentials spent on the non-uniform points of one propagation (about 2 s);
@@ -108,35 +109,51 @@ def uniform_step(t: np.ndarray) -> float | None:
     return float(step) if np.all(np.abs(dt - step) <= tolerance) else None
 
 
-def uniform_prefix(t: np.ndarray) -> tuple[int, float | None]:
-    """Length and step of the grid's uniform leading part.
+@dataclass(frozen=True)
+class Grid:
+    """A time grid, analysed once: its uniform leading part and its distinct steps.
 
-    The whole grid, or all but a shorter last step (a run that ends between
-    two output steps), or nothing (step None).
+    Attributes
+    ----------
+    times : ndarray, shape (n_time,)
+        Strictly increasing, s.
+    n_uniform : int
+        Length of the uniform leading part propagated by block exponentials:
+        the whole grid, all but a shorter last step (a run ending between two
+        output steps), or 0.
+    step : float or None
+        Step of that part, s.
+    kinds : ndarray, shape (n_kinds,)
+        The distinct steps, s.
+    which : ndarray of int64, shape (n_time - 1,)
+        Index into ``kinds`` of every step.
 
-    >>> uniform_prefix(np.array([0.0, 1.0, 2.0, 3.0, 3.5]))
-    (4, 1.0)
+    Examples
+    --------
+    >>> grid = Grid.of(np.array([0.0, 1.0, 2.0, 3.0, 3.5]))
+    >>> grid.n_uniform, grid.step, grid.kinds.tolist(), grid.which.tolist()
+    (4, 1.0, [1.0, 0.5], [0, 0, 0, 1])
     """
-    step = uniform_step(t)
-    if step is not None:
-        return t.size, step
-    if t.size > 3:
-        step = uniform_step(t[:-1])
+
+    times: np.ndarray
+    n_uniform: int
+    step: float | None
+    kinds: np.ndarray
+    which: np.ndarray
+
+    @classmethod
+    def of(cls, t: np.ndarray) -> Grid:
+        steps = t.size - 1
+        step = uniform_step(t)
         if step is not None:
-            return t.size - 1, step
-    return 1, None
-
-
-def step_kinds(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The distinct steps of a grid (s) and, for each step, which of them it is.
-
-    A uniform grid (to rounding) has one kind, its exact step.
-    """
-    step = uniform_step(t)
-    if step is not None:
-        return np.array([step]), np.zeros(t.size - 1, dtype=np.int64)
-    kinds, which = np.unique(np.diff(t), return_inverse=True)
-    return kinds, which.astype(np.int64)
+            return cls(t, t.size, step, np.array([step]), np.zeros(steps, dtype=np.int64))
+        step = uniform_step(t[:-1]) if t.size > 3 else None
+        if step is not None:
+            which = np.zeros(steps, dtype=np.int64)
+            which[-1] = 1
+            return cls(t, t.size - 1, step, np.array([step, t[-1] - t[-2]]), which)
+        kinds, which = np.unique(np.diff(t), return_inverse=True)
+        return cls(t, 0, None, kinds, which.astype(np.int64))
 
 
 def balance(M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -154,24 +171,6 @@ def balance(M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return M * (scale[None, None, :] / scale[None, :, None]), scale
 
 
-def arithmetic_exponentials(M: np.ndarray, step: float, count: int) -> np.ndarray:
-    """expm(M k step) for k = 0 .. count-1, shape (N, count, q, q), by doubling.
-
-    Each transition is a product of at most log2(count) exact exponentials, so
-    rounding grows with log2(count), not with count.
-    """
-    q = M.shape[-1]
-    powers = np.empty((M.shape[0], count, q, q))
-    powers[:, 0] = np.eye(q)
-    filled = 1
-    while filled < count:
-        block = min(filled, count - filled)
-        factor = scipy.linalg.expm(M * (step * filled))
-        np.matmul(powers[:, :block], factor[:, None], out=powers[:, filled : filled + block])
-        filled += block
-    return powers
-
-
 def _apply(G: np.ndarray, z: np.ndarray) -> np.ndarray:
     """G_i z_i for matrices G (1 or N, k, r, q) and vectors z (N, q): shape (N, k, r)."""
     if G.shape[0] == 1:
@@ -183,8 +182,8 @@ def _apply(G: np.ndarray, z: np.ndarray) -> np.ndarray:
 class ConstantInputPropagator:
     """Samples y_k = R expm(M (t_k - t_0)) z of z' = M z on a grid, for any batch of z.
 
-    The exponentials are computed once, at construction; calling the
-    propagator applies them to initial vectors.
+    The exponentials are computed at construction; calling the propagator
+    applies them to initial vectors.
 
     Parameters
     ----------
@@ -192,74 +191,72 @@ class ConstantInputPropagator:
         Generator (1/s): the state matrix with the constant inputs folded in.
     R : ndarray, shape (1 or N, r, q)
         Rows wanted (states, outputs).
-    t : ndarray, shape (n_time,)
-        Strictly increasing grid, s.
+    grid : Grid
+        The time grid.
+    n_moving : int
+        Leading entries of z that change in time; the rest are constant
+        inputs (zero rows of M).
     """
 
-    def __init__(self, M: np.ndarray, R: np.ndarray, t: np.ndarray):
+    def __init__(self, M: np.ndarray, R: np.ndarray, grid: Grid, n_moving: int):
+        self.n_moving = n_moving
         self.M, self.scale = balance(M)
-        self.R = R * self.scale
-        self.t = t
-        self.n_uniform, step = uniform_prefix(t)
-        self.gains = self.coarse = None
-        if step is not None:
-            # L substeps per block: L fine and n_time / L coarse transitions balance the workspace
-            self.substeps = max(1, math.isqrt(self.n_uniform - 1) + 1)
-            n_blocks = -(-self.n_uniform // self.substeps)
-            fine = arithmetic_exponentials(self.M, step, self.substeps)
-            gains = self.R[:, None] @ fine  # (1 or N, L, r, q)
-            # columns j * r + row: sample j of a block is one matrix product with the block's start
-            self.gains = gains.transpose(0, 3, 1, 2).reshape(gains.shape[0], -1, self.substeps * gains.shape[2])
-            self.coarse = arithmetic_exponentials(self.M, step * self.substeps, n_blocks)
-        else:
-            self.n_uniform = 0
-        self.point_offsets = t[self.n_uniform :] - t[0]
+        self.R = np.ascontiguousarray(R * self.scale)
+        self.t = grid.times
+        self.n_uniform = grid.n_uniform
+        if grid.step is not None:
+            # L ~ sqrt(n_time) substeps per block: L fine and n_time / L block products per member
+            self.substeps = math.isqrt(self.n_uniform - 1) + 1
+            self.n_blocks = -(-self.t.size // self.substeps)
+            self.step_transition = scipy.linalg.expm(self.M * grid.step)
+            if self.M.shape[0] == 1:
+                self.block_transition = scipy.linalg.expm(self.M * (grid.step * self.substeps))
+            else:  # scipy's expm loops over a batch in Python: square the step transitions instead
+                self.block_transition = np.linalg.matrix_power(self.step_transition, self.substeps)
+        self.point_offsets = self.t[self.n_uniform :] - self.t[0]
 
     @property
     def n_rows(self) -> int:
         return self.R.shape[1]
 
     def __call__(self, z0: np.ndarray) -> np.ndarray:
-        """Rows at every time, shape (N, n_time, r), for initial vectors z0 of shape (N, q)."""
-        z = z0 / self.scale
-        out = np.empty((z.shape[0], self.t.size, self.n_rows))
-        if self.n_uniform:
-            self._fill_blocks(z, out[:, : self.n_uniform])
-        if self.point_offsets.size:
-            self._fill_points(z, out[:, self.n_uniform :])
-        return out
+        """Rows at every time, shape (N, n_time, r), for initial vectors z0 of shape (N, q).
 
-    def _fill_blocks(self, z: np.ndarray, out: np.ndarray) -> None:
-        members, n_points, r = out.shape
-        L = self.substeps
-        starts = _apply(self.coarse, z)  # (N, n_blocks, q): the state at each block's start
-        full = n_points // L
-        if full:
-            # a view: within a member, (full * L, r) samples are (full, L * r) contiguous rows
-            target = out[:, : full * L].reshape(members, full, L * r)
-            np.matmul(starts[:, :full], self.gains if self.gains.shape[0] > 1 else self.gains[0], out=target)
-        rest = n_points - full * L
-        if rest:
-            last = np.matmul(starts[:, full, None, :], self.gains[..., : rest * r])[:, 0]
-            out[:, full * L :] = last.reshape(members, rest, r)
+        The result is a view of a channel-major buffer (N, r, n_time + padding to
+        whole blocks): each channel's history is contiguous, so reductions over
+        time read memory in order.
+        """
+        z = np.ascontiguousarray(z0 / self.scale)
+        members, T, r = z.shape[0], self.t.size, self.n_rows
+        if not self.n_uniform:
+            out = np.empty((members, r, T))
+            self._fill_points(z, out)
+            return out.transpose(0, 2, 1)
+        out = np.empty((members, r, self.n_blocks * self.substeps))
+        fill_blocks(self.step_transition, self.block_transition, self.R, z, self.n_moving, self.substeps, out)
+        if self.point_offsets.size:
+            self._fill_points(z, out[:, :, self.n_uniform : T])
+        return out[:, :, :T].transpose(0, 2, 1)
 
     def _fill_points(self, z: np.ndarray, out: np.ndarray) -> None:
+        """Rows at the point times into ``out`` of shape (N, r, n_points)."""
         q = self.M.shape[-1]
         group = max(1, _GROUP_FLOATS // (self.M.shape[0] * q * q))
         for lo in range(0, self.point_offsets.size, group):
             offsets = self.point_offsets[lo : lo + group]
             transitions = scipy.linalg.expm(self.M[:, None] * offsets[None, :, None, None])
-            out[:, lo : lo + offsets.size] = _apply(self.R[:, None] @ transitions, z)
+            out[:, :, lo : lo + offsets.size] = _apply(self.R[:, None] @ transitions, z).transpose(0, 2, 1)
 
 
-def propagate_steps_exact(A: np.ndarray, B: np.ndarray, t: np.ndarray, x0: np.ndarray, u: np.ndarray) -> np.ndarray:
+def propagate_steps_exact(A: np.ndarray, B: np.ndarray, grid: Grid, x0: np.ndarray, u: np.ndarray) -> np.ndarray:
     """States of x' = A x + B u at every time, stepping exactly from point to point.
 
     Parameters
     ----------
     A : ndarray, shape (1 or N, n, n)
     B : ndarray, shape (1 or N, n, m)
-    t : ndarray, shape (n_time,)
+    grid : Grid
+        The time grid (n_time points).
     x0 : ndarray, shape (N, n)
     u : ndarray, shape (1 or N, 1 or n_time, m)
         ``u[:, k]`` holds on [t_k, t_(k+1)); a time length of 1 holds over the run.
@@ -268,32 +265,34 @@ def propagate_steps_exact(A: np.ndarray, B: np.ndarray, t: np.ndarray, x0: np.nd
     -------
     ndarray, shape (N, n_time, n)
     """
-    out = np.empty((x0.shape[0], t.size, A.shape[-1]))
-    if t.size == 1:
+    out = np.empty((x0.shape[0], grid.times.size, A.shape[-1]))
+    if grid.times.size == 1:
         out[:, 0] = x0
         return out
-    kinds, which = step_kinds(t)
-    Ad, Bd = zoh_discretize(A, B, kinds)
-    propagate_steps(np.ascontiguousarray(Ad), np.ascontiguousarray(Bd), which, np.ascontiguousarray(x0, dtype=float),
+    n, m = A.shape[-1], B.shape[-1]
+    generator = np.zeros((max(A.shape[0], B.shape[0]), n + m, n + m))
+    generator[:, :n, :n], generator[:, :n, n:] = A, B
+    scale = balance(generator)[1][:n]  # step in D^-1 x, as the exponentials do
+    Ad, Bd = zoh_discretize(A * (scale / scale[:, None]), B / scale[:, None], grid.kinds)
+    propagate_steps(np.ascontiguousarray(Ad), np.ascontiguousarray(Bd), grid.which, np.ascontiguousarray(x0 / scale),
                     np.ascontiguousarray(u, dtype=float), out)
+    out *= scale
     return out
 
 
-def propagate_constant_input(M: np.ndarray, R: np.ndarray, t: np.ndarray):
+def propagate_constant_input(M: np.ndarray, R: np.ndarray, grid: Grid, n_moving: int):
     """A propagator ``z0 (N, q) -> rows (N, n_time, r)`` for z' = M z, the cheapest exact one.
 
     Exponentials at block and point times (:class:`ConstantInputPropagator`),
     unless a batch of models would need more than :data:`POINT_EXPONENTIALS`
     point exponentials on a non-uniform grid: then exact steps.
     """
-    n_uniform, _ = uniform_prefix(t)
-    n_points = t.size - (n_uniform if n_uniform > 1 else 0)
-    if M.shape[0] * n_points <= POINT_EXPONENTIALS:
-        return ConstantInputPropagator(M, R, t)
+    if M.shape[0] * (grid.times.size - grid.n_uniform) <= POINT_EXPONENTIALS:
+        return ConstantInputPropagator(M, R, grid, n_moving)
 
     def stepped(z0: np.ndarray) -> np.ndarray:
         no_input = np.zeros((1, 1, 0))
-        z = propagate_steps_exact(M, np.zeros((1, M.shape[-1], 0)), t, z0, no_input)
+        z = propagate_steps_exact(M, np.zeros((1, M.shape[-1], 0)), grid, z0, no_input)
         return z @ R[0].T if R.shape[0] == 1 else np.matmul(z, np.swapaxes(R, -1, -2))
 
     return stepped
