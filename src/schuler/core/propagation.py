@@ -8,31 +8,45 @@ axis of length N gives each member its own.
 **Block exponentials** (inputs constant over the run, uniform grid of step h).
 With the inputs in the state, z = [x; u] (or z = [x; 1] and the column B u),
 z' = M z and z(t_k) = expm(M k h) z(t_0). Writing k = b L + j with
-L ~ sqrt(n_time) substeps per block,
+L ~ sqrt(n_time) samples per block,
 
-    z(t_(bL+j)) = expm(M j h) expm(M b L h) z(t_0),
+    y(t_(bL+j)) = [R expm(M h)^j] [expm(M L h)^b z(t_0)]:
 
-so L "fine" and ceil(n_time / L) "coarse" transitions are all the exponentials
-needed. Each set is built by doubling (the transitions for 2^i..2^(i+1)-1 are
-those for 0..2^i-1 times the exact expm(M 2^i h)), and the samples are two
-batched matrix products: there is no loop over time, and a batch of different
-models (M of shape (N, q, q)) costs the same products per member.
+L fine rows times ceil(n_time / L) block starts, both built by products of two
+exact exponentials, Phi = expm(M h) and Psi = expm(M L h) (for a batch of
+models Psi = Phi^L by squaring, as scipy's expm loops over a batch in Python).
+No product chain is longer than ~2 sqrt(n_time). The samples are filled by the
+compiled :func:`~schuler.core._lti_kernels.fill_blocks`, which adds the
+constant inputs' share of each sample once per member, so a sample costs n
+multiply-adds whatever the number of inputs. A batch of models (M of shape
+(N, q, q)) costs the same per member as a shared one: no loop over time steps
+or members in Python.
 
 **Balancing.** Error models mix channels of very different magnitude
 (position errors in km, attitude errors in microradians). Before any
-exponential M is balanced by an exact diagonal similarity D^-1 M D (powers of
+exponential, M is balanced by an exact diagonal similarity D^-1 M D (powers of
 two, so no rounding; Parlett and Reinsch's algorithm, LAPACK ``gebal`` through
-:func:`scipy.linalg.matrix_balance`), one D for a whole batch; the
-propagation runs on D^-1 z and the rows become R D. On the 13-state psi-angle
-model over 48 h this takes the error from 1.2e-6 to 1.2e-13 of each channel's
-maximum (see :mod:`schuler.core.lti`).
+:func:`scipy.linalg.matrix_balance`), one D for a whole batch; propagation runs
+on D^-1 z and the rows become R D. Measured on the 13-state psi-angle model
+over 48 h against an extended-precision reference, in units of each channel's
+maximum: unbalanced 1e-8 with z = [x; u] and 2-4e-10 with the inputs folded
+into one column; balanced 2e-13 for either, and 9e-12 for steps at 1 s
+(unbalanced 3e-8).
 
 **Point exponentials** (constant inputs, non-uniform grid): expm(M (t_k - t_0))
 at each point, in groups so that the workspace stays small.
 
-**Steps** (inputs that vary in time, or a batch of models on a non-uniform
-grid): the recursion x_(k+1) = Ad x_k + Bd u_k with one exact (Ad, Bd) per
-distinct step, run by the compiled kernel of :mod:`schuler.core._lti_kernels`.
+**Steps** (inputs that vary in time, or a batch of models on a long
+non-uniform grid): the recursion x_(k+1) = Ad x_k + Bd u_k, balanced as above,
+with one exact (Ad, Bd) per distinct step, run by the compiled
+:func:`~schuler.core._lti_kernels.propagate_steps`.
+
+References
+----------
+B. N. Parlett and C. Reinsch, "Balancing a matrix for calculation of
+eigenvalues and eigenvectors", Numerische Mathematik 13, 1969.
+C. F. Van Loan, "Computing integrals involving the matrix exponential",
+IEEE Transactions on Automatic Control 23(3), 1978.
 """
 
 from __future__ import annotations

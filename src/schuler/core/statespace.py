@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -39,10 +40,11 @@ class StateSpace:
         SI unit of each channel, for labels and tables.
     """
 
-    A: np.ndarray
-    B: np.ndarray | None = None
-    C: np.ndarray | None = None
-    D: np.ndarray | None = None
+    # array_like (or None) as given; float ndarrays of the documented shapes once constructed
+    A: Any
+    B: Any = None
+    C: Any = None
+    D: Any = None
     states: tuple[str, ...] = ()
     inputs: tuple[str, ...] = ()
     outputs: tuple[str, ...] = ()
@@ -119,5 +121,8 @@ class StateSpace:
         """Models start:stop of a batch (the model itself when not batched)."""
         if self.batch_size is None:
             return self
-        return StateSpace(*(M[start:stop] if M.ndim == 3 else M for M in (self.A, self.B, self.C, self.D)),
-                          self.states, self.inputs, self.outputs, self.state_units, self.output_units)
+        def cut(M: np.ndarray) -> np.ndarray:
+            return M[start:stop] if M.ndim == 3 else M
+
+        return StateSpace(cut(self.A), cut(self.B), cut(self.C), cut(self.D), self.states, self.inputs,
+                          self.outputs, self.state_units, self.output_units)

@@ -82,7 +82,7 @@ class StreamingStatistics:
     def _sample(self, samples: np.ndarray) -> None:
         """Keep the members with the smallest random keys, replacing others in place (no pool copy)."""
         size, kept = self._reservoir_size, self._kept
-        keys = self._rng.random(samples.shape[0])
+        keys = np.asarray(self._rng.random(samples.shape[0]))
         if kept + keys.size <= size:
             self._reservoir[kept : kept + keys.size] = samples
             self._keys[kept : kept + keys.size] = keys

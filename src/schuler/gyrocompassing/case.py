@@ -80,23 +80,23 @@ class AlignmentCase:
     (2, (2, 6), (2, 3, 3))
     """
 
-    latitude: object = DEFAULT_LATITUDE
-    azimuth: object = 0.0
-    drift_x: object = 0.0
-    drift_y: object = 0.0
-    drift_z: object = 0.0
-    drift_east: object = 0.0
-    drift_north: object = 0.0
-    latitude_error: object = 0.0
-    accel_error_x: object = 0.0
-    accel_error_y: object = 0.0
-    time_constant: object = DEFAULT_TIME_CONSTANT
-    damping: object = DEFAULT_DAMPING
-    c_gamma: object = None
-    c_a: object = None
-    initial_azimuth_error: object = DEFAULT_INITIAL_AZIMUTH_ERROR
-    initial_beta: object = 0.0
-    initial_alpha: object = 0.0
+    latitude: float | np.ndarray = DEFAULT_LATITUDE
+    azimuth: float | np.ndarray = 0.0
+    drift_x: float | np.ndarray = 0.0
+    drift_y: float | np.ndarray = 0.0
+    drift_z: float | np.ndarray = 0.0
+    drift_east: float | np.ndarray = 0.0
+    drift_north: float | np.ndarray = 0.0
+    latitude_error: float | np.ndarray = 0.0
+    accel_error_x: float | np.ndarray = 0.0
+    accel_error_y: float | np.ndarray = 0.0
+    time_constant: float | np.ndarray = DEFAULT_TIME_CONSTANT
+    damping: float | np.ndarray = DEFAULT_DAMPING
+    c_gamma: float | np.ndarray | None = None
+    c_a: float | np.ndarray | None = None
+    initial_azimuth_error: float | np.ndarray = DEFAULT_INITIAL_AZIMUTH_ERROR
+    initial_beta: float | np.ndarray = 0.0
+    initial_alpha: float | np.ndarray = 0.0
     max_latitude: float = DEFAULT_MAX_LATITUDE
     earth_rate: float = EARTH_RATE
     gravity: float = STANDARD_GRAVITY
