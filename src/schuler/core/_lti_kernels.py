@@ -1,9 +1,12 @@
-"""Compiled time loop of the linear-systems engine: exact zero-order-hold steps on plain arrays.
+"""Compiled loops of the linear-systems engine, on plain arrays written in place.
 
-A recursion x_(k+1) = Ad x_k + Bd u_k with an input that changes every step
-is sequential by nature; this kernel runs it for every member at machine speed
-and writes into a preallocated array. Everything else (discretisation, shapes,
-the choice of method) stays in :mod:`schuler.core._propagation`.
+* :func:`propagate_steps`: the recursion x_(k+1) = Ad x_k + Bd u_k with an input
+  that changes every step, sequential by nature, for every member.
+* :func:`fill_blocks`: the samples of the block scheme, y = rows Phi^j Psi^b z0,
+  which numpy would spread over many small matrix products per member.
+
+Everything else (discretisation, balancing, shapes, the choice of method) stays
+in :mod:`schuler.core.propagation`.
 """
 
 from __future__ import annotations
@@ -15,40 +18,65 @@ import numpy as np
 @numba.njit(cache=True)
 def propagate_steps(Ad: np.ndarray, Bd: np.ndarray, kind: np.ndarray, x0: np.ndarray, u: np.ndarray,
                     out: np.ndarray) -> None:
-    """Fill ``out`` with x_(k+1) = Ad[kind[k], a] x_k + Bd[kind[k], a] u[w, c] for every member.
+    """Fill ``out`` with x_(k+1) = Ad[kind[k]] x_k + Bd[kind[k]] u_k for every member.
+
+    Member-last layouts: the innermost loop runs over members, contiguous in
+    memory, so a step of N members is a few vector operations, as a matrix
+    product over members would be, without a Python loop over time.
 
     Parameters
     ----------
-    Ad : ndarray, shape (n_kinds, 1 or N, n, n)
-        Exact transition over each distinct step; a leading 1 shares it among members.
-    Bd : ndarray, shape (n_kinds, 1 or N, n, m)
+    Ad : ndarray, shape (n_kinds, n, n, 1 or N)
+        Exact transition over each distinct step; a last axis of 1 shares it among members.
+    Bd : ndarray, shape (n_kinds, n, m, 1 or N)
         Exact input matrix over each distinct step.
     kind : ndarray of int64, shape (n_time - 1,)
         Which distinct step each grid step is.
-    x0 : ndarray, shape (N, n)
+    x0 : ndarray, shape (n, N)
         States at the first time point.
-    u : ndarray, shape (1 or N, 1 or n_time, m)
+    u : ndarray, shape (1 or n_time, m, 1 or N)
         Inputs held over each step; a time length of 1 holds them over the run.
-    out : ndarray, shape (N, n_time, n)
+    out : ndarray, shape (n_time, n, N)
         States at every time point (written).
     """
-    members, n_time, n = out.shape
-    m = u.shape[2]
-    for i in range(members):
-        a = 0 if Ad.shape[1] == 1 else i
-        w = 0 if u.shape[0] == 1 else i
+    n_time, n, members = out.shape
+    m = u.shape[1]
+    shared_model = Ad.shape[3] == 1
+    shared_input = u.shape[2] == 1
+    out[0] = x0
+    for k in range(n_time - 1):
+        s = kind[k]
+        c = 0 if u.shape[0] == 1 else k
         for r in range(n):
-            out[i, 0, r] = x0[i, r]
-        for k in range(n_time - 1):
-            s = kind[k]
-            c = 0 if u.shape[1] == 1 else k
-            for r in range(n):
-                total = 0.0
-                for j in range(n):
-                    total += Ad[s, a, r, j] * out[i, k, j]
-                for j in range(m):
-                    total += Bd[s, a, r, j] * u[w, c, j]
-                out[i, k + 1, r] = total
+            row = out[k + 1, r]
+            row[:] = 0.0
+            for j in range(n):
+                previous = out[k, j]
+                if shared_model:
+                    a = Ad[s, r, j, 0]
+                    for i in range(members):
+                        row[i] += a * previous[i]
+                else:
+                    a_all = Ad[s, r, j]
+                    for i in range(members):
+                        row[i] += a_all[i] * previous[i]
+            for j in range(m):
+                b_all = Bd[s, r, j]
+                held = u[c, j]
+                if shared_model and shared_input:
+                    forced = b_all[0] * held[0]
+                    for i in range(members):
+                        row[i] += forced
+                elif shared_model:
+                    b = b_all[0]
+                    for i in range(members):
+                        row[i] += b * held[i]
+                elif shared_input:
+                    for i in range(members):
+                        row[i] += b_all[i] * held[0]
+                else:
+                    for i in range(members):
+                        row[i] += b_all[i] * held[i]
 
 
 @numba.njit(cache=True)

@@ -278,20 +278,19 @@ def propagate_steps_exact(A: np.ndarray, B: np.ndarray, grid: Grid, x0: np.ndarr
     Returns
     -------
     ndarray, shape (N, n_time, n)
+        A view of a time-major buffer (the kernel steps all members at once).
     """
-    out = np.empty((x0.shape[0], grid.times.size, A.shape[-1]))
-    if grid.times.size == 1:
-        out[:, 0] = x0
-        return out
     n, m = A.shape[-1], B.shape[-1]
+    members = x0.shape[0]
+    out = np.empty((grid.times.size, n, members))
     generator = np.zeros((max(A.shape[0], B.shape[0]), n + m, n + m))
     generator[:, :n, :n], generator[:, :n, n:] = A, B
     scale = balance(generator)[1][:n]  # step in D^-1 x, as the exponentials do
     Ad, Bd = zoh_discretize(A * (scale / scale[:, None]), B / scale[:, None], grid.kinds)
-    propagate_steps(np.ascontiguousarray(Ad), np.ascontiguousarray(Bd), grid.which, np.ascontiguousarray(x0 / scale),
-                    np.ascontiguousarray(u, dtype=float), out)
-    out *= scale
-    return out
+    propagate_steps(np.ascontiguousarray(Ad.transpose(0, 2, 3, 1)), np.ascontiguousarray(Bd.transpose(0, 2, 3, 1)),
+                    grid.which, np.ascontiguousarray((x0 / scale).T), np.ascontiguousarray(u.transpose(1, 2, 0)), out)
+    out *= scale[:, None]
+    return out.transpose(2, 0, 1)
 
 
 def propagate_constant_input(M: np.ndarray, R: np.ndarray, grid: Grid, n_moving: int):
