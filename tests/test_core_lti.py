@@ -131,9 +131,9 @@ def test_batch_of_different_state_matrices_equals_member_by_member():
     batch = simulate(StateSpace(A, B, states=("x", "v")), t, initial_state=[1.0, 0.0], inputs=[1e-6])
     for i in (0, 11, 24):
         single = simulate(StateSpace(A[i], B[i], states=("x", "v")), t, initial_state=[1.0, 0.0], inputs=[1e-6])
-        # a batch of different A steps through time; a single model takes the
-        # constant-input path (exponentials per time point): two exact algorithms
-        # that agree to rounding, 1e-12 of the channel's magnitude
+        # a batch of different A builds each member's block transition by squaring, a single
+        # model by its own exponential: two exact algorithms that agree to rounding, 1e-12 of
+        # the channel's magnitude
         scale = np.abs(single["x"]).max()
         np.testing.assert_allclose(batch["x"][i], single["x"], rtol=0, atol=1e-12 * scale)
         np.testing.assert_allclose(batch["x"][i], np.cos(omegas[i] * t) + 1e-6 / omegas[i] ** 2 * (1 - np.cos(omegas[i] * t)), atol=1e-10)
