@@ -420,3 +420,32 @@ def test_streaming_reservoir_does_not_depend_on_chunking():
     nothing_kept.update(data)
     with pytest.raises(InvalidParameter, match="reservoir_size"):
         nothing_kept.percentile(50)
+
+
+@st.composite
+def constant_input_problems(draw):
+    """A stable model (shared or one per member), a grid (uniform, maybe with a shorter last step) and inputs."""
+    n, m, members = draw(st.integers(1, 5)), draw(st.integers(0, 3)), draw(st.integers(1, 4))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    batched = draw(st.booleans())
+    M = rng.normal(size=(members if batched else 1, n, n))
+    shift = np.max(np.linalg.eigvals(M).real, axis=-1) + rng.uniform(0.05, 1.0)
+    A = M - shift[:, None, None] * np.eye(n)
+    B = rng.normal(size=(n, m))
+    points = draw(st.integers(1, 400))
+    step = draw(st.floats(0.01, 2.0))
+    t = step * np.arange(points)
+    if draw(st.booleans()) and points > 3:
+        t[-1] -= 0.4 * step
+    return StateSpace(A if batched else A[0], B), t, rng.normal(size=(members, n)), rng.normal(size=(members, m))
+
+
+@settings(max_examples=40, deadline=None)
+@given(constant_input_problems())
+def test_block_exponentials_equal_exact_steps(problem):
+    # two exact algorithms (block products of exponentials; one ZOH step after another) agree to rounding
+    system, t, x0, u = problem
+    blocks = simulate(system, t, x0, inputs=u).states
+    steps = simulate(system, t, x0, input_series=np.broadcast_to(u[:, None, :], (u.shape[0], t.size, u.shape[1]))).states
+    scale = np.maximum(np.abs(steps).max(axis=1, keepdims=True), 1e-300)
+    assert np.max(np.abs(blocks - steps) / scale) < 1e-10

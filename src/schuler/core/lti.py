@@ -146,12 +146,10 @@ def _drive(system: StateSpace, t: np.ndarray, initial_state, inputs, input_serie
     if len(set(sizes.values())) > 1:
         raise InvalidParameter(list(sizes)[-1], f"member counts disagree: {sizes}")
     members = next(iter(sizes.values()), None)
-    return _Drive(
-        x0.reshape(-1, n),
-        None if u is None else u.reshape(-1, m),
-        None if series is None else series.reshape(-1, T, m),
-        members,
-    )
+    def with_members(a, ndim):
+        return a if a is None or a.ndim == ndim else a[None]
+
+    return _Drive(with_members(x0, 2), with_members(u, 2), with_members(series, 3), members)
 
 
 def _batched(M: np.ndarray) -> np.ndarray:

@@ -288,7 +288,8 @@ def propagate_steps_exact(A: np.ndarray, B: np.ndarray, grid: Grid, x0: np.ndarr
     scale = balance(generator)[1][:n]  # step in D^-1 x, as the exponentials do
     Ad, Bd = zoh_discretize(A * (scale / scale[:, None]), B / scale[:, None], grid.kinds)
     propagate_steps(np.ascontiguousarray(Ad.transpose(0, 2, 3, 1)), np.ascontiguousarray(Bd.transpose(0, 2, 3, 1)),
-                    grid.which, np.ascontiguousarray((x0 / scale).T), np.ascontiguousarray(u.transpose(1, 2, 0)), out)
+                    grid.which, np.ascontiguousarray((x0 / scale).T),
+                    np.require(u.transpose(1, 2, 0), np.float64, ["C", "W"]), out)  # one compiled signature
     out *= scale[:, None]
     return out.transpose(2, 0, 1)
 
