@@ -145,10 +145,10 @@ def speed() -> bool:
     ivp_total = ivp.cpu * MEMBERS / IVP_MEMBERS
     dlsim_total = dlsim.cpu * MEMBERS / DLSIM_MEMBERS
     print(f"1. speed: {MEMBERS} members x {STEPS} steps, 3 states, 2 inputs (CPU s; wall s in brackets)")
-    print(f"   solve_ivp loop (RK45, rtol 1e-10) : {ivp_total:8.1f} s ({ivp_total / MEMBERS * 1e3:.1f} ms per member; "
-          f"timed {IVP_MEMBERS}, scaled)")
-    print(f"   dlsim loop (exact ZOH)            : {dlsim_total:8.1f} s ({dlsim_total / MEMBERS * 1e3:.1f} ms per member; "
-          f"timed {DLSIM_MEMBERS}, scaled)")
+    print(f"   solve_ivp loop (RK45, rtol 1e-10) : {ivp_total:8.1f} s "
+          f"({ivp_total / MEMBERS * 1e3:.1f} ms per member; timed {IVP_MEMBERS}, scaled)")
+    print(f"   dlsim loop (exact ZOH)            : {dlsim_total:8.1f} s "
+          f"({dlsim_total / MEMBERS * 1e3:.1f} ms per member; timed {DLSIM_MEMBERS}, scaled)")
     runs = (("engine, streamed, all states", streamed), ("engine, streamed, position only", position_only),
             ("engine, all histories (1.7 GB)", histories))
     for label, clock in runs:

@@ -446,6 +446,7 @@ def test_block_exponentials_equal_exact_steps(problem):
     # two exact algorithms (block products of exponentials; one ZOH step after another) agree to rounding
     system, t, x0, u = problem
     blocks = simulate(system, t, x0, inputs=u).states
-    steps = simulate(system, t, x0, input_series=np.broadcast_to(u[:, None, :], (u.shape[0], t.size, u.shape[1]))).states
+    held = np.broadcast_to(u[:, None, :], (u.shape[0], t.size, u.shape[1]))
+    steps = simulate(system, t, x0, input_series=held).states
     scale = np.maximum(np.abs(steps).max(axis=1, keepdims=True), 1e-300)
     assert np.max(np.abs(blocks - steps) / scale) < 1e-10
