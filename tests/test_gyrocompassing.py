@@ -273,16 +273,22 @@ def test_batched_sweep_equals_single_runs():
         assert batch["azimuth_error_simulated_rad"][i] == pytest.approx(batch["azimuth_error_rad"][i], rel=1e-9)
 
 
-def test_dense_outputs_exact_when_members_equal_engine_steps():
-    # 3 members and 3 engine steps: inputs must not be mistaken for a time series
+def test_batched_simulation_exact_when_members_equal_time_points():
+    # 3 members on 3 (and 122) time points: (N, m) inputs are constant per member, never a time series;
+    # the engine's block exponentials agree with exact steps to rounding of the ~0.01 rad signals
     system = models.full_mu_nu_model(np.radians([10.0, 40.0, 70.0]), 0.3, 0.05, 20.0)
     x0 = np.tile(models.initial_state("full", 0.01), (3, 1))
     u = np.array([[1e-8, 0, 0, 0, 0, 0], [0, 2e-8, 0, 0, 1e-3, 0], [0, 0, 3e-8, 1e-4, 0, 0]])
-    dense = study.dense_outputs(system, 1.0, 121, x0, u, ["delta", "beta"])
-    held = np.broadcast_to(u[:, None, :], (3, 122, 6))
-    reference = simulate(system, np.arange(122.0), x0, held)
-    for name in ("delta", "beta"):
-        np.testing.assert_allclose(dense[name], reference[name], rtol=0, atol=1e-16)
+    for n_time in (3, 122):
+        t = np.arange(float(n_time))
+        blocks = simulate(system, t, x0, inputs=u)
+        held = simulate(system, t, x0, input_series=np.broadcast_to(u[:, None, :], (3, n_time, 6)))
+        for name in ("delta", "beta"):
+            np.testing.assert_allclose(blocks[name], held[name], rtol=0, atol=1e-16)
+    chunked = study.simulate_cases(system, np.arange(122.0), x0, u, 3, chunk_size=1)
+    whole = study.simulate_cases(system, np.arange(122.0), x0, u, 3)
+    np.testing.assert_allclose(chunked.max_abs_delta, whole.max_abs_delta, rtol=1e-14)  # chunking changes rounding only
+    np.testing.assert_allclose(chunked.azimuth_error, blocks["delta"][:, -1], rtol=0, atol=1e-16)
 
 
 def test_monte_carlo_spread_matches_analytic_sigma():
