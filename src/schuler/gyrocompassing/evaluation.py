@@ -22,8 +22,22 @@ import warnings
 import numpy as np
 
 from schuler.contract import Cases, Output
-from schuler.gyrocompassing import analytic, models, study
-from schuler.gyrocompassing.results import AlignmentResult, write_files
+from schuler.core.earth import EARTH_RATE
+from schuler.gyrocompassing import analytic, models
+from schuler.gyrocompassing.case import (
+    DEFAULT_DAMPING,
+    DEFAULT_INITIAL_AZIMUTH_ERROR,
+    DEFAULT_MAX_LATITUDE,
+    DEFAULT_TIME_CONSTANT,
+    MAX_DURATION,
+    AlignmentCase,
+    DegradedAccuracyWarning,
+    analytic_results,
+    automatic_duration,
+)
+from schuler.gyrocompassing.results import AlignmentResult
+from schuler.gyrocompassing.simulation import evaluate_cases
+from schuler.gyrocompassing.simulation import run_case as simulate_case
 from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
 
@@ -43,16 +57,16 @@ PARAMETERS = ParameterSet((
               minimum=-0.1, maximum=0.1),
     Parameter("accel_bias_y", "g", 0.0, "Bias Delta a_y of the y accelerometer (measured - true).",
               minimum=-0.1, maximum=0.1),
-    Parameter("time_constant", "s", study.DEFAULT_TIME_CONSTANT,
+    Parameter("time_constant", "s", DEFAULT_TIME_CONSTANT,
               "Time constant T of the azimuth loop (gains not given follow from T and zeta).",
               minimum=0.1, maximum=1e5),
-    Parameter("damping", "", study.DEFAULT_DAMPING, "Damping ratio zeta of the azimuth loop.",
+    Parameter("damping", "", DEFAULT_DAMPING, "Damping ratio zeta of the azimuth loop.",
               minimum=0.01, maximum=100),
     Parameter("c_gamma", "1/s", None, "Level correction gain c_Gamma (not set: 2 zeta / T).",
               minimum=1e-6, maximum=100),
     Parameter("c_a", "1/s", None, "Azimuth correction gain c_a (not set: 1 / (T^2 U cos(latitude))).",
               minimum=1e-6, maximum=1e8),
-    Parameter("initial_azimuth_error", "deg", math.degrees(study.DEFAULT_INITIAL_AZIMUTH_ERROR),
+    Parameter("initial_azimuth_error", "deg", math.degrees(DEFAULT_INITIAL_AZIMUTH_ERROR),
               "Initial azimuth misalignment delta0.", minimum=-90, maximum=90),
     Parameter("initial_beta", "arcmin", 0.0, "Initial level error beta0 (0: levelled).", **_ERROR_RANGE),
     Parameter("initial_alpha", "arcmin", 0.0, "Initial level error alpha0 (0: levelled).", **_ERROR_RANGE),
@@ -60,10 +74,10 @@ PARAMETERS = ParameterSet((
               choices=models.MODELS, kind="choice"),
     Parameter("duration", "s", None,
               "Simulated time (not set: 2 h, or 3 settling times if longer, at most 48 h).",
-              minimum=0, exclusive_minimum=True, maximum=study.MAX_DURATION),
+              minimum=0, exclusive_minimum=True, maximum=MAX_DURATION),
     Parameter("output_step", "s", 1.0, "Output step (the simulation is exact between outputs).",
               minimum=1e-3, maximum=3600),
-    Parameter("max_latitude", "deg", math.degrees(study.DEFAULT_MAX_LATITUDE),
+    Parameter("max_latitude", "deg", math.degrees(DEFAULT_MAX_LATITUDE),
               "Latitude above which azimuth is reported not observable.", minimum=0, maximum=90,
               exclusive_minimum=True, exclusive_maximum=True),
     Parameter("sigma_drift", "deg/h", 0.01, "Monte Carlo: 1-sigma of the x and y residual drifts.", minimum=0),
@@ -105,8 +119,8 @@ _CASE_FIELDS = ("latitude", "azimuth", "drift_east", "drift_north", "drift_x", "
                 "initial_beta", "initial_alpha")
 
 
-def alignment_case(cases: Cases) -> study.AlignmentCase:
-    """The :class:`~schuler.gyrocompassing.study.AlignmentCase` of a batch, random terms drawn for members."""
+def alignment_case(cases: Cases) -> AlignmentCase:
+    """The :class:`~schuler.gyrocompassing.AlignmentCase` of a batch, random terms drawn for members."""
     arrays = {name: cases.float(name) for name in _CASE_FIELDS}
     arrays["accel_error_x"] = cases.float("accel_bias_x")
     arrays["accel_error_y"] = cases.float("accel_bias_y")
@@ -116,8 +130,8 @@ def alignment_case(cases: Cases) -> study.AlignmentCase:
                             ("accel_error_x", "sigma_accel"), ("accel_error_y", "sigma_accel")):
             arrays[name] = arrays[name] + cases.float(sigma) * draw(name, cases.members)
     max_latitude = cases.float("max_latitude")
-    return study.AlignmentCase(**arrays, max_latitude=float(max_latitude.max()) if max_latitude.size else
-                               study.DEFAULT_MAX_LATITUDE)
+    return AlignmentCase(**arrays, max_latitude=float(max_latitude.max()) if max_latitude.size else
+                               DEFAULT_MAX_LATITUDE)
 
 
 def evaluate(cases: Cases) -> dict[str, np.ndarray]:
@@ -130,8 +144,8 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     fidelity = cases.fidelity or FIDELITIES[0]
     # a duration not set is the case's own automatic one, so a batch gives what each case alone gives
-    settling = study.analytic_results(alignment_case(cases), "simplified")["settling_time_s"]
-    automatic = np.array([study.automatic_duration(t) for t in np.broadcast_to(settling, (n,))])
+    settling = analytic_results(alignment_case(cases), "simplified")["settling_time_s"]
+    automatic = np.array([automatic_duration(t) for t in np.broadcast_to(settling, (n,))])
     resolved = Cases({**{name: cases[name] for name in cases.names}, "duration": cases.value_or("duration", automatic)},
                      members=cases.members, random=cases.random, fidelity=cases.fidelity)
     for index, group in resolved.groups("model", "duration", "output_step", "max_latitude"):
@@ -150,9 +164,9 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
         points = duration / float(cases.float("output_step")[0]) + 2
         require(points * 8 * 6 * min(len(cases), _CHUNK_MEMBERS), "this simulation",
                 "--duration or --output-step (or --fidelity closed)")
-    result = study.evaluate_cases(case, model, simulate_runs=simulate, duration=duration,
+    result = evaluate_cases(case, model, simulate_runs=simulate, duration=duration,
                                   time_step=float(cases.float("output_step")[0]))
-    full = study.analytic_results(case, "full-ab")["azimuth_error_rad"]
+    full = analytic_results(case, "full-ab")["azimuth_error_rad"]
     c_gamma, c_a = result["c_gamma"], result["c_a"]
     system = case.model(model)
     gains = analytic.steady_state_gain_matrix(system.A, system.B)[..., list(system.states).index("delta"), :]
@@ -199,7 +213,7 @@ def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
     cases = Cases.from_case(case, fidelity=fidelity)
     outputs = {name: float(values[0]) for name, values in evaluate(cases).items()}
     aligned = alignment_case(cases)
-    single = study.AlignmentCase(**{f: (v[0] if isinstance(v, np.ndarray) else v)
+    single = AlignmentCase(**{f: (v[0] if isinstance(v, np.ndarray) else v)
                                     for f, v in vars(aligned).items()})
     model = case["model"]
     histories = simplified = None
@@ -208,12 +222,12 @@ def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
         with warnings.catch_warnings():
             # evaluate has warned about the latitude already; the histories are the same case
             warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")
-            histories = study.run_case(single, model, duration=outputs["duration_s"], time_step=case["output_step"])
+            histories = simulate_case(single, model, duration=outputs["duration_s"], time_step=case["output_step"])
             simplified = histories
             if model != "simplified":
                 # (1.19) beside the model for the comparison figures; the model's own run has warned already
-                warnings.simplefilter("ignore", study.DegradedAccuracyWarning)
-                simplified = study.run_case(single, "simplified", duration=outputs["duration_s"],
+                warnings.simplefilter("ignore", DegradedAccuracyWarning)
+                simplified = simulate_case(single, "simplified", duration=outputs["duration_s"],
                                             time_step=case["output_step"])
     violations = [] if histories is None else list(histories.violations)
     return AlignmentResult(
@@ -227,7 +241,7 @@ def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
 
 def _regime(c_gamma: float, c_a: float, latitude: float) -> str:
     h_sq = (c_gamma / 2) ** 2
-    omega0_sq = c_a * math.cos(latitude) * study.EARTH_RATE
+    omega0_sq = c_a * math.cos(latitude) * EARTH_RATE
     if math.isclose(h_sq, omega0_sq, rel_tol=1e-9):
         return "critical"
     return "oscillatory" if omega0_sq > h_sq else "aperiodic"
@@ -235,7 +249,7 @@ def _regime(c_gamma: float, c_a: float, latitude: float) -> str:
 
 def member_bytes(case: Case) -> int:
     """Memory one member holds while simulated: its history of 3 states and 3 outputs, 8 bytes each."""
-    duration = case["duration"] or study.MAX_DURATION
+    duration = case["duration"] or MAX_DURATION
     return int(6 * 8 * (duration / case["output_step"] + 2))
 
 

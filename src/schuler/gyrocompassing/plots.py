@@ -25,7 +25,7 @@ def _figure(rows: int = 1, height: float = 3.2):
 
 
 def time_history(runs: dict, title: str = "Gyrocompassing: azimuth and level errors", settling_times: float = 4.0):
-    """delta and beta against time for one or more runs (label -> :class:`study.CaseRun`), Fig. 1.4 style.
+    """delta and beta against time for one or more runs (label -> :class:`~schuler.gyrocompassing.simulation.CaseRun`), Fig. 1.4 style.
 
     The time axis spans ``settling_times`` analytic settling times (or the whole
     run if shorter), so that the transient is visible.

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar
 
-from schuler.gyrocompassing import study
+from schuler.gyrocompassing.simulation import CaseRun
 from schuler.reproduction import Reproduction
 from schuler.results import Result, RunResult
 from schuler.units import to_unit
@@ -45,8 +45,8 @@ class AlignmentResult(RunResult):
     constraints_ok: bool | None
     constraint_violations: list
     duration_s: float
-    run: study.CaseRun | None = field(default=None, repr=False)
-    simplified_run: study.CaseRun | None = field(default=None, repr=False)
+    run: CaseRun | None = field(default=None, repr=False)
+    simplified_run: CaseRun | None = field(default=None, repr=False)
 
     units: ClassVar[dict[str, str]] = {"c_gamma": "1/s", "c_a": "1/s", "damping": "1"}
 
