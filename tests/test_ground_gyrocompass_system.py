@@ -295,7 +295,8 @@ def test_reproduction_values_as_printed():
 
 def test_reproduction_json_has_units():
     data = reproduce(3).to_dict()
-    assert data["units"] == {"computed": "the row's unit"}
+    assert data["units"]["computed"] == "the row's unit"
+    assert data["units"]["computed_misfit"].startswith("rad^2") and data["units"]["cells"] == "1"
     assert {"stages_in_source_units", "table1_readings", "identification"} <= set(data["details"])
 
 
