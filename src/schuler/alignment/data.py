@@ -74,9 +74,7 @@ class StaticBatch:
         self.sample_interval_s = dt
         if not (math.isfinite(self.latitude_rad) and abs(self.latitude_rad) <= math.pi / 2):
             raise InvalidParameter("latitude", f"{self.latitude_rad!r} rad must be within [-pi/2, pi/2]")
-        if self.gravity_m_s2 is None:
-            self.gravity_m_s2 = float(normal_gravity(self.latitude_rad))
-        if not (math.isfinite(self.gravity_m_s2) and self.gravity_m_s2 > 0):
+        if self.gravity_m_s2 is not None and not (math.isfinite(self.gravity_m_s2) and self.gravity_m_s2 > 0):
             raise InvalidParameter("gravity", f"must be finite and > 0 m/s^2, got {self.gravity_m_s2!r}")
         for name in ("gyro_increment", "accel_increment"):
             if not np.all(np.isfinite(getattr(self, name))):
@@ -98,6 +96,11 @@ class StaticBatch:
         first, stop = window_indices(record.samples, record.sample_interval_s, start_s, duration_s)
         return cls(record.gyro_increment_rad[None, first:stop], record.accel_increment_m_s[None, first:stop],
                    record.sample_interval_s, float(latitude), record.gravity_m_s2)
+
+    @property
+    def gravity(self) -> float:
+        """g at the site, m/s^2 (the one given, or WGS-84 normal gravity at the latitude)."""
+        return float(normal_gravity(self.latitude_rad)) if self.gravity_m_s2 is None else float(self.gravity_m_s2)
 
     @property
     def members(self) -> int:

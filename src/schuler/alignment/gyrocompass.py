@@ -106,7 +106,8 @@ def align_gyrocompass(batch: StaticBatch, *, time_constant_s: float = DEFAULT_TI
     ends = batch.history_indices(history_step_s)
     history = np.empty((batch.members, ends.size, 3, 3))
     _kernels.gyrocompass_loop(batch.gyro_increment, batch.accel_increment, dt, attitude,
-                              earth_rate_ned(batch.latitude_rad), float(batch.gravity_m_s2), c_gamma, c_a, ends, history)
+                              earth_rate_ned(batch.latitude_rad), batch.gravity, c_gamma, c_a, ends,
+                              history)
     roll, pitch, heading = euler_from_dcm(history)
     return MethodEstimate("gyrocompass", roll[:, -1], pitch[:, -1], heading[:, -1], None, ends * dt, roll, pitch,
                           heading)

@@ -77,7 +77,7 @@ def align_inertial(batch: StaticBatch, history_step_s: float = 1.0) -> MethodEst
     first = np.searchsorted(ends, history // 2, side="right") - 1
     usable = (first >= 0) & (first < second)
     first, second = first[usable], second[usable]
-    v_nav = navigation_velocity(times, batch.latitude_rad, batch.gravity_m_s2)
+    v_nav = navigation_velocity(times, batch.latitude_rad, batch.gravity)
     start_attitude = triad(velocity[:, first], velocity[:, second], v_nav[first], v_nav[second])
     earth_turn = rotation_matrix(-earth_rate_ned(batch.latitude_rad) * times[second][:, None])
     dcm = earth_turn @ start_attitude @ attitude[:, second]

@@ -58,8 +58,8 @@ from schuler.alignment.attitude import (
 )
 from schuler.alignment.coarse import coarse_attitude
 from schuler.alignment.data import MethodEstimate, StaticBatch
-from schuler.alignment.limits import accuracy_limit
-from schuler.core.earth import EARTH_RATE
+from schuler.alignment.limits import accuracy_limit, effective_bias_sigma
+from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
 
 STATES = 12
@@ -92,16 +92,18 @@ class KalmanTuning:
     velocity_noise: float
 
     @classmethod
-    def from_model(cls, model, velocity_noise: float = 0.01, window_s: float = 600.0) -> KalmanTuning:
-        """From an :class:`~schuler.imu.error_model.ErrorModel`: N, turn-on bias with bias instability B, and a bias
-        walk that lets B build up over ``window_s`` (q = B^2 / window)."""
+    def from_model(cls, model, velocity_noise: float = 0.01, window_s: float = 600.0,
+                   gravity: float = STANDARD_GRAVITY) -> KalmanTuning:
+        """From an :class:`~schuler.imu.error_model.ErrorModel`: N, the constant error at rest
+        (:func:`~schuler.alignment.limits.effective_bias_sigma`), and a bias walk that lets the bias
+        instability B build up over ``window_s`` (q = B^2 / window)."""
         if not (math.isfinite(velocity_noise) and velocity_noise > 0):
             raise InvalidParameter("velocity_noise", f"must be finite and > 0 m/s, got {velocity_noise!r}")
         gyro, accel = model.gyro, model.accel
+        gyro_bias, accel_bias = effective_bias_sigma(model, gravity)
         return cls(np.asarray(gyro.random_walk, dtype=float), np.asarray(accel.random_walk, dtype=float),
-                   np.hypot(gyro.bias, gyro.bias_instability), np.hypot(accel.bias, accel.bias_instability),
-                   gyro.bias_instability / math.sqrt(window_s), accel.bias_instability / math.sqrt(window_s),
-                   float(velocity_noise))
+                   gyro_bias, accel_bias, gyro.bias_instability / math.sqrt(window_s),
+                   accel.bias_instability / math.sqrt(window_s), float(velocity_noise))
 
 
 def coarse_error_map(latitude: float, gravity: float) -> np.ndarray:
@@ -131,12 +133,12 @@ def _initial_covariance(model, tuning: KalmanTuning, batch: StaticBatch, heading
                         initial_window_s: float) -> np.ndarray:
     """P0 (m, 12, 12): the coarse start's error is M b (correlated with the bias states) plus its noise, inflated."""
     limit = accuracy_limit("coarse", model, latitude=batch.latitude_rad, heading=float(np.median(heading)),
-                           duration=initial_window_s, gravity=batch.gravity_m_s2)
+                           duration=initial_window_s, gravity=batch.gravity)
     tilt_noise = max(limit.roll_noise_rad, limit.pitch_noise_rad)
     biases = np.zeros((heading.size, 6, 6))
     biases[:, 0:3, 0:3] = _resolved(tuning.gyro_bias, heading)
     biases[:, 3:6, 3:6] = _resolved(tuning.accel_bias, heading)
-    M = coarse_error_map(batch.latitude_rad, batch.gravity_m_s2)
+    M = coarse_error_map(batch.latitude_rad, batch.gravity)
     P = np.zeros((heading.size, STATES, STATES))
     P[:, 0:3, 0:3] = M @ biases @ M.T + INFLATION * np.diag(
         [tilt_noise**2, tilt_noise**2, limit.heading_noise_rad**2])
@@ -214,7 +216,7 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
         raise InvalidParameter("update_interval", f"must be finite and > 0 s, got {update_interval_s!r}")
     dt = batch.sample_interval_s
     per_update = max(1, int(round(update_interval_s / dt)))
-    tuning = KalmanTuning.from_model(model, velocity_noise)
+    tuning = KalmanTuning.from_model(model, velocity_noise, gravity=batch.gravity)
     initial = max(2, min(batch.samples, int(round(initial_window_s / dt))))
     rate, force = batch.mean_rates(initial)
     roll0, pitch0, heading0 = coarse_attitude(force, rate, batch.latitude_rad)
@@ -222,7 +224,7 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
     m = batch.members
     P = _initial_covariance(model, tuning, batch, heading0, initial * dt)
     omega = earth_rate_ned(batch.latitude_rad)
-    gravity = np.array([0.0, 0.0, batch.gravity_m_s2])
+    gravity = np.array([0.0, 0.0, batch.gravity])
     velocity = np.zeros((m, 3))
     gyro_bias, accel_bias = np.zeros((m, 3)), np.zeros((m, 3))   # NED-resolved estimates
     previous = np.zeros((m, 6))
@@ -236,9 +238,9 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
         span = (stop - start) * dt
         to_body = np.swapaxes(C, 1, 2)
         _kernels.navigate_at_rest(batch.gyro_increment, batch.accel_increment, int(start), int(stop), dt, C, velocity,
-                                  np.einsum("mij,mj->mi", to_body, gyro_bias), np.einsum("mij,mj->mi", to_body, accel_bias),
-                                  omega, gravity, previous)
-        Phi, G = _transition(C, batch.gravity_m_s2, omega, span)
+                                  np.einsum("mij,mj->mi", to_body, gyro_bias),
+                                  np.einsum("mij,mj->mi", to_body, accel_bias), omega, gravity, previous)
+        Phi, G = _transition(C, batch.gravity, omega, span)
         GQG = G @ intensity @ np.swapaxes(G, 1, 2)
         P = Phi @ P @ np.swapaxes(Phi, 1, 2) + 0.5 * span * (Phi @ GQG @ np.swapaxes(Phi, 1, 2) + GQG)
         S = P[:, 3:6, 3:6] + R

@@ -273,6 +273,30 @@ def kpi_equivalent_inputs(gyro_bias_ned, accel_bias_ned, gravity=STANDARD_GRAVIT
             "eps_beta": float(-b_a[0] / gravity), "eps_alpha": float(b_a[1] / gravity)}
 
 
+def effective_bias_sigma(errors, gravity: float = STANDARD_GRAVITY) -> tuple[np.ndarray, np.ndarray]:
+    """1-sigma of the constant error each sensor shows at rest and level, body axes: (gyro rad/s, accel m/s^2).
+
+    At rest the inputs are constant, so every constant error term acts as a bias:
+    turn-on bias b, bias instability B (counted as a further constant of 1-sigma B:
+    over an alignment window it moves little), misalignment and scale factor times
+    the input (accelerometers: M_i3 g on x and y, S_3 g on z; gyros: up to Omega times
+    the row of M and S), and the gyros' g-sensitivity G_i3 g.
+
+    Parameters
+    ----------
+    errors : ErrorModel
+        Per-axis 1-sigma values (:mod:`schuler.imu.error_model`).
+    gravity : float
+        g, m/s^2.
+    """
+    gyro, accel = errors.gyro, errors.accel
+    gyro_var = (gyro.bias**2 + gyro.bias_instability**2 + (gyro.g_sensitivity[:, 2] * gravity) ** 2
+                + EARTH_RATE**2 * ((gyro.misalignment**2).sum(axis=1) + gyro.scale_factor**2))
+    accel_input = np.array([accel.misalignment[0, 2], accel.misalignment[1, 2], accel.scale_factor[2]]) * gravity
+    accel_var = accel.bias**2 + accel.bias_instability**2 + accel_input**2
+    return np.sqrt(gyro_var), np.sqrt(accel_var)
+
+
 @dataclass(frozen=True)
 class AccuracyLimit:
     """1-sigma accuracy of one method for one error model and window (rad).
@@ -322,9 +346,8 @@ def accuracy_limit(method: str, errors, *, latitude: float, heading: float, dura
     ----------
     method : {"coarse", "inertial_frame", "kalman", "gyrocompass"}
     errors : ErrorModel
-        1-sigma turn-on biases (``bias``), bias instability B (counted as a further
-        constant bias of 1-sigma B: over an alignment window it moves little) and
-        white noise N (``random_walk``) of both triads, body axes (:mod:`schuler.imu.error_model`).
+        The sensors' errors, body axes (:mod:`schuler.imu.error_model`): their constant part
+        at rest (:func:`effective_bias_sigma`) and white noise N (``random_walk``).
     latitude, heading : float
         Site latitude and (approximate) true heading of the level body, rad.
     duration : float
@@ -348,8 +371,7 @@ def accuracy_limit(method: str, errors, *, latitude: float, heading: float, dura
         raise InvalidParameter("duration", f"must be finite and > 0 s, got {duration!r}")
     rate = float(horizontal_rate(latitude))
     tan_l = math.tan(latitude)
-    gyro_b = np.hypot(errors.gyro.bias, errors.gyro.bias_instability)
-    accel_b = np.hypot(errors.accel.bias, errors.accel.bias_instability)
+    gyro_b, accel_b = effective_bias_sigma(errors, gravity)
     roll_bias, pitch_bias = accel_b[1] / gravity, accel_b[0] / gravity
     heading_bias = math.hypot(_sigma_east(heading, gyro_b) / rate, _sigma_east(heading, accel_b) * tan_l / gravity)
     n_g, n_a = errors.gyro.random_walk, errors.accel.random_walk

@@ -117,7 +117,7 @@ class SixPositionPlan:
         During a turn the table turns clockwise (seen from above) at 2 pi / turn_s; the
         body's Earth rate follows the heading at each sample's middle.
         """
-        dt, omega = self.sample_interval_s, earth_rate_ned(self.latitude_rad)
+        omega = earth_rate_ned(self.latitude_rad)
         gyro, accel = np.empty((self.samples, 3)), np.empty((self.samples, 3))
         down = np.array([0.0, 0.0, -self.gravity])
         for name, turning, first, stop in self.segments():
