@@ -28,9 +28,9 @@ from schuler.alignment.attitude import wrap_angle
 from schuler.alignment.coarse import align_coarse
 from schuler.alignment.data import BYTES_PER_SAMPLE, MethodEstimate, StaticBatch, convergence_time, window_indices
 from schuler.alignment.gyrocompass import DEFAULT_DAMPING, DEFAULT_TIME_CONSTANT, align_gyrocompass, loop_gains
-from schuler.alignment.inertial import align_inertial
+from schuler.alignment.inertial import align_inertial, net_rotation
 from schuler.alignment.kalman import align_kalman
-from schuler.alignment.limits import METHODS, accuracy_limit, static_errors
+from schuler.alignment.limits import METHODS, accuracy_limit, horizontal_rate, static_errors
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.record import ImuRecord
 from schuler.imu.simulate import ImuSimulator, simulate_members, static_truth
@@ -99,7 +99,8 @@ class AlignmentComparison(Result):
     north, in (-180, 180] deg), ``roll_sigma_rad``, ``pitch_sigma_rad``,
     ``heading_sigma_rad`` (the method's own 1-sigma; null where it has none),
     ``convergence_time_s`` (after it the heading stays within the noise part of its
-    limit of its final value: the bias part is common to all methods and never converges away), ``limit_roll_rad``, ``limit_pitch_rad``, ``limit_heading_rad`` (1-sigma
+    limit of its final value: the bias part is common to all methods and never
+    converges away), ``limit_roll_rad``, ``limit_pitch_rad``, ``limit_heading_rad`` (1-sigma
     limits), ``limit_heading_bias_rad`` and ``limit_heading_noise_rad`` (their two
     parts), and, when the truth is known, ``heading_error_rad`` (computed - true) and
     ``predicted_heading_error_rad`` (the static limit's formula with the record's own biases).
@@ -114,6 +115,8 @@ class AlignmentComparison(Result):
     error_model_source: str
     methods: dict[str, dict[str, Any]]
     agreement: dict[str, dict[str, float | bool]]
+    body_rotation_rad: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    coarse_disturbance_rad: float = 0.0
     true_attitude_rad: tuple[float, float, float] | None = None
     time_constant_s: float = DEFAULT_TIME_CONSTANT
     damping: float = DEFAULT_DAMPING
@@ -123,6 +126,8 @@ class AlignmentComparison(Result):
     histories: dict[str, MethodEstimate] = field(default_factory=dict, repr=False)
 
     units = {"latitude_rad": "rad", "c_gamma": "1/s", "c_a": "1/s", "damping": "1",
+             "body_rotation_rad": "rad, the body's net turn over the window (north, east, down)",
+             "coarse_disturbance_rad": "rad, the heading shift that turn gives coarse alignment",
              "agreement": "heading difference from kalman (rad) and its ratio to the combined noise limit (1)"}
 
     def render(self):
@@ -214,17 +219,30 @@ def compare_alignment(batch: StaticBatch, model: ErrorModel, settings: Alignment
         ratio = abs(difference) / combined if combined > 0 else math.inf
         agreement[name] = {"difference_rad": difference, "ratio": ratio, "agrees": bool(ratio <= AGREEMENT_SIGMAS)}
     c_gamma, c_a = loop_gains(batch.latitude_rad, settings.time_constant_s, settings.damping)
+    rotation = net_rotation(batch)[0]
+    disturbance = float(-(rotation[1] / batch.duration_s) / horizontal_rate(batch.latitude_rad))
     notes = []
-    if not agreement["coarse"]["agrees"] and agreement["inertial_frame"]["agrees"]:
-        notes.append("coarse alignment disagrees while the inertial-frame method agrees: the mean angular rate holds "
-                     "a net attitude change of the body over the window (a disturbance), which coarse alignment "
-                     "reads as Earth rate and the inertial-frame method follows with the gyros")
+    if not agreement["coarse"]["agrees"]:
+        arcsec, deg = math.degrees(1.0) * 3600.0, math.degrees(1.0)
+        notes.append(f"coarse alignment disagrees: the body turned by {rotation[1] * arcsec:.0f} arcsec about east "
+                     f"over the window (gyros integrated in the inertial frame), a mean rate coarse alignment takes "
+                     f"for Earth rate: that alone moves its heading by {disturbance * deg:+.2f} deg (observed "
+                     f"{agreement['coarse']['difference_rad'] * deg:+.2f} deg from Kalman); the inertial-frame "
+                     "method, the filter and the loop follow the turn with the gyros")
+    if not agreement["gyrocompass"]["agrees"]:
+        memory = 4.0 * settings.damping * settings.time_constant_s
+        notes.append(f"the gyrocompass loop disagrees: it reads the instantaneous horizontal specific force as tilt, "
+                     f"so the body's sway (horizontal accelerations) turns it in azimuth through c_a; it averages "
+                     f"over about 4 zeta T = {memory:.0f} s only, where the inertial-frame method and the filter use "
+                     "the integrated specific force over the whole window")
     return AlignmentComparison(
         source=source, latitude_rad=batch.latitude_rad, start_s=start_s, duration_s=batch.duration_s,
         sample_interval_s=batch.sample_interval_s, error_model=model.name, error_model_source=model_source,
         methods=methods, agreement=agreement,
         true_attitude_rad=None if truth is None else (float(truth[0]), float(truth[1]), float(truth[2])),
-        time_constant_s=settings.time_constant_s, damping=settings.damping, c_gamma=c_gamma, c_a=c_a, notes=notes,
+        time_constant_s=settings.time_constant_s, damping=settings.damping, c_gamma=c_gamma, c_a=c_a,
+        body_rotation_rad=(float(rotation[0]), float(rotation[1]), float(rotation[2])),
+        coarse_disturbance_rad=disturbance, notes=notes,
         histories=estimates)
 
 
@@ -256,23 +274,18 @@ def window_record(record: ImuRecord, start_s: float, duration_s: float | None) -
 
 
 def record_model(record: ImuRecord, grade: str | None) -> tuple[ErrorModel, str]:
-    """The error model of a recording: the grade given, or the closest grade to its Allan curves with its own noise.
+    """The error model of a recording's sensors: the grade given, or the grade closest to its Allan deviation.
 
-    Without ``grade``, the record's Allan analysis (:mod:`schuler.imu.characterise`) gives its
-    grade (turn-on biases, scale factors) and its identified white noise N (where resolved).
+    The limits are the sensors' (spec 06): the record's own motion is not folded into
+    them. At short tau a vehicle's vibration looks like large white noise, yet it
+    averages away; what the body's sway and settling do to each method is reported
+    beside the limits instead (:func:`compare_alignment`).
     """
     if grade is not None:
         return preset(grade), "grade given"
-    from schuler.imu.characterise import analyse_record, model_from_analysis
+    from schuler.imu.characterise import analyse_record
 
     analysis = analyse_record(record)
-    identified = model_from_analysis(analysis)
-    base = preset(analysis.grade or "consumer")
-
-    def own_noise(errors, found):
-        return replace(errors, random_walk=np.where(found.random_walk > 0, found.random_walk, errors.random_walk))
-
-    model = replace(base, gyro=own_noise(base.gyro, identified.gyro), accel=own_noise(base.accel, identified.accel),
-                    name=f"{base.name}, noise identified")
-    return model, f"closest grade to the record's Allan deviation ({analysis.grade or 'none: consumer assumed'}), " \
-                  "white noise identified from it"
+    found = analysis.grade or "consumer"
+    return preset(found), ("closest grade to the record's Allan deviation" if analysis.grade else
+                           "no grade below the record's Allan deviation: consumer assumed")

@@ -114,6 +114,12 @@ class StaticBatch:
     def duration_s(self) -> float:
         return round(self.samples * self.sample_interval_s, 12)
 
+    def head(self, duration_s: float) -> StaticBatch:
+        """The first ``duration_s`` seconds (at least 2 samples, at most all), as a batch (views, no copy)."""
+        samples = max(2, min(self.samples, int(round(duration_s / self.sample_interval_s))))
+        return StaticBatch(self.gyro_increment[:, :samples], self.accel_increment[:, :samples],
+                           self.sample_interval_s, self.latitude_rad, self.gravity_m_s2)
+
     def history_indices(self, step_s: float) -> np.ndarray:
         """Sample counts (1-based ends) at which histories are reported: every ``step_s``, and the last sample."""
         stride = max(1, int(round(step_s / self.sample_interval_s)))

@@ -38,9 +38,9 @@ import math
 import numpy as np
 
 from schuler.alignment import _kernels
-from schuler.alignment.attitude import dcm_from_euler, earth_rate_ned, euler_from_dcm
-from schuler.alignment.coarse import coarse_attitude
+from schuler.alignment.attitude import earth_rate_ned, euler_from_dcm
 from schuler.alignment.data import MethodEstimate, StaticBatch
+from schuler.alignment.inertial import start_attitude
 from schuler.alignment.limits import horizontal_rate
 from schuler.exceptions import InvalidParameter
 
@@ -80,7 +80,7 @@ def settling_time(time_constant: float, damping: float) -> float:
 def align_gyrocompass(batch: StaticBatch, *, time_constant_s: float = DEFAULT_TIME_CONSTANT,
                       damping: float = DEFAULT_DAMPING, initial_window_s: float = 30.0,
                       history_step_s: float = 1.0) -> MethodEstimate:
-    """The strapdown gyrocompass over every record of ``batch``, started from coarse alignment.
+    """The strapdown gyrocompass over every record of ``batch``, started from inertial-frame alignment.
 
     Parameters
     ----------
@@ -88,7 +88,7 @@ def align_gyrocompass(batch: StaticBatch, *, time_constant_s: float = DEFAULT_TI
     time_constant_s, damping : float
         T (s) and zeta of the azimuth loop.
     initial_window_s : float
-        Coarse alignment over the first seconds gives the start.
+        Inertial-frame alignment over the first seconds gives the start.
     history_step_s : float
         Step of the histories, s.
 
@@ -100,9 +100,7 @@ def align_gyrocompass(batch: StaticBatch, *, time_constant_s: float = DEFAULT_TI
     """
     c_gamma, c_a = loop_gains(batch.latitude_rad, time_constant_s, damping)
     dt = batch.sample_interval_s
-    initial = max(2, min(batch.samples, int(round(initial_window_s / dt))))
-    rate, force = batch.mean_rates(initial)
-    attitude = dcm_from_euler(*coarse_attitude(force, rate, batch.latitude_rad))
+    attitude = start_attitude(batch.head(initial_window_s))
     ends = batch.history_indices(history_step_s)
     history = np.empty((batch.members, ends.size, 3, 3))
     _kernels.gyrocompass_loop(batch.gyro_increment, batch.accel_increment, dt, attitude,

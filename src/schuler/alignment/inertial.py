@@ -53,6 +53,40 @@ def navigation_velocity(times, latitude, gravity) -> np.ndarray:
     return integral @ np.array([0.0, 0.0, -gravity])
 
 
+def _start_and_end(batch: StaticBatch):
+    ends = np.array(sorted({max(1, batch.samples // 2), batch.samples}))
+    attitude = np.empty((batch.members, ends.size, 3, 3))
+    velocity = np.empty((batch.members, ends.size, 3))
+    _kernels.inertial_integrate(batch.gyro_increment, batch.accel_increment, ends, attitude, velocity)
+    v_nav = navigation_velocity(ends * batch.sample_interval_s, batch.latitude_rad, batch.gravity)
+    return triad(velocity[:, 0], velocity[:, -1], v_nav[0], v_nav[-1]), attitude[:, -1]
+
+
+def net_rotation(batch: StaticBatch) -> np.ndarray:
+    """The body's rotation relative to the Earth over the window, NED rotation vector (m, 3), rad.
+
+    C_b^n(T) C_b^n(0)^T with C_b^n(T) = exp(-[omega_ie x] T) C_{ib0}^{n0} C_b^{ib0}(T): zero for a body
+    at rest, the net turn of a disturbed one (a vehicle settling, people boarding). Its mean rate
+    over the window is what coarse alignment takes for Earth rate: about east, it moves coarse
+    alignment's heading by -(rotation_E / T) / (Omega cos L).
+    """
+    from scipy.spatial.transform import Rotation
+
+    start, body = _start_and_end(batch)
+    earth_turn = rotation_matrix(-earth_rate_ned(batch.latitude_rad) * batch.duration_s)
+    relative = earth_turn @ start @ body @ np.swapaxes(start, 1, 2)
+    return Rotation.from_matrix(relative).as_rotvec()
+
+
+def start_attitude(batch: StaticBatch) -> np.ndarray:
+    """C_b^n at the start of the batch's window, (m, 3, 3): C_{ib0}^{n0} from TRIAD at T/2 and T (module notes).
+
+    What the Kalman filter and the gyrocompass start from: unlike coarse alignment it
+    keeps its heading when the body is disturbed.
+    """
+    return _start_and_end(batch)[0]
+
+
 def align_inertial(batch: StaticBatch, history_step_s: float = 1.0) -> MethodEstimate:
     """Inertial-frame alignment of every record of ``batch``, with the history over the window.
 

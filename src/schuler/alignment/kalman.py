@@ -27,8 +27,10 @@ biases into the compensation.
 
 Batched across records: the filter's matrices are ``(m, 12, 12)`` arrays and
 every step is one ``matmul`` over the members; the mechanisation is one numba
-call per update for all members. The filter starts from coarse alignment over
-``initial_window`` seconds; its initial covariance holds the start's error from
+call per update for all members. The filter starts from inertial-frame alignment
+over ``initial_window`` seconds (:func:`~schuler.alignment.inertial.start_attitude`:
+coarse alignment over a short disturbed window can be off by tens of degrees, even
+180, which no linear filter recovers from); its initial covariance holds the start's error from
 the biases, correlated with the bias states (:func:`coarse_error_map`), and the
 noise part of its static limit inflated tenfold (the filter reads those samples again).
 
@@ -56,8 +58,8 @@ from schuler.alignment.attitude import (
     rotation_matrix,
     skew_batch,
 )
-from schuler.alignment.coarse import coarse_attitude
 from schuler.alignment.data import MethodEstimate, StaticBatch
+from schuler.alignment.inertial import start_attitude
 from schuler.alignment.limits import accuracy_limit, effective_bias_sigma
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
@@ -107,9 +109,9 @@ class KalmanTuning:
 
 
 def coarse_error_map(latitude: float, gravity: float) -> np.ndarray:
-    """d phi / d(b_g^n, b_a^n) (3, 6): the coarse start's attitude error from constant biases resolved in NED.
+    """d phi / d(b_g^n, b_a^n) (3, 6): the start's attitude error from constant biases resolved in NED.
 
-    Coarse alignment zeroes the sensed level specific force and east rate in the
+    Any alignment at rest (coarse, inertial frame) zeroes the sensed level specific force and east rate in the
     computed frame: g phi_E + b_aN = 0, -g phi_N + b_aE = 0 and
     Omega cos L phi_D + Omega sin L phi_N = b_gE, so phi_N = b_aE / g, phi_E = -b_aN / g,
     phi_D = b_gE / (Omega cos L) - tan(L) b_aE / g (the static limits of :mod:`.limits`).
@@ -131,8 +133,8 @@ def _resolved(sigma_body, heading: np.ndarray) -> np.ndarray:
 
 def _initial_covariance(model, tuning: KalmanTuning, batch: StaticBatch, heading: np.ndarray,
                         initial_window_s: float) -> np.ndarray:
-    """P0 (m, 12, 12): the coarse start's error is M b (correlated with the bias states) plus its noise, inflated."""
-    limit = accuracy_limit("coarse", model, latitude=batch.latitude_rad, heading=float(np.median(heading)),
+    """P0 (m, 12, 12): the start's error is M b (correlated with the bias states) plus its noise, inflated."""
+    limit = accuracy_limit("inertial_frame", model, latitude=batch.latitude_rad, heading=float(np.median(heading)),
                            duration=initial_window_s, gravity=batch.gravity)
     tilt_noise = max(limit.roll_noise_rad, limit.pitch_noise_rad)
     biases = np.zeros((heading.size, 6, 6))
@@ -203,7 +205,7 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
     update_interval_s : float
         Time between filter updates, s (rounded to whole samples).
     initial_window_s : float
-        Coarse alignment over the first seconds gives the start (shortened to the window if longer).
+        Inertial-frame alignment over the first seconds gives the start (shortened to the window if longer).
     history_step_s : float
         Step of the histories, s (rounded to whole updates).
 
@@ -217,12 +219,11 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
     dt = batch.sample_interval_s
     per_update = max(1, int(round(update_interval_s / dt)))
     tuning = KalmanTuning.from_model(model, velocity_noise, gravity=batch.gravity)
-    initial = max(2, min(batch.samples, int(round(initial_window_s / dt))))
-    rate, force = batch.mean_rates(initial)
-    roll0, pitch0, heading0 = coarse_attitude(force, rate, batch.latitude_rad)
-    C = dcm_from_euler(roll0, pitch0, heading0)
+    head = batch.head(initial_window_s)
+    C = start_attitude(head)
+    heading0 = euler_from_dcm(C)[2]
     m = batch.members
-    P = _initial_covariance(model, tuning, batch, heading0, initial * dt)
+    P = _initial_covariance(model, tuning, batch, heading0, head.duration_s)
     omega = earth_rate_ned(batch.latitude_rad)
     gravity = np.array([0.0, 0.0, batch.gravity])
     velocity = np.zeros((m, 3))
