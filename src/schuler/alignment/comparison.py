@@ -177,7 +177,7 @@ def _row(estimate: MethodEstimate, limit, truth, predicted) -> dict[str, Any]:
         row["heading_error_rad"] = float(wrap_angle(estimate.heading_rad[0] - truth[2]))
         row["roll_error_rad"] = float(estimate.roll_rad[0] - truth[0])
         row["pitch_error_rad"] = float(estimate.pitch_rad[0] - truth[1])
-        row["predicted_heading_error_rad"] = float(predicted)
+        row["predicted_heading_error_rad"] = None if predicted is None else float(predicted)
     return row
 
 

@@ -363,7 +363,8 @@ def accuracy_limit(method: str, errors, *, latitude: float, heading: float, dura
         Bias part from :func:`static_errors` for independent axes, noise part from
         :func:`random_walk_factor` (or :func:`gyrocompass_noise`); the coarse and Kalman level
         noise is N_a / (g sqrt(T)); the inertial-frame level noise adds the gyro-propagated tilt
-        N sqrt(2 T / 3) and takes its specific-force direction over T / 2 (sqrt(2) N_a / (g sqrt(T))).
+        N sqrt(2 T / 3) and takes its specific-force direction over T / 2 (sqrt(2) N_a / (g sqrt(T))),
+        and its bias part the gyro drift b_g T / 2 from the middle of the window to its end.
     """
     if method not in METHODS:
         raise InvalidParameter("method", f"{method!r} is not one of {', '.join(METHODS)}")
@@ -389,6 +390,12 @@ def accuracy_limit(method: str, errors, *, latitude: float, heading: float, dura
     heading_noise = k * _sigma_east(heading, n_g) / (rate * math.sqrt(duration))
     accel_share = _sigma_east(heading, n_a) * tan_l / (gravity * math.sqrt(duration))
     if method == "inertial_frame":
+        # its estimate of C_b^n(0) rests on the middle of the window: carried to the end by the gyros, the level and
+        # the heading drift by about b_g T / 2 (tests/test_alignment.py: b_gD T / 2 in heading, 0.3-1.2 b_g T / 2
+        # in the level, mixed by the start's own error)
+        drift = gyro_b * duration / 2.0
+        roll_bias, pitch_bias = math.hypot(roll_bias, drift[0]), math.hypot(pitch_bias, drift[1])
+        heading_bias = math.hypot(heading_bias, drift[2])
         roll_noise = math.hypot(math.sqrt(2.0) * n_a[1] / (gravity * math.sqrt(duration)),
                                 n_g[0] * math.sqrt(2.0 * duration / 3.0))
         pitch_noise = math.hypot(math.sqrt(2.0) * n_a[0] / (gravity * math.sqrt(duration)),
