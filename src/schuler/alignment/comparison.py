@@ -86,7 +86,8 @@ def method_limits(model: ErrorModel, batch: StaticBatch, heading: float, setting
     """Each method's :class:`~schuler.alignment.limits.AccuracyLimit` for this model, site and window."""
     c_gamma, c_a = loop_gains(batch.latitude_rad, settings.time_constant_s, settings.damping)
     return {method: accuracy_limit(method, model, latitude=batch.latitude_rad, heading=heading,
-                                   duration=batch.duration_s, gravity=batch.gravity, c_gamma=c_gamma, c_a=c_a)
+                                   duration=batch.duration_s, gravity=batch.gravity, c_gamma=c_gamma, c_a=c_a,
+                                   velocity_noise=settings.velocity_noise, update_interval=settings.update_interval_s)
             for method in METHODS}
 
 

@@ -297,6 +297,31 @@ def effective_bias_sigma(errors, gravity: float = STANDARD_GRAVITY) -> tuple[np.
     return np.sqrt(gyro_var), np.sqrt(accel_var)
 
 
+def kalman_level_noise(gyro_random_walk: float, accel_random_walk: float, velocity_noise: float,
+                       update_interval: float, gravity: float = STANDARD_GRAVITY) -> float:
+    """Steady 1-sigma of a tilt tracked by zero-velocity updates while the gyro noise walks it, rad.
+
+    Per level axis, dv' = g phi + w_a and phi' = w_g (intensities N_a^2, N^2), sampled every
+    dt = ``update_interval``: Phi = [[1, g dt], [0, 1]],
+    Q_d = [[N_a^2 dt + g^2 N^2 dt^3 / 3, g N^2 dt^2 / 2], [g N^2 dt^2 / 2, N^2 dt]], v observed with
+    variance sigma_v^2. The stationary prior covariance solves the discrete Riccati equation; the
+    value returned is after the update, where the filter reports: the Kalman filter's level noise
+    once it has converged (the level is observed in seconds, unlike the heading).
+    """
+    from scipy.linalg import solve_discrete_are
+
+    dt, n_g, n_a = update_interval, max(gyro_random_walk, 1e-30), max(accel_random_walk, 1e-30)
+    Phi = np.array([[1.0, gravity * dt], [0.0, 1.0]])
+    Q = np.array([[n_a**2 * dt + gravity**2 * n_g**2 * dt**3 / 3.0, gravity * n_g**2 * dt**2 / 2.0],
+                  [gravity * n_g**2 * dt**2 / 2.0, n_g**2 * dt]])
+    H = np.array([[1.0, 0.0]])
+    R = np.array([[velocity_noise**2]])
+    prior = solve_discrete_are(Phi.T, H.T, Q, R)
+    gain = prior @ H.T / (H @ prior @ H.T + R)
+    posterior = prior - gain @ H @ prior
+    return float(math.sqrt(max(posterior[1, 1], 0.0)))
+
+
 @dataclass(frozen=True)
 class AccuracyLimit:
     """1-sigma accuracy of one method for one error model and window (rad).
@@ -338,8 +363,8 @@ def _sigma_north(heading: float, sigma_xyz) -> float:
 
 
 def accuracy_limit(method: str, errors, *, latitude: float, heading: float, duration: float,
-                   gravity: float = STANDARD_GRAVITY, c_gamma: float | None = None,
-                   c_a: float | None = None) -> AccuracyLimit:
+                   gravity: float = STANDARD_GRAVITY, c_gamma: float | None = None, c_a: float | None = None,
+                   velocity_noise: float = 0.01, update_interval: float = 1.0) -> AccuracyLimit:
     """The 1-sigma limit of ``method`` for sensor errors ``errors`` over a window of ``duration`` s.
 
     Parameters
@@ -356,15 +381,19 @@ def accuracy_limit(method: str, errors, *, latitude: float, heading: float, dura
         g, m/s^2.
     c_gamma, c_a : float
         The gyrocompass loop's gains, 1/s (``method="gyrocompass"`` only).
+    velocity_noise, update_interval : float
+        The Kalman filter's zero-velocity noise (m/s) and update interval (s) (``method="kalman"``).
 
     Returns
     -------
     AccuracyLimit
         Bias part from :func:`static_errors` for independent axes, noise part from
-        :func:`random_walk_factor` (or :func:`gyrocompass_noise`); the coarse and Kalman level
-        noise is N_a / (g sqrt(T)); the inertial-frame level noise adds the gyro-propagated tilt
-        N sqrt(2 T / 3) and takes its specific-force direction over T / 2 (sqrt(2) N_a / (g sqrt(T))),
-        and its bias part the gyro drift b_g T / 2 from the middle of the window to its end.
+        :func:`random_walk_factor` (or :func:`gyrocompass_noise`); the coarse level noise is
+        N_a / (g sqrt(T)), the Kalman filter's its tracking noise (:func:`kalman_level_noise`); the inertial-frame level noise adds the gyro-propagated tilt
+        (north N sqrt(2 T / 3), east N sqrt(T / 6)) and takes its specific-force direction over T / 2
+        (sqrt(2) N_a / (g sqrt(T))),
+        and its bias part the gyro drift to the window's end: (3/4) b_gN T in the north tilt, b_gD T / 2 in
+        heading.
     """
     if method not in METHODS:
         raise InvalidParameter("method", f"{method!r} is not one of {', '.join(METHODS)}")
@@ -390,16 +419,26 @@ def accuracy_limit(method: str, errors, *, latitude: float, heading: float, dura
     heading_noise = k * _sigma_east(heading, n_g) / (rate * math.sqrt(duration))
     accel_share = _sigma_east(heading, n_a) * tan_l / (gravity * math.sqrt(duration))
     if method == "inertial_frame":
-        # its estimate of C_b^n(0) rests on the middle of the window: carried to the end by the gyros, the level and
-        # the heading drift by about b_g T / 2 (tests/test_alignment.py: b_gD T / 2 in heading, 0.3-1.2 b_g T / 2
-        # in the level, mixed by the start's own error)
-        drift = gyro_b * duration / 2.0
-        roll_bias, pitch_bias = math.hypot(roll_bias, drift[0]), math.hypot(pitch_bias, drift[1])
-        heading_bias = math.hypot(heading_bias, drift[2])
-        roll_noise = math.hypot(math.sqrt(2.0) * n_a[1] / (gravity * math.sqrt(duration)),
-                                n_g[0] * math.sqrt(2.0 * duration / 3.0))
-        pitch_noise = math.hypot(math.sqrt(2.0) * n_a[0] / (gravity * math.sqrt(duration)),
-                                 n_g[1] * math.sqrt(2.0 * duration / 3.0))
+        # its estimate of C_b^n(0) rests on the specific force over the window, then the gyros carry it to the end:
+        # the north tilt drifts by (3/4) b_gN T (the east one is absorbed with the heading) and the heading by
+        # b_gD T / 2 (tests/test_alignment.py); a level body at heading psi sees the north tilt in roll and pitch
+        north_drift = 0.75 * _sigma_north(heading, gyro_b) * duration
+        roll_bias = math.hypot(roll_bias, math.cos(heading) * north_drift)
+        pitch_bias = math.hypot(pitch_bias, math.sin(heading) * north_drift)
+        heading_bias = math.hypot(heading_bias, gyro_b[2] * duration / 2.0)
+        # tilt noise carried by the gyros to the window's end, impulse responses of the method (u = s / T,
+        # before | after u = 1/2): north k = 2u | 1 (var 2T/3), east k = -u | 3u - 2 (var T/6: the heading
+        # takes up the rest; tests/test_alignment.py)
+        north = _sigma_north(heading, n_g) * math.sqrt(2.0 * duration / 3.0)
+        east = _sigma_east(heading, n_g) * math.sqrt(duration / 6.0)
+        c, s = math.cos(heading), math.sin(heading)
+        level_accel = math.sqrt(2.0) / (gravity * math.sqrt(duration))
+        roll_noise = math.sqrt((c * north) ** 2 + (s * east) ** 2 + (level_accel * n_a[1]) ** 2)
+        pitch_noise = math.sqrt((s * north) ** 2 + (c * east) ** 2 + (level_accel * n_a[0]) ** 2)
+    elif method == "kalman":
+        heading_noise = math.hypot(heading_noise, accel_share)
+        roll_noise = kalman_level_noise(n_g[0], n_a[1], velocity_noise, update_interval, gravity)
+        pitch_noise = kalman_level_noise(n_g[1], n_a[0], velocity_noise, update_interval, gravity)
     else:
         heading_noise = math.hypot(heading_noise, accel_share)
         roll_noise = n_a[1] / (gravity * math.sqrt(duration))
