@@ -32,7 +32,6 @@ from __future__ import annotations
 import math
 
 import numba
-import numpy as np
 
 from schuler.core.earth import (
     NORTH_GRAVITY_PER_HEIGHT,
@@ -231,19 +230,19 @@ def solve_cross(a0, a1, a2, b0, b1, b2):
 
 @jit
 def frame_step(s, c, r_e, inv_sqrt_w, inv_rn_h, inv_re_h, inv_c, h, vn, ve, vd, vn_prev, ve_prev, vd_prev, dt,
-               rate, coriolis, centripetal):
+               ie_n, ie_d, rate, coriolis, centripetal):
     """The navigation frame's rotation zeta over a step and the non-specific-force acceleration.
 
     Returns (zeta_N, zeta_E, zeta_D) in rad and (a_N, a_E, a_D) in m/s^2 with
-    a = g - (coriolis 2 omega_ie + omega_en) x v_m + centripetal omega_ie x (omega_ie x r):
-    ``coriolis`` = 1 and ``centripetal`` = 0 for a correct computer; 0 and 1 leave
-    the Coriolis and centripetal terms uncompensated (source 000's W*).
+    a = g - (coriolis 2 omega_ie + omega_en) x v_m + centripetal omega_ie x (omega_ie x r),
+    omega_ie = (ie_n, 0, ie_d) (rad/s; Omega (cos L, 0, -sin L) at the computed
+    or an entered latitude): ``coriolis`` = 1 and ``centripetal`` = 0 for a
+    correct computer; 0 and 1 leave the Coriolis and centripetal terms
+    uncompensated (source 000's W*).
     """
     vn_m = 1.5 * vn - 0.5 * vn_prev
     ve_m = 1.5 * ve - 0.5 * ve_prev
     vd_m = 1.5 * vd - 0.5 * vd_prev
-    ie_n = rate * c
-    ie_d = -rate * s
     en_n = ve_m * inv_re_h
     en_e = -vn_m * inv_rn_h
     en_d = -en_n * s * inv_c
@@ -314,7 +313,7 @@ def inverse_steps(dt, quaternions, velocities, state, increments, positions, nav
         vn, ve, vd = velocities[k, 0], velocities[k, 1], velocities[k, 2]
         vn1, ve1, vd1 = velocities[k + 1, 0], velocities[k + 1, 1], velocities[k + 1, 2]
         zn, ze, zd, an, ae, ad = frame_step(s, c, r_e, inv_sqrt_w, inv_rn_h, inv_re_h, inv_c, h, vn, ve, vd,
-                                            vn_prev, ve_prev, vd_prev, dt, rate, 1.0, 0.0)
+                                            vn_prev, ve_prev, vd_prev, dt, rate * c, -rate * s, rate, 1.0, 0.0)
         # specific-force increment in NED, then back through (I - [zeta x]/2) and C_{k-1}
         fn = vn1 - vn - an * dt
         fe = ve1 - ve - ae * dt

@@ -13,6 +13,8 @@ loop turns the platform until the gyro reads the command.
 
 from __future__ import annotations
 
+import math
+
 import numba
 
 from schuler.navigate._kernels import (
@@ -31,7 +33,6 @@ from schuler.navigate._kernels import (
     VEL_PREV,
     apply_sensor,
     attitude_step,
-    sensor_row,
     frame_step,
     geometry,
     normalize,
@@ -39,6 +40,7 @@ from schuler.navigate._kernels import (
     quat_from_rotation_vector,
     quat_multiply,
     rotate,
+    sensor_row,
     store_output,
 )
 
@@ -62,7 +64,8 @@ def _vertical(mode, h, vd, vd1, dt, h_true, vd_true, baro_error, k1, k2, k3, b_h
 
 @numba.njit(cache=True, parallel=True)
 def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, accel, gyro_noise, accel_noise,
-                    has_noise, out, out_every, vertical_mode, baro, rate, coriolis, centripetal):
+                    has_noise, out, out_every, vertical_mode, baro, rate, coriolis, centripetal, entered_earth_rate,
+                    use_entered):
     """Advance every member through ``increments.shape[0]`` strapdown steps.
 
     Parameters
@@ -93,6 +96,10 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
         Earth rate, rad/s.
     coriolis, centripetal : float
         1 and 0 for a correct computer (see :func:`frame_step`).
+    entered_earth_rate : (n, 2)
+        Omega cos L, -Omega sin L (rad/s) at the true latitude at the start of each
+        interval, used instead of the computed latitude's when ``use_entered``
+        (an Earth-rate compensation from an entered latitude, as source 000's (8)).
     """
     n_members = state.shape[0]
     n = increments.shape[0]
@@ -127,8 +134,12 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
             x = e0 + 0.5 * (d1 * e2 - d2 * e1) + ((t1 * e2 - t2 * e1) + (u1 * d2 - u2 * d1)) / 12.0
             y = e1 + 0.5 * (d2 * e0 - d0 * e2) + ((t2 * e0 - t0 * e2) + (u2 * d0 - u0 * d2)) / 12.0
             z = e2 + 0.5 * (d0 * e1 - d1 * e0) + ((t0 * e1 - t1 * e0) + (u0 * d1 - u1 * d0)) / 12.0
+            if use_entered:
+                ie_n, ie_d = entered_earth_rate[k, 0], entered_earth_rate[k, 1]
+            else:
+                ie_n, ie_d = rate * c, -rate * s
             zn, ze, zd, an, ae, ad = frame_step(s, c, r_e, inv_sqrt_w, inv_rn_h, inv_re_h, inv_c, h, vn, ve, vd,
-                                                vnp, vep, vdp, dt, rate, coriolis, centripetal)
+                                                vnp, vep, vdp, dt, ie_n, ie_d, rate, coriolis, centripetal)
             wn, we, wd = rotate(q0, q1, q2, q3, x, y, z)
             vn1 = vn + wn - 0.5 * (ze * wd - zd * we) + an * dt
             ve1 = ve + we - 0.5 * (zd * wn - zn * wd) + ae * dt
@@ -156,7 +167,8 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
 
 @numba.njit(cache=True, parallel=True)
 def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro, accel, gyro_noise, accel_noise,
-                   has_noise, out, out_every, vertical_mode, baro, rate, coriolis, centripetal):
+                   has_noise, out, out_every, vertical_mode, baro, rate, coriolis, centripetal, entered_earth_rate,
+                   use_entered, slave_azimuth):
     """Advance every member through one chunk of the platform (gimballed, local-level) mechanization.
 
     The platform carries the sensors and is torqued at the computed frame rate
@@ -167,7 +179,10 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
     specific-force increment in platform axes, (I + S + M) R(q_pn)^T f dt + b dt,
     which the computer takes as NED. Parameters as :func:`strapdown_chunk`, with
     ``nav_increments`` (n, 6): the truth's zeta (rad) and NED specific-force
-    increment (m/s), and ``gyro`` rows holding (I + S + M)^-1.
+    increment (m/s), and ``gyro`` rows holding (I + S + M)^-1. With ``slave_azimuth``
+    the platform's turn about its vertical is removed after every step (the
+    twist of q_pn about z): an external azimuth reference, leaving the gyros
+    only the level axes (source 000's two-axis gyro vertical).
     """
     n_members = state.shape[0]
     n = nav_increments.shape[0]
@@ -184,8 +199,12 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
         g_row = sensor_row(gyro[m])
         a_row = sensor_row(accel[m])
         for k in range(n):
+            if use_entered:
+                ie_n, ie_d = entered_earth_rate[k, 0], entered_earth_rate[k, 1]
+            else:
+                ie_n, ie_d = rate * c, -rate * s
             zn, ze, zd, an, ae, ad = frame_step(s, c, r_e, inv_sqrt_w, inv_rn_h, inv_re_h, inv_c, h, vn, ve, vd,
-                                                vnp, vep, vdp, dt, rate, coriolis, centripetal)
+                                                vnp, vep, vdp, dt, ie_n, ie_d, rate, coriolis, centripetal)
             c0, c1, c2 = zn - g_row[9] * dt, ze - g_row[10] * dt, zd - g_row[11] * dt
             if has_noise:
                 c0 -= gyro_noise[m, k, 0]
@@ -211,6 +230,9 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
             b0, b1, b2, b3 = quat_from_rotation_vector(r0, r1, r2)
             q0, q1, q2, q3 = quat_multiply(a0, a1, a2, a3, q0, q1, q2, q3)
             q0, q1, q2, q3 = normalize(*quat_multiply(q0, q1, q2, q3, b0, b1, b2, b3))
+            if slave_azimuth:  # q <- q twist*, twist = (q0, 0, 0, q3) / |.|
+                scale = 1.0 / math.sqrt(q0 * q0 + q3 * q3)
+                q0, q1, q2, q3 = quat_multiply(q0, q1, q2, q3, q0 * scale, 0.0, 0.0, -q3 * scale)
             vnp, vep, vdp = vn, ve, vd
             vn, ve, vd = vn1, ve1, vd1
             sample = first_sample + k + 1

@@ -36,8 +36,8 @@ Examples
 >>> from schuler.navigate.trajectory import Stationary
 >>> result = navigate(Stationary(latitude=np.radians(45.0)), duration=600.0, imu_rate=10.0, output_step=60.0,
 ...                   initial_errors=InitialErrors(velocity_error_north=0.1))
->>> round(float(result.position_error_north_m[-1]), 2)
-58.78
+>>> round(float(result.position_error_north_m[-1]), 2)   # (dV / w_s) sin(w_s t) = 54.6 m
+54.57
 """
 
 from __future__ import annotations
@@ -84,7 +84,7 @@ def output_interval(output_step: float, imu_rate: float) -> int:
     if round(count) < 1 or abs(count - round(count)) > 1e-6 * count:
         raise InvalidParameter("output_step", f"{output_step:g} s is not a whole number of IMU intervals "
                                               f"at {imu_rate:g} Hz")
-    return int(round(count))
+    return round(count)
 
 
 def _check_choice(name: str, value: str, choices: tuple[str, ...]) -> int:
@@ -112,7 +112,7 @@ def estimate_memory(members: int, n_outputs: int, chunk: int, with_noise: bool) 
     """Bytes a run holds at once: outputs and errors per member, one block of truth and noise.
 
     >>> estimate_memory(1000, 1081, 65536, False) // 2**20
-    213
+    210
     """
     outputs = members * n_outputs * (_kernels.OUTPUT_SIZE + 13) * 8
     truth = n_outputs * 40 * 8 + chunk * 40 * 8
@@ -154,6 +154,12 @@ def _baro_parameters(generator: TruthGenerator, time_constant: float, baro_error
     return np.array([gains.k1, gains.k2, gains.k3, baro_error])
 
 
+def _entered_earth_rate(part, previous_latitude: float, rate: float) -> np.ndarray:
+    """Omega (cos L, -sin L) at the true latitude at the start of each interval of a chunk, (n, 2)."""
+    latitude = np.concatenate([[previous_latitude], part.positions[:-1, 0]])
+    return np.ascontiguousarray(np.stack([rate * np.cos(latitude), -rate * np.sin(latitude)], axis=1))
+
+
 class _IntervalMeans:
     """Sums of the truth over each output interval, for the linear model's frozen coefficients."""
 
@@ -181,8 +187,10 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
              mode: str = "strapdown", vertical_channel: str = "off", initial_errors: InitialErrors | None = None,
              sensor_errors: SensorErrors | None = None, noise: SensorNoise | None = None, member_ids=None,
              earth_rate: float = EARTH_RATE, coriolis_compensation: bool = True,
-             centripetal_compensation: bool = True, baro_error: float = 0.0, baro_time_constant: float = 100.0,
-             max_memory: int = DEFAULT_MAX_MEMORY, record_interval_means: bool = False) -> NavigationResult:
+             centripetal_compensation: bool = True, earth_rate_latitude: str = "computed",
+             azimuth_reference: bool = False, baro_error: float = 0.0,
+             baro_time_constant: float = 100.0, max_memory: int = DEFAULT_MAX_MEMORY,
+             record_interval_means: bool = False) -> NavigationResult:
     """Simulate the nonlinear INS along a trajectory and return its errors at the output step.
 
     Parameters
@@ -212,6 +220,13 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
         Whether the computer subtracts the Coriolis acceleration 2 omega_ie x v and
         uses gravity (with the centrifugal part) rather than gravitation. Turning
         both off gives source 000's uncompensated W*.
+    earth_rate_latitude : {"computed", "true"}
+        The latitude of the computer's Earth rate: its own (an INS) or the true
+        one, entered from outside (source 000's compensation torques (8)).
+    azimuth_reference : bool
+        Platform only: slave the platform's azimuth to the true heading (an
+        external azimuth reference), so that only its level axes answer to the
+        gyros, as source 000's two-axis gyro vertical.
     baro_error : float
         Constant barometric height error, m (``vertical_channel="baro"``).
     baro_time_constant : float
@@ -231,6 +246,9 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
         For a bad argument or a run that would not fit in ``max_memory``.
     """
     _check_choice("mode", mode, MODES)
+    entered = _check_choice("earth_rate_latitude", earth_rate_latitude, ("computed", "true")) == 1
+    if azimuth_reference and mode != "platform":
+        raise InvalidParameter("azimuth_reference", "slaving the azimuth needs the platform mechanization")
     vertical_code = _VERTICAL_CODES[VERTICAL_CHANNELS[_check_choice("vertical_channel", vertical_channel,
                                                                     VERTICAL_CHANNELS)]]
     initial_errors = initial_errors or InitialErrors()
@@ -265,6 +283,8 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
     truth[0] = np.concatenate([generator.initial_position, generator.initial_velocity, generator.initial_quaternion])
     means = _IntervalMeans(n_out - 1, every, generator.dt) if record_interval_means else None
     empty_noise = np.zeros((n_members, 0, 3))
+    no_rate = np.zeros((0, 2))
+    previous_latitude = generator.initial_position[0]
     kernel = _loops.platform_chunk if platform else _loops.strapdown_chunk
     flags = (float(coriolis_compensation), 0.0 if centripetal_compensation else 1.0)
     for part in generator.chunks(chunk):
@@ -276,8 +296,11 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
             gyro_noise = accel_noise = empty_noise
         vertical = np.ascontiguousarray(np.stack([part.positions[:, 2], part.velocities[:, 2]], axis=1))
         sensed = part.nav_increments if platform else part.increments
+        entered_rate = _entered_earth_rate(part, previous_latitude, generator.earth_rate) if entered else no_rate
+        previous_latitude = part.positions[-1, 0]
         kernel(generator.dt, part.start, sensed, vertical, states, gyro, accel, gyro_noise, accel_noise,
-               noise is not None, out, every, vertical_code, baro, generator.earth_rate, *flags)
+               noise is not None, out, every, vertical_code, baro, generator.earth_rate, *flags, entered_rate, entered,
+               *((azimuth_reference,) if platform else ()))
         ends = part.start + np.arange(1, n + 1)
         rows = np.flatnonzero(ends % every == 0)
         truth[ends[rows] // every] = np.concatenate([part.positions[rows], part.velocities[rows],

@@ -25,6 +25,7 @@ Examples
 --------
 >>> path = GreatCircle(latitude=np.radians(45.0), longitude=0.0, height=0.0, heading=np.radians(30.0),
 ...                    speed=250.0, duration=3600.0)
+>>> from schuler.navigate.attitude import euler_from_quaternion
 >>> v, q = path.kinematics(np.array([0.0, 3600.0]))
 >>> heading = euler_from_quaternion(q)[:, 2]
 >>> bool(np.allclose(np.linalg.norm(v, axis=1), 250.0)), bool(heading[1] > heading[0])
@@ -40,7 +41,7 @@ from scipy.integrate import solve_ivp
 
 from schuler.core.earth import STANDARD_GRAVITY, radii_of_curvature
 from schuler.exceptions import InvalidParameter, SimulationError
-from schuler.navigate.attitude import euler_from_quaternion, quaternion_from_euler
+from schuler.navigate.attitude import quaternion_from_euler
 
 MAX_LATITUDE = np.radians(89.0)
 """Trajectories must stay within 89 deg of the equator: NED and the transport rate are singular at the poles."""

@@ -22,8 +22,9 @@ True
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import ClassVar, Iterator
+from typing import ClassVar
 
 import numpy as np
 
@@ -50,7 +51,7 @@ def sample_count(duration: float, imu_rate: float) -> int:
     if abs(count - round(count)) > 1e-6 * max(1.0, count) or round(count) < 1:
         raise InvalidParameter("duration", f"{duration:g} s is not a whole number of IMU intervals at "
                                            f"{imu_rate:g} Hz")
-    return int(round(count))
+    return round(count)
 
 
 @dataclass
