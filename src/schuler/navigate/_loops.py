@@ -176,8 +176,8 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
     rho = (I + S + M)^-1 (zeta_c - b dt - noise) in platform axes, while the true
     NED frame turns by zeta (the truth's). Its orientation q_pn (platform axes ->
     true NED) follows q <- q(-zeta) q q(rho). The accelerometers measure the true
-    specific-force increment in platform axes, (I + S + M) R(q_pn)^T f dt + b dt,
-    which the computer takes as NED. Parameters as :func:`strapdown_chunk`, with
+    specific-force increment in platform axes, (I + S + M) R(q_pn)^T f dt + b dt
+    (q_pn at the step's middle), which the computer takes as NED. Parameters as :func:`strapdown_chunk`, with
     ``nav_increments`` (n, 6): the truth's zeta (rad) and NED specific-force
     increment (m/s), and ``gyro`` rows holding (I + S + M)^-1. With ``slave_azimuth``
     the platform's turn about its vertical is removed after every step (the
@@ -211,8 +211,19 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
                 c1 -= gyro_noise[m, k, 1]
                 c2 -= gyro_noise[m, k, 2]
             r0, r1, r2 = apply_sensor(g_row, c0, c1, c2, 0.0)
-            # true specific force in platform axes, then the accelerometer errors
-            x, y, z = rotate(q0, -q1, -q2, -q3, nav_increments[k, 3], nav_increments[k, 4], nav_increments[k, 5])
+            a0, a1, a2, a3 = quat_from_rotation_vector(-nav_increments[k, 0], -nav_increments[k, 1],
+                                                       -nav_increments[k, 2])
+            b0, b1, b2, b3 = quat_from_rotation_vector(r0, r1, r2)
+            n0, n1, n2, n3 = quat_multiply(a0, a1, a2, a3, q0, q1, q2, q3)
+            n0, n1, n2, n3 = normalize(*quat_multiply(n0, n1, n2, n3, b0, b1, b2, b3))
+            if slave_azimuth:  # q <- q twist*, twist = (q0, 0, 0, q3) / |.|
+                scale = 1.0 / math.sqrt(n0 * n0 + n3 * n3)
+                n0, n1, n2, n3 = quat_multiply(n0, n1, n2, n3, n0 * scale, 0.0, 0.0, -n3 * scale)
+            # true specific force in platform axes at the step's middle, then the accelerometer errors
+            m0, m1, m2, m3 = q0 + n0, q1 + n1, q2 + n2, q3 + n3
+            scale = 1.0 / math.sqrt(m0 * m0 + m1 * m1 + m2 * m2 + m3 * m3)
+            x, y, z = rotate(m0 * scale, -m1 * scale, -m2 * scale, -m3 * scale, nav_increments[k, 3],
+                             nav_increments[k, 4], nav_increments[k, 5])
             e0, e1, e2 = apply_sensor(a_row, x, y, z, dt)
             if has_noise:
                 e0 += accel_noise[m, k, 0]
@@ -225,14 +236,7 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
                                                    truth_vertical[k, 1], baro_error, k1, k2, k3, b_hat)
             lat, lon, h, s, c, r_n, r_e, inv_sqrt_w, inv_rn_h, inv_re_h, inv_c = position_step(
                 lat, lon, h, s, c, r_n, inv_re_h, inv_c, vn, ve, vd, vn1, ve1, vd1, dt, h_set, use_set)
-            a0, a1, a2, a3 = quat_from_rotation_vector(-nav_increments[k, 0], -nav_increments[k, 1],
-                                                       -nav_increments[k, 2])
-            b0, b1, b2, b3 = quat_from_rotation_vector(r0, r1, r2)
-            q0, q1, q2, q3 = quat_multiply(a0, a1, a2, a3, q0, q1, q2, q3)
-            q0, q1, q2, q3 = normalize(*quat_multiply(q0, q1, q2, q3, b0, b1, b2, b3))
-            if slave_azimuth:  # q <- q twist*, twist = (q0, 0, 0, q3) / |.|
-                scale = 1.0 / math.sqrt(q0 * q0 + q3 * q3)
-                q0, q1, q2, q3 = quat_multiply(q0, q1, q2, q3, q0 * scale, 0.0, 0.0, -q3 * scale)
+            q0, q1, q2, q3 = n0, n1, n2, n3
             vnp, vep, vdp = vn, ve, vd
             vn, ve, vd = vn1, ve1, vd1
             sample = first_sample + k + 1
