@@ -7,7 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from schuler.core.earth import gravity_height_coefficient, meridian_radius, somigliana_gravity
+from schuler.core.earth import (
+    gravity_height_coefficient,
+    meridian_radius,
+    somigliana_gravity,
+)
 from schuler.exceptions import InvalidParameter
 from schuler.navigate.errors import InitialErrors, SensorErrors, WhiteNoise
 from schuler.navigate.mechanization import navigate

@@ -13,7 +13,12 @@ from schuler.exceptions import InvalidParameter
 from schuler.navigate.attitude import euler_from_quaternion, rotation_matrix
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.profile import load_profile, parse_profile
-from schuler.navigate.trajectory import GreatCircle, Stationary, WaypointProfile, smoothstep
+from schuler.navigate.trajectory import (
+    GreatCircle,
+    Stationary,
+    WaypointProfile,
+    smoothstep,
+)
 from schuler.navigate.truth import TruthGenerator, ideal_imu
 
 PROFILE = Path(__file__).resolve().parents[1] / "examples" / "profiles" / "manoeuvring_flight.toml"
