@@ -216,8 +216,8 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
             b0, b1, b2, b3 = quat_from_rotation_vector(r0, r1, r2)
             n0, n1, n2, n3 = quat_multiply(a0, a1, a2, a3, q0, q1, q2, q3)
             n0, n1, n2, n3 = normalize(*quat_multiply(n0, n1, n2, n3, b0, b1, b2, b3))
-            if slave_azimuth:  # q <- q twist*, twist = (q0, 0, 0, q3) / |.|
-                scale = 1.0 / math.sqrt(n0 * n0 + n3 * n3)
+            if slave_azimuth:  # q <- q twist*, twist = (q0, 0, 0, q3) / |.| taken with q0 >= 0 (keeps q's sign)
+                scale = math.copysign(1.0 / math.sqrt(n0 * n0 + n3 * n3), n0)
                 n0, n1, n2, n3 = quat_multiply(n0, n1, n2, n3, n0 * scale, 0.0, 0.0, -n3 * scale)
             # true specific force in platform axes at the step's middle, then the accelerometer errors
             m0, m1, m2, m3 = q0 + n0, q1 + n1, q2 + n2, q3 + n3

@@ -139,7 +139,8 @@ def _initial_states(generator: TruthGenerator, errors: InitialErrors, members: i
     if mode == "platform":
         # C_p^n = C_b^n C_b^p^T with the gimbals reading C_b^p = the computed attitude
         computed = quaternion_multiply(generator.initial_quaternion, conjugate(computed))
-    states[:, _kernels.QUAT:_kernels.QUAT + 4] = computed
+    # one sign for all (q and -q are the same rotation): the platform's q_pn starts near +1
+    states[:, _kernels.QUAT:_kernels.QUAT + 4] = np.where(computed[..., :1] < 0.0, -computed, computed)
     return states
 
 
