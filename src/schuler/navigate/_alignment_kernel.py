@@ -17,10 +17,10 @@ import math
 
 import numba
 
-from schuler.navigate._kernels import quat_multiply, rotate
+from schuler.navigate._kernels import FAST_MATH, quat_multiply, rotate
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FAST_MATH)
 def _relative_rate(q0, q1, q2, q3, p):
     """omega_gp in platform axes; p holds the member's constants (see :func:`align`)."""
     # level-frame vectors in platform axes: C_g^p = R(q)^T
@@ -34,14 +34,14 @@ def _relative_rate(q0, q1, q2, q3, p):
             p[6] - p[9] + p[15] * a_eta - uz)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FAST_MATH)
 def _derivative(q0, q1, q2, q3, p):
     wx, wy, wz = _relative_rate(q0, q1, q2, q3, p)
     d0, d1, d2, d3 = quat_multiply(q0, q1, q2, q3, 0.0, wx, wy, wz)
     return 0.5 * d0, 0.5 * d1, 0.5 * d2, 0.5 * d3
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, fastmath=FAST_MATH)
 def align(quaternions, parameters, step, n_steps, out_every, out):
     """Integrate every member's platform quaternion and record it every ``out_every`` steps.
 

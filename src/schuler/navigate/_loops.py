@@ -19,6 +19,7 @@ import numba
 
 from schuler.navigate._kernels import (
     BARO,
+    FAST_MATH,
     BARO_BIAS,
     COS_LAT,
     DTHETA_PREV,
@@ -45,7 +46,7 @@ from schuler.navigate._kernels import (
 )
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, fastmath=FAST_MATH)
 def _vertical(mode, h, vd, vd1, dt, h_true, vd_true, baro_error, k1, k2, k3, b_hat):
     """Vertical channel after the velocity update: returns (v_D, height override, use it, b_hat).
 
@@ -62,7 +63,7 @@ def _vertical(mode, h, vd, vd1, dt, h_true, vd_true, baro_error, k1, k2, k3, b_h
     return vd1, 0.0, False, b_hat
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, fastmath=FAST_MATH)
 def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, accel, gyro_noise, accel_noise,
                     has_noise, out, out_every, vertical_mode, baro, rate, coriolis, centripetal, entered_earth_rate,
                     use_entered):
@@ -117,6 +118,9 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
         r_n, r_e, inv_sqrt_w, inv_rn_h, inv_re_h, inv_c = geometry(s, c, h)
         g_row = sensor_row(gyro[m])
         a_row = sensor_row(accel[m])
+        # samples to the next output and its row (no integer division in the loop)
+        countdown = out_every - first_sample % out_every
+        row = first_sample // out_every
         for k in range(n):
             d0, d1, d2 = apply_sensor(g_row, increments[k, 0], increments[k, 1], increments[k, 2], dt)
             e0, e1, e2 = apply_sensor(a_row, increments[k, 3], increments[k, 4], increments[k, 5], dt)
@@ -153,9 +157,11 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
             vn, ve, vd = vn1, ve1, vd1
             t0, t1, t2 = d0, d1, d2
             u0, u1, u2 = e0, e1, e2
-            sample = first_sample + k + 1
-            if sample % out_every == 0:
-                store_output(out[m], sample // out_every, lat, lon, h, vn, ve, vd, q0, q1, q2, q3)
+            countdown -= 1
+            if countdown == 0:  # the sample first_sample + k + 1 is an output time
+                countdown = out_every
+                row += 1
+                store_output(out[m], row, lat, lon, h, vn, ve, vd, q0, q1, q2, q3)
         st[LAT], st[LON], st[HGT], st[SIN_LAT], st[COS_LAT] = lat, lon, h, s, c
         st[VEL], st[VEL + 1], st[VEL + 2] = vn, ve, vd
         st[VEL_PREV], st[VEL_PREV + 1], st[VEL_PREV + 2] = vnp, vep, vdp
@@ -165,7 +171,7 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
         st[BARO_BIAS] = b_hat
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, fastmath=FAST_MATH)
 def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro, accel, gyro_noise, accel_noise,
                    has_noise, out, out_every, vertical_mode, baro, rate, coriolis, centripetal, entered_earth_rate,
                    use_entered, slave_azimuth):
@@ -198,6 +204,9 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
         r_n, r_e, inv_sqrt_w, inv_rn_h, inv_re_h, inv_c = geometry(s, c, h)
         g_row = sensor_row(gyro[m])
         a_row = sensor_row(accel[m])
+        # samples to the next output and its row (no integer division in the loop)
+        countdown = out_every - first_sample % out_every
+        row = first_sample // out_every
         for k in range(n):
             if use_entered:
                 ie_n, ie_d = entered_earth_rate[k, 0], entered_earth_rate[k, 1]
@@ -239,9 +248,11 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
             q0, q1, q2, q3 = n0, n1, n2, n3
             vnp, vep, vdp = vn, ve, vd
             vn, ve, vd = vn1, ve1, vd1
-            sample = first_sample + k + 1
-            if sample % out_every == 0:
-                store_output(out[m], sample // out_every, lat, lon, h, vn, ve, vd, q0, q1, q2, q3)
+            countdown -= 1
+            if countdown == 0:  # the sample first_sample + k + 1 is an output time
+                countdown = out_every
+                row += 1
+                store_output(out[m], row, lat, lon, h, vn, ve, vd, q0, q1, q2, q3)
         st[LAT], st[LON], st[HGT], st[SIN_LAT], st[COS_LAT] = lat, lon, h, s, c
         st[VEL], st[VEL + 1], st[VEL + 2] = vn, ve, vd
         st[VEL_PREV], st[VEL_PREV + 1], st[VEL_PREV + 2] = vnp, vep, vdp

@@ -284,9 +284,9 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
     truth[0] = np.concatenate([generator.initial_position, generator.initial_velocity, generator.initial_quaternion])
     means = _IntervalMeans(n_out - 1, every, generator.dt) if record_interval_means else None
     empty_noise = np.zeros((n_members, 0, 3))
+    kernel = _loops.platform_chunk if platform else _loops.strapdown_chunk
     no_rate = np.zeros((0, 2))
     previous_latitude = generator.initial_position[0]
-    kernel = _loops.platform_chunk if platform else _loops.strapdown_chunk
     flags = (float(coriolis_compensation), 0.0 if centripetal_compensation else 1.0)
     for part in generator.chunks(chunk):
         n = part.increments.shape[0]
