@@ -19,11 +19,11 @@ import numba
 
 from schuler.navigate._kernels import (
     BARO,
-    FAST_MATH,
     BARO_BIAS,
     COS_LAT,
     DTHETA_PREV,
     DV_PREV,
+    FAST_MATH,
     HELD,
     HGT,
     LAT,
