@@ -30,6 +30,7 @@ import math
 import resource
 import sys
 import time
+import tracemalloc
 
 import numpy as np
 
@@ -68,6 +69,15 @@ def timed(function):
     wall, cpu = time.perf_counter(), time.process_time()
     result = function()
     return result, time.perf_counter() - wall, time.process_time() - cpu
+
+
+def peak_memory(function) -> float:
+    """Peak of numpy/Python allocations during one call, MiB (tracemalloc)."""
+    tracemalloc.start()
+    function()
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return peak / 2**20
 
 
 def run_schuler(hours: float, errors: bool = True):
@@ -153,7 +163,8 @@ def main() -> int:
     result, wall, cpu = timed(lambda: run_schuler(HOURS))
     floor = run_schuler(HOURS, errors=False)
     print(f"schuler: {HOURS:g} h at {IMU_RATE:g} Hz ({samples:,} samples) end to end in {wall:.2f} s wall, "
-          f"{cpu:.2f} s CPU: {samples / wall / 1e6:.2f} M samples/s wall, {samples / cpu / 1e6:.2f} M/s CPU")
+          f"{cpu:.2f} s CPU: {samples / wall / 1e6:.2f} M samples/s wall, {samples / cpu / 1e6:.2f} M/s CPU; "
+          f"peak allocation {peak_memory(lambda: run_schuler(HOURS)):.0f} MiB")
     ok = True
     try:
         import pyins  # noqa: F401 - presence check
@@ -186,7 +197,8 @@ def main() -> int:
     print(f"batch: {MEMBERS} members x {MONTE_CARLO_HOURS:g} h at {IMU_RATE:g} Hz with per-member constant errors in "
           f"{b_wall:.2f} s wall, {b_cpu:.2f} s CPU: {batch_samples / b_wall / 1e6:.1f} M member-samples/s wall, "
           f"{batch_samples / b_cpu / 1e6:.1f} M/s per CPU (target >= {TARGET_BATCH / 1e6:g} M/s); "
-          f"planned memory {estimate:.1f} MiB")
+          f"planned memory {estimate:.1f} MiB, peak allocation "
+          f"{peak_memory(lambda: run_batch(MEMBERS, MONTE_CARLO_HOURS)):.0f} MiB")
     noise = WhiteNoise(angle_random_walk=2.9e-6, velocity_random_walk=1e-4, seed=7)
     noisy_members = MEMBERS // 4
     noisy_samples = noisy_members * round(MONTE_CARLO_HOURS * 3600 * IMU_RATE)
@@ -194,7 +206,7 @@ def main() -> int:
     print(f"batch with white noise (RandomStreams.normal_series): {noisy_members} members in {n_wall:.2f} s wall: "
           f"{noisy_samples / n_wall / 1e6:.2f} M member-samples/s wall, {noisy_samples / n_cpu / 1e6:.2f} M/s per CPU")
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    print(f"peak resident memory of the whole benchmark: {peak:.0f} MiB")
+    print(f"peak resident memory of the whole benchmark (pyins's frames included): {peak:.0f} MiB")
     ok = ok and batch_samples / b_wall >= TARGET_BATCH
     print("PASS" if ok else "FAIL")
     return 0 if ok else 1

@@ -189,3 +189,22 @@ def test_memory_is_estimated_before_allocating():
     with pytest.raises(InvalidParameter, match="MiB"):
         navigate(AT_REST, 48 * 3600.0, imu_rate=1.0, output_step=1.0,
                  initial_errors=InitialErrors(roll_error=np.zeros(100_000)))
+
+
+def test_result_json_names_units_and_rendering():
+    import json
+
+    held = navigate(AT_REST, 600.0, imu_rate=10.0, output_step=60.0, initial_errors=InitialErrors(roll_error=1e-4))
+    data = json.loads(json.dumps(held.to_dict()))
+    for name in ("t_s", "position_error_north_m", "position_error_east_m", "velocity_error_north_m_s",
+                 "velocity_error_east_m_s", "roll_error_rad", "pitch_error_rad", "heading_error_rad"):
+        assert len(data[name]) == 11, name
+    assert "height_error_m" not in data and "velocity_error_down_m_s" not in data  # the channel is held
+    assert data["units"]["imu_rate_hz"] == "Hz" and data["members"] is None
+    text = str(held)
+    assert "roll_error (arcsec)" in text and "20.63" in text  # 1e-4 rad = 20.63 arcsec at t = 0 ... max
+    free = navigate(AT_REST, 600.0, imu_rate=10.0, output_step=60.0, vertical_channel="free",
+                    initial_errors=InitialErrors(height_error=[1.0, 2.0]))
+    data = free.to_dict()
+    assert np.shape(data["height_error_m"]) == (2, 11) and data["members"] == 2
+    assert "std final" in str(free)

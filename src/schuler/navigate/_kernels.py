@@ -7,9 +7,9 @@ numpy; the tests hold the two together) and :mod:`schuler.navigate.attitude`.
 Quaternions are Hamilton's, scalar first, q = (q0, q1, q2, q3); q_bn maps body
 vectors into the navigation frame, v_n = q v_b q*, so that C_b^n = R(q_bn).
 
-One navigation step from t_{k-1} to t_k (Groves 2013, Sec. 5.4 and 5.5;
-Savage 2000, Vol. 1, ch. 7 and 8) with the increments dtheta_k (rad) and
-dv_k (m/s) of the interval:
+One navigation step from t_{k-1} to t_k (Groves 2013, Sec. 5.4 and 5.5; the
+two-sample coning and sculling corrections of Savage 1998, JGCD 21(1), (2), as
+in spec 06) with the increments dtheta_k (rad) and dv_k (m/s) of the interval:
 
 * rotation vector with the coning correction, phi = dtheta_k + dtheta_{k-1} x dtheta_k / 12;
 * specific-force increment with the rotation and sculling corrections,

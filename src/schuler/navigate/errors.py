@@ -41,6 +41,7 @@ from dataclasses import dataclass, fields
 from typing import ClassVar, Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from schuler.core.earth import radii_of_curvature
 from schuler.core.random import RandomStreams
@@ -81,15 +82,15 @@ class InitialErrors:
         rad, differences of the Euler angles.
     """
 
-    position_error_north: object = 0.0
-    position_error_east: object = 0.0
-    height_error: object = 0.0
-    velocity_error_north: object = 0.0
-    velocity_error_east: object = 0.0
-    velocity_error_down: object = 0.0
-    roll_error: object = 0.0
-    pitch_error: object = 0.0
-    heading_error: object = 0.0
+    position_error_north: ArrayLike = 0.0
+    position_error_east: ArrayLike = 0.0
+    height_error: ArrayLike = 0.0
+    velocity_error_north: ArrayLike = 0.0
+    velocity_error_east: ArrayLike = 0.0
+    velocity_error_down: ArrayLike = 0.0
+    roll_error: ArrayLike = 0.0
+    pitch_error: ArrayLike = 0.0
+    heading_error: ArrayLike = 0.0
 
     def __post_init__(self):
         for f in fields(self):
@@ -147,12 +148,12 @@ class SensorErrors:
         Off-diagonal misalignment M, rad (the diagonal must be zero: that is S).
     """
 
-    gyro_bias: object = (0.0, 0.0, 0.0)
-    accel_bias: object = (0.0, 0.0, 0.0)
-    gyro_scale_factor: object = (0.0, 0.0, 0.0)
-    accel_scale_factor: object = (0.0, 0.0, 0.0)
-    gyro_misalignment: object = ((0.0,) * 3,) * 3
-    accel_misalignment: object = ((0.0,) * 3,) * 3
+    gyro_bias: ArrayLike = (0.0, 0.0, 0.0)
+    accel_bias: ArrayLike = (0.0, 0.0, 0.0)
+    gyro_scale_factor: ArrayLike = (0.0, 0.0, 0.0)
+    accel_scale_factor: ArrayLike = (0.0, 0.0, 0.0)
+    gyro_misalignment: ArrayLike = ((0.0,) * 3,) * 3
+    accel_misalignment: ArrayLike = ((0.0,) * 3,) * 3
 
     _TAILS: ClassVar[dict[str, tuple[int, ...]]] = {"gyro_bias": (3,), "accel_bias": (3,), "gyro_scale_factor": (3,), "accel_scale_factor": (3,),
               "gyro_misalignment": (3, 3), "accel_misalignment": (3, 3)}

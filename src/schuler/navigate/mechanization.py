@@ -28,7 +28,10 @@ References
 ----------
 P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
 Systems*, 2nd ed., Artech House, 2013, ch. 5.
-P. G. Savage, *Strapdown Analytics*, Strapdown Associates, 2000, ch. 7, 8.
+P. G. Savage, *Strapdown Analytics*, Strapdown Associates, 2000.
+P. G. Savage, "Strapdown inertial navigation integration algorithm design, part 1: attitude
+algorithms" and "part 2: velocity and position algorithms", *Journal of Guidance, Control, and
+Dynamics* 21(1), 19-28 and 21(2), 208-221, 1998 (the two-sample coning and sculling corrections).
 K. R. Britting, *Inertial Navigation Systems Analysis*, Wiley, 1971.
 
 Examples
