@@ -7,16 +7,16 @@ import math
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
 
-from schuler.navigate import plots  # noqa: E402
-from schuler.navigate.alignment import kpi_gyrocompassing  # noqa: E402
-from schuler.navigate.errors import InitialErrors  # noqa: E402
-from schuler.navigate.mechanization import navigate  # noqa: E402
-from schuler.navigate.seeds import bollay_error_sources, drozdovich_worked_example  # noqa: E402
-from schuler.navigate.trajectory import Stationary  # noqa: E402
+from schuler.navigate import plots
+from schuler.navigate.alignment import kpi_gyrocompassing
+from schuler.navigate.errors import InitialErrors
+from schuler.navigate.mechanization import navigate
+from schuler.navigate.seeds import bollay_error_sources, drozdovich_worked_example
+from schuler.navigate.trajectory import Stationary
 
 
 @pytest.fixture(autouse=True)
