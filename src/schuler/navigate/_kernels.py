@@ -95,15 +95,6 @@ def geometry(s, c, h):
 
 
 @jit
-def earth_geometry(latitude):
-    """sin L, cos L and the radii of curvature R_N, R_E of a latitude (rad)."""
-    s = math.sin(latitude)
-    c = math.cos(latitude)
-    r_n, r_e, _, _, _, _ = geometry(s, c, 0.0)
-    return s, c, r_n, r_e
-
-
-@jit
 def rotate_latitude(s, c, delta):
     """(sin, cos) of L + delta from those of L; a series for |delta| < 1e-3 rad (error below 1e-20)."""
     if abs(delta) < 1e-3:
