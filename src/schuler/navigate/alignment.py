@@ -23,6 +23,11 @@ north) from the platform's z axis, z_p = (sin alpha, -sin beta, ...) in
 (east, north, up). To first order these are (1.17)/(1.18)'s delta, beta, alpha;
 the linear models follow from this one by linearisation (tested).
 
+References
+----------
+KPI laboratory manual on physical gyrocompassing of a semi-analytic INS (source 003, Meleshko),
+Sec. 2: control law (1.6), models (1.17)-(1.19), steady state (1.21), transient (1.22)-(1.24).
+
 Examples
 --------
 >>> from schuler.gyrocompassing.analytic import gains_from_design

@@ -11,6 +11,12 @@
 
 The gyrocompassing comparison (source 003) is :func:`schuler.navigate.alignment.kpi_gyrocompassing`.
 
+References
+----------
+W. Bollay, "The Story of 84 Minutes" (source 002), Problems 1-4.
+M. I. Drozdovich, "On an inertial method of measuring velocities", 1959, JPRS 2912 (source 000),
+eqs. (8), (13), (19)-(29).
+
 Examples
 --------
 >>> comparison = drozdovich_worked_example(duration=6 * 3600.0, output_step=600.0)

@@ -21,6 +21,13 @@ IMU are consistent to rounding.
   tan(roll) = V cos(gamma) psi' / g0, and pitches with its flight path
   (pitch = gamma). TOML input: :mod:`schuler.navigate.profile`.
 
+References
+----------
+P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd ed.,
+Artech House, 2013, Sec. 2.4 (curvilinear position, radii of curvature).
+A. Clairaut's relation for geodesics on surfaces of revolution: r sin(psi) = const, r the parallel's radius
+(e.g. M. P. do Carmo, *Differential Geometry of Curves and Surfaces*, Prentice-Hall, 1976, Sec. 4-4).
+
 Examples
 --------
 >>> path = GreatCircle(latitude=np.radians(45.0), longitude=0.0, height=0.0, heading=np.radians(30.0),
