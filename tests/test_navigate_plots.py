@@ -47,5 +47,5 @@ def test_seed_figures():
     assert len(drozdovich.axes[0].lines) == 4
     comparison = kpi_gyrocompassing(np.radians([1 / 60, 1.0, 20.0]), duration=600.0, time_step=0.5)
     figure = plots.plot_gyrocompassing(comparison)
-    assert len(figure.axes) == 2 and len(figure.axes[1].lines) == 6
+    assert len(figure.axes) == 2 and len(figure.axes[1].lines) == 7
     assert math.isclose(figure.axes[0].lines[0].get_ydata()[0], 1.0)

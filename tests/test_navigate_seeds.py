@@ -57,11 +57,14 @@ def test_nonlinear_steady_state_is_the_full_model_cross_coupling_included():
 
 def test_gyrocompassing_departures_from_1_arcmin_to_0_4_rad():
     # levelled start, 0.01 deg/h residual east drift at Kyiv: the nonlinear platform keeps (1.17)'s and
-    # (1.19)'s steady state (3.59 arcmin) to 1e-5 and their settling time (190.6 s) to 0.1 % up to 0.4 rad
+    # (1.19)'s steady state (3.59 arcmin) to 1e-5 and their settling time (190.6 s) to 0.1 % up to 0.4 rad;
+    # the decay time (50.2 s) grows with delta0 and departs by 0.8 % at 0.4 rad
     comparison = kpi_gyrocompassing()
     assert comparison.initial_azimuth_errors_rad[[0, -1]] == pytest.approx([math.radians(1 / 60), 0.4])
     assert np.abs(comparison.steady_departure_full).max() < 1e-5
     assert np.abs(comparison.settling_departure_full).max() < 2e-3
+    assert comparison.decay_departure_full[-1] == pytest.approx(0.0078, abs=0.001)
+    assert np.abs(comparison.decay_departure_full[:6]).max() < 1e-4  # up to 27 arcmin: linear
     assert all(value is None for value in comparison.first_departure_rad.values())
     assert comparison.settling_full_s[0] == pytest.approx(190.6, abs=0.2)
     assert comparison.settling_formula_s == pytest.approx(187.5, abs=0.1)  # 5 / h, h = zeta / T

@@ -210,7 +210,10 @@ class GyrocompassingComparison(Result):
     settling times the time after which the azimuth error stays within 1 % of
     |delta0 - steady state| of its steady state (s), for the nonlinear run and
     for simulations of the full (1.17) and simplified (1.19) models from the
-    same start; ``settling_formula_s`` is the source's 5 / h. Departures are
+    same start; ``settling_formula_s`` is the source's 5 / h. A band crossing
+    jumps when an overshoot grazes the band's edge, so the decay times
+    tau = integral |delta - delta_ss| dt / |delta0 - delta_ss| (s, smooth in
+    delta0; 1/h for an exponential envelope) are compared too. Departures are
     (nonlinear - linear) / |linear|; ``first_departure_rad`` gives, per
     comparison, the smallest delta0 whose departure exceeds 1 % (None: none
     in the range).
@@ -231,6 +234,9 @@ class GyrocompassingComparison(Result):
     steady_departure_simplified: np.ndarray
     settling_departure_full: np.ndarray
     settling_departure_simplified: np.ndarray
+    decay_nonlinear_s: np.ndarray
+    decay_full_s: np.ndarray
+    decay_departure_full: np.ndarray
     first_departure_rad: dict
     t_s: np.ndarray = field(repr=False)
     azimuth_error_nonlinear_rad: np.ndarray = field(repr=False)
@@ -243,7 +249,7 @@ class GyrocompassingComparison(Result):
 
         table = Table(title="Gyrocompassing: nonlinear platform vs (1.17) full and (1.19) simplified")
         for column in ("delta0 (arcmin)", "steady nl (arcmin)", "vs (1.17)", "vs (1.19)", "settling nl (s)",
-                       "(1.17) (s)", "(1.19) (s)", "vs (1.17)", "vs (1.19)"):
+                       "(1.17) (s)", "(1.19) (s)", "vs (1.17)", "vs (1.19)", "decay nl (s)", "vs (1.17)"):
             table.add_column(column, justify="right")
         arcmin = 180.0 * 60.0 / np.pi
         for i, delta0 in enumerate(self.initial_azimuth_errors_rad):
@@ -251,7 +257,8 @@ class GyrocompassingComparison(Result):
                           f"{self.steady_departure_full[i]:+.2%}", f"{self.steady_departure_simplified[i]:+.2%}",
                           f"{self.settling_nonlinear_s[i]:.1f}", f"{self.settling_full_s[i]:.1f}",
                           f"{self.settling_simplified_s[i]:.1f}", f"{self.settling_departure_full[i]:+.2%}",
-                          f"{self.settling_departure_simplified[i]:+.2%}")
+                          f"{self.settling_departure_simplified[i]:+.2%}", f"{self.decay_nonlinear_s[i]:.2f}",
+                          f"{self.decay_departure_full[i]:+.2%}")
         lines = [f"{name}: first departure > 1 % at delta0 = "
                  + ("none in range" if value is None else f"{value * arcmin:,.1f} arcmin ({value:.3g} rad)")
                  for name, value in self.first_departure_rad.items()]
@@ -261,6 +268,12 @@ class GyrocompassingComparison(Result):
 def _departure(nonlinear, linear) -> np.ndarray:
     linear = np.asarray(linear, dtype=float)
     return (np.asarray(nonlinear) - linear) / np.abs(linear)
+
+
+def _decay_time(t, signal, final, initial) -> np.ndarray:
+    """tau = integral |delta - delta_ss| dt / |delta0 - delta_ss|, s (trapezoid rule)."""
+    excess = np.abs(np.asarray(signal) - np.asarray(final)[..., None])
+    return np.trapezoid(excess, t, axis=-1) / np.abs(np.asarray(initial) - np.asarray(final))
 
 
 def _first(initial, departure) -> float | None:
@@ -326,11 +339,14 @@ def kpi_gyrocompassing(initial_azimuth_errors=None, *, latitude: float = KYIV_LA
     settle_nl = band_settling_time(t, run.azimuth_error_rad, steady_nl, delta0)
     settle_full = band_settling_time(t, full, steady_full, delta0)
     settle_simple = band_settling_time(t, simplified, simplified[:, tail].mean(axis=1), delta0)
+    decay_nl = _decay_time(t, run.azimuth_error_rad, steady_nl, delta0)
+    decay_full = _decay_time(t, full, np.full(delta0.size, steady_full), delta0)
     departures = {
         "steady state vs (1.17)": _departure(steady_nl, np.full(delta0.size, steady_full)),
         "steady state vs (1.19)": _departure(steady_nl, np.full(delta0.size, steady_simple)),
         "settling time vs (1.17)": _departure(settle_nl, settle_full),
         "settling time vs (1.19)": _departure(settle_nl, settle_simple),
+        "decay time vs (1.17)": _departure(decay_nl, decay_full),
     }
     return GyrocompassingComparison(
         latitude_rad=float(latitude), c_gamma_per_s=c_gamma, c_a_per_s=c_a, initial_azimuth_errors_rad=delta0,
@@ -341,6 +357,7 @@ def kpi_gyrocompassing(initial_azimuth_errors=None, *, latitude: float = KYIV_LA
         steady_departure_simplified=departures["steady state vs (1.19)"],
         settling_departure_full=departures["settling time vs (1.17)"],
         settling_departure_simplified=departures["settling time vs (1.19)"],
+        decay_nonlinear_s=decay_nl, decay_full_s=decay_full, decay_departure_full=departures["decay time vs (1.17)"],
         first_departure_rad={name: _first(delta0, value) for name, value in departures.items()},
         t_s=t, azimuth_error_nonlinear_rad=run.azimuth_error_rad, azimuth_error_full_rad=full,
         azimuth_error_simplified_rad=simplified)

@@ -127,7 +127,8 @@ def plot_gyrocompassing(comparison):
     for values, label in ((comparison.steady_departure_full, "steady state vs (1.17)"),
                           (comparison.steady_departure_simplified, "steady state vs (1.19)"),
                           (comparison.settling_departure_full, "settling time vs (1.17)"),
-                          (comparison.settling_departure_simplified, "settling time vs (1.19)")):
+                          (comparison.settling_departure_simplified, "settling time vs (1.19)"),
+                          (comparison.decay_departure_full, "decay time vs (1.17)")):
         departures.semilogx(delta0, 100 * np.asarray(values), "o-", ms=3, label=label)
     for bound in (1.0, -1.0):
         departures.axhline(bound, color="k", lw=0.8, ls=":")
