@@ -3,8 +3,9 @@
 All values SI. The defaults are WGS-84's rotation rate, the IUGG mean radius and
 standard gravity; the WGS-84 functions give the ellipsoid's radii of curvature,
 normal gravity with height, the gravity vector, the Earth and transport rates in
-the local North-East-Down frame (Groves 2013, ch. 2 and eq. (5.44)). A reproduction of a source uses that source's constants through one
-of the named presets (:data:`BOLLAY`, :data:`DROZDOVICH`), never the defaults.
+the local North-East-Down frame (Groves 2013, ch. 2 and eq. (5.44)). A
+reproduction of a source uses that source's constants through one of the named
+presets (:data:`BOLLAY`, :data:`DROZDOVICH`), never the defaults.
 
 Examples
 --------
