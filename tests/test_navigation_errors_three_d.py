@@ -7,14 +7,28 @@ import math
 import numpy as np
 import pytest
 
-from schuler.core.earth import BOLLAY, EARTH_RATE, MEAN_RADIUS, STANDARD_GRAVITY
+from schuler.core.earth import (
+    BOLLAY,
+    EARTH_RATE,
+    MEAN_RADIUS,
+    STANDARD_GRAVITY,
+    earth_rate_ned,
+    gravity_ned,
+    meridian_radius,
+    transport_rate_ned,
+    transverse_radius,
+)
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
 from schuler.navigation_errors.single_channel import flat_error, spherical_error
 from schuler.navigation_errors.three_d import (
     foucault_velocity_response,
+    propagate_along,
     psi_angle_model,
     stationary_modes,
+    wgs84_error_matrices,
+    wgs84_gravity_gradient,
+    wgs84_psi_angle_model,
 )
 from schuler.navigation_errors.three_d_run import THREE_D_PARAMETERS, three_d
 
@@ -186,21 +200,10 @@ def test_action_warns_when_the_latitude_changes_much():
 def test_action_bad_input(values, name):
     with pytest.raises(InvalidParameter) as error:
         _three_d(**values)
-# --- WGS-84: gravity gradient, models along a trajectory ---------------------------------------------
+    assert error.value.name == name
 
-from schuler.core.earth import (
-    earth_rate_ned,
-    gravity_ned,
-    meridian_radius,
-    transport_rate_ned,
-    transverse_radius,
-)
-from schuler.navigation_errors.three_d import (
-    propagate_along,
-    wgs84_error_matrices,
-    wgs84_gravity_gradient,
-    wgs84_psi_angle_model,
-)
+
+# --- WGS-84: gravity gradient, models along a trajectory ---------------------------------------------
 
 
 @pytest.mark.parametrize("latitude_deg, height", [(0.0, 0.0), (45.0, 10_000.0), (-70.0, 3000.0)])

@@ -40,11 +40,8 @@ from schuler.core.earth import (
     somigliana_gravity,
     transverse_radius,
 )
-from schuler.gyro_vertical.model import (
-    GreatCircleTrajectory,
-    GyroVertical,
-    SpeedProfile,
-)
+from schuler.gyro_vertical.model import GyroVertical
+from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, SpeedProfile
 from schuler.gyro_vertical.quasi_steady import quasi_steady_response
 from schuler.gyro_vertical.reproduction import worked_example
 from schuler.navigate.errors import InitialErrors, SensorErrors
