@@ -372,7 +372,7 @@ def test_simulated_fidelity_honours_duration_per_case():
     values = {"drift_east": np.full(3, 0.01 * DEG_PER_H), "duration": np.array([300.0, 1500.0, np.nan]),
               "output_step": np.array([1.0, 2.0, 1.0])}
     out = SYSTEM.evaluate_values(values)
-    np.testing.assert_array_equal(out["duration_s"], [300.0, 1500.0, 7200.0])
+    np.testing.assert_array_equal(out["simulated_duration_s"], [300.0, 1500.0, 7200.0])
     for i in range(3):
         given = {k: float(v[i]) for k, v in values.items() if not np.isnan(v[i])}
         single = SYSTEM.run(**given)

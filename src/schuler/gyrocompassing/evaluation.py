@@ -100,13 +100,13 @@ OUTPUTS = (
     Output("settling_time_simulated_s", "s", "", "last exit from the 1 % band (simulated; inf: not settled)"),
     Output("c_gamma", "1/s", "", "level correction gain used"),
     Output("c_a", "1/s", "", "azimuth correction gain used"),
-    Output("time_constant_s", "s", "", "time constant T of the gains used"),
-    Output("damping", "1", "", "damping ratio zeta of the gains used"),
+    Output("design_time_constant_s", "s", "", "time constant T of the gains used"),
+    Output("design_damping", "1", "", "damping ratio zeta of the gains used"),
     Output("max_abs_delta_rad", "rad", "", "largest |delta| over the run (simulated)"),
     Output("max_abs_beta_rad", "rad", "", "largest |beta| over the run (simulated)"),
     Output("max_abs_delta_rate_rad_s", "rad/s", "", "largest |delta'| over the run (simulated)"),
     Output("constraints_ok", "1", "", "1 when |delta| < 0.4 rad, |beta| < 0.01 rad, |delta'| < 0.2 rad/s throughout"),
-    Output("duration_s", "s", "", "simulated time"),
+    Output("simulated_duration_s", "s", "", "simulated time"),
 )
 
 FIDELITIES = ("simulated", "closed")
@@ -185,8 +185,8 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
         "settling_time_s": result["settling_time_s"],
         "c_gamma": c_gamma,
         "c_a": c_a,
-        "time_constant_s": result["time_constant_s"],
-        "damping": result["damping"],
+        "design_time_constant_s": result["time_constant_s"],
+        "design_damping": result["damping"],
     }
     if simulate:
         out.update({
@@ -195,7 +195,7 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
             "max_abs_beta_rad": result["max_abs_beta_rad"],
             "max_abs_delta_rate_rad_s": result["max_abs_delta_rate_rad_per_s"],
             "constraints_ok": np.asarray(result["constraints_ok"], dtype=float),
-            "duration_s": np.full(len(cases), duration),
+            "simulated_duration_s": np.full(len(cases), duration),
         })
     return out
 
@@ -222,12 +222,12 @@ def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
         with warnings.catch_warnings():
             # evaluate has warned about the latitude already; the histories are the same case
             warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")
-            histories = simulate_case(single, model, duration=outputs["duration_s"], time_step=case["output_step"])
+            histories = simulate_case(single, model, duration=outputs["simulated_duration_s"], time_step=case["output_step"])
             simplified = histories
             if model != "simplified":
                 # (1.19) beside the model for the comparison figures; the model's own run has warned already
                 warnings.simplefilter("ignore", DegradedAccuracyWarning)
-                simplified = simulate_case(single, "simplified", duration=outputs["duration_s"],
+                simplified = simulate_case(single, "simplified", duration=outputs["simulated_duration_s"],
                                             time_step=case["output_step"])
     violations = [] if histories is None else list(histories.violations)
     return AlignmentResult(
