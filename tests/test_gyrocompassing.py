@@ -417,3 +417,20 @@ def test_system_evaluate_accepts_every_parameter_as_an_array():
     values["latitude"][-1] = math.radians(87.0)
     with pytest.raises(NotObservable):
         SYSTEM.evaluate(Cases(values))
+
+
+def test_simulated_band_time_lies_below_the_envelope_time_of_the_oscillation():
+    # with the gains of 50 deg held fixed, the loop oscillates faster near the equator: the 1 % band is left for
+    # the last time at a peak, within half a period before the envelope exp(-h t) sqrt(1 + h^2/w^2) reaches 1 %,
+    # and 5/h (the e^-5 envelope) is later still (the report's latitude sweep: 150-170 s against 187.5 s)
+    c_gamma, c_a = AlignmentCase().gains()
+    latitudes = np.radians([0.0, 10.0, 20.0, 30.0])
+    swept = evaluate_cases(AlignmentCase(latitude=latitudes, drift_east=0.01 * DEG_PER_H, c_gamma=float(c_gamma),
+                                         c_a=float(c_a)), "simplified", simulate_runs=True, duration=1200.0,
+                           time_step=0.1)
+    h = float(c_gamma) / 2
+    omega = np.sqrt(float(c_a) * EARTH_RATE * np.cos(latitudes) - h**2)
+    envelope = np.log(100 * np.sqrt(1 + (h / omega) ** 2)) / h
+    simulated = swept["settling_time_simulated_s"]
+    assert np.all(simulated <= envelope + 0.1) and np.all(simulated >= envelope - np.pi / omega - 0.1)
+    assert np.all(simulated < 5 / h) and swept["settling_time_s"] == pytest.approx(5 / h)

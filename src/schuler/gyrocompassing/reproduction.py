@@ -191,7 +191,12 @@ def report(outdir: Path) -> ReportSection:
         "align_latitude_sweep": "Accuracy and time against latitude with the gains of T = 30 s, zeta = 0.8 at "
                                 "50 deg held fixed: (1.21) and the analytic settling time (lines), simulated full "
                                 "model (circles). The error grows as 1/cos(latitude); poleward of 66 deg the loop "
-                                "is aperiodic and slows down.",
+                                "is aperiodic and slows down. Where the loop oscillates, the simulated time is "
+                                "shorter than 5/h: 5/h is the time the envelope exp(-h t) takes to fall to "
+                                "exp(-5) = 0.67 %, while the simulation reports the last exit from a 1 % band, "
+                                "which happens at the last oscillation peak above 1 %, before the envelope "
+                                "ln(100 sqrt(1 + h^2/omega^2))/h; near the equator omega is largest and the two "
+                                "differ most (150-170 s against 187.5 s).",
         "align_monte_carlo": "Monte Carlo (400 members; 0.01 deg/h drifts, 100 micro-g accelerometers, "
                              "1-sigma): simulated azimuth errors and the analytic 1-sigma.",
         "align_printed_1_17": "The printed third line of (1.17) diverges at A = 0; the corrected one converges.",
