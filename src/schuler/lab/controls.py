@@ -137,6 +137,9 @@ def parse_typed(parameters: ParameterSet, typed: Mapping[str, str]) -> tuple[Cas
             parameter.parse(text, parameter.option)
         except SchulerError as error:
             errors[name] = str(error)
+        except Exception:  # the units library fails on some texts ("()") with errors of its own
+            unit = (parameter.unit if parameter.kind == "quantity" else "") or "plain numbers"
+            errors[name] = f"{parameter.option}: cannot read {text.strip()!r} as a quantity in {unit}"
     if errors:
         return None, errors
     try:
