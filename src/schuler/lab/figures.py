@@ -23,7 +23,7 @@ from dash import dcc, html
 from schuler.contract import System
 from schuler.units import to_unit
 
-MAX_POINTS = 1500
+MAX_POINTS = 500
 """Points per trace sent to the browser (histories are thinned evenly, first and last point kept)."""
 
 SETTLING_TIMES_SHOWN = 4.0

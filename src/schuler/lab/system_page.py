@@ -59,7 +59,6 @@ def layout(system: System) -> html.Div:
     name = system.name
     return html.Div([
         dcc.Store(id="system-name", data=name),
-        dcc.Store(id="case-typed"),
         dcc.Store(id="run-error"),
         dcc.Store(id="figure-request"),
         html.Div([
@@ -108,23 +107,21 @@ def register(app: Dash) -> None:
 
     @app.callback(
         Output({"type": ERROR, "name": ALL}, "children"),
-        Output("case-typed", "data"),
         Input({"type": PARAM, "name": ALL}, "value"),
         Input("run-error", "data"),
         State({"type": PARAM, "name": ALL}, "id"),
         State("system-name", "data"),
-        State("case-typed", "data"),
     )
-    def check(values, run_error, ids, name, current):
+    def check(values, run_error, ids, name):
         parameters = page_parameters(get_system(name))
         typed = typed_values(parameters, ids, values)
-        case, errors = parse_typed(parameters, typed)
+        _, errors = parse_typed(parameters, typed)
         if run_error and run_error.get("typed") == typed and run_error.get("name"):
             errors.setdefault(run_error["name"], run_error["message"])
-        messages = [errors.get(ident["name"], "") for ident in ids]
-        changed = case is not None and typed != current
-        return messages, (typed if changed else no_update)
+        return [errors.get(ident["name"], "") for ident in ids]
 
+    # The run starts from the inputs themselves (not after the check above): one round trip less. A case that
+    # does not parse changes nothing; the check shows why.
     @app.callback(
         Output("headline", "children"),
         Output("monte-carlo", "children"),
@@ -133,7 +130,8 @@ def register(app: Dash) -> None:
         Output("run-error", "data"),
         Output("run-message", "children"),
         Output("run-notes", "children"),
-        Input("case-typed", "data"),
+        Input({"type": PARAM, "name": ALL}, "value"),
+        State({"type": PARAM, "name": ALL}, "id"),
         State("system-name", "data"),
         State("session", "data"),
         background=True,
@@ -142,12 +140,12 @@ def register(app: Dash) -> None:
         running=[(Output("run-status", "className"), "status running", "status"),
                  (Output("run-cancel", "disabled"), False, True)],
         cancel=[Input("run-cancel", "n_clicks")],
-        prevent_initial_call=True,
     )
-    def run(set_progress, typed, name, session):
-        if typed is None:
-            raise PreventUpdate
+    def run(set_progress, values, ids, name, session):
         system = get_system(name)
+        typed = typed_values(page_parameters(system), ids, values)
+        if parse_typed(page_parameters(system), typed)[0] is None:
+            raise PreventUpdate
         unchanged = (no_update,) * 4
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -167,7 +165,8 @@ def register(app: Dash) -> None:
         if figures is None:
             shown, request = html.P("rendering the figures...", className="hint"), typed
         else:
-            shown, request = [block(stem, fig) for stem, fig in figures] or html.P("no histories (closed form)"), None
+            shown, request = [block(stem, fig) for stem, fig in figures] or html.P("no histories (closed form)"), \
+                no_update
         return views.headline(system, values), statistics, shown, request, None, "", notes(caught)
 
     @app.callback(
@@ -194,7 +193,8 @@ def register(app: Dash) -> None:
         Output("download", "data"),
         Output("download-status", "children"),
         Input("download-files", "n_clicks"),
-        State("case-typed", "data"),
+        State({"type": PARAM, "name": ALL}, "value"),
+        State({"type": PARAM, "name": ALL}, "id"),
         State("system-name", "data"),
         State("session", "data"),
         background=True,
@@ -203,10 +203,10 @@ def register(app: Dash) -> None:
                  (Output("download-status", "children"), "writing files...", "")],
         prevent_initial_call=True,
     )
-    def download(clicks, typed, name, session):
+    def download(clicks, values, ids, name, session):
         system = get_system(name)
         try:
-            archive = files_archive(system, run_typed(system, typed or {}))
+            archive = files_archive(system, run_typed(system, typed_values(page_parameters(system), ids, values)))
         except SchulerError as error:
             return no_update, str(error)
         return dcc.send_bytes(archive, f"{name}_lab.zip"), ""

@@ -91,7 +91,6 @@ def layout(system: System, page: str) -> html.Div:
         aside[1:1] = [html.H3("Sweep"), *controls(SWEEP, id_type=SWEEP_PARAM), html.H3("Case")]
     return html.Div([
         dcc.Store(id="task-page", data=page),
-        dcc.Store(id="task-typed"),
         html.Div([html.H1(f"Task {number}: {TASKS[number]}"),
                   html.Blockquote(manual.TASK_TEXT[number], className="manual"),
                   html.H2("Control questions"), html.Ol(questions, className="questions")], className="page-head"),
@@ -237,35 +236,36 @@ def compute(system: System, page: str, typed: dict[str, str], sweep_typed: dict[
     return view
 
 
+def wanted_case(values, sweep_texts, ids, sweep_ids) -> tuple[dict, dict[str, str], dict[str, str]]:
+    """The values typed on a task page ({"case": ..., "sweep": ...}) and the messages of the wrong ones."""
+    system = get_system("align")
+    typed = typed_values(system.parameters, ids, values)
+    sweep_typed = {i["name"]: str(v) for i, v in zip(sweep_ids, sweep_texts) if v not in (None, "")}
+    _, errors = parse_typed(system.parameters, typed)
+    sweep_errors: dict[str, str] = {}
+    if sweep_ids:
+        try:
+            sweep_values(system, sweep_typed)
+        except SchulerError as error:
+            owner, message = error_owner(SWEEP, error)
+            sweep_errors[owner or "sweep"] = message
+    return {"case": typed, "sweep": sweep_typed}, errors, sweep_errors
+
+
 def register(app: Dash) -> None:
     """The callbacks of the task pages."""
 
     @app.callback(
         Output({"type": f"{TASK_PARAM}-error", "name": ALL}, "children"),
         Output({"type": f"{SWEEP_PARAM}-error", "name": ALL}, "children"),
-        Output("task-typed", "data"),
         Input({"type": TASK_PARAM, "name": ALL}, "value"),
         Input({"type": SWEEP_PARAM, "name": ALL}, "value"),
         State({"type": TASK_PARAM, "name": ALL}, "id"),
         State({"type": SWEEP_PARAM, "name": ALL}, "id"),
-        State("task-typed", "data"),
     )
-    def check(values, sweep_values_, ids, sweep_ids, current):
-        system = get_system("align")
-        typed = typed_values(system.parameters, ids, values)
-        sweep_typed = {i["name"]: str(v) for i, v in zip(sweep_ids, sweep_values_) if v not in (None, "")}
-        case, errors = parse_typed(system.parameters, typed)
-        sweep_errors = {}
-        if sweep_ids:
-            try:
-                sweep_values(system, sweep_typed)
-            except SchulerError as error:
-                owner, message = error_owner(SWEEP, error)
-                sweep_errors[owner or "sweep"] = message
-        wanted = {"case": typed, "sweep": sweep_typed}
-        valid = case is not None and not sweep_errors
-        return ([errors.get(i["name"], "") for i in ids], [sweep_errors.get(i["name"], "") for i in sweep_ids],
-                wanted if valid and wanted != current else no_update)
+    def check(values, sweep_texts, ids, sweep_ids):
+        _, errors, sweep_errors = wanted_case(values, sweep_texts, ids, sweep_ids)
+        return [errors.get(i["name"], "") for i in ids], [sweep_errors.get(i["name"], "") for i in sweep_ids]
 
     @app.callback(
         Output({"type": SWEEP_PARAM, "name": "sweep_from"}, "value"),
@@ -283,7 +283,10 @@ def register(app: Dash) -> None:
         Output("task-figures", "children"),
         Output("task-message", "children"),
         Output("task-notes", "children"),
-        Input("task-typed", "data"),
+        Input({"type": TASK_PARAM, "name": ALL}, "value"),
+        Input({"type": SWEEP_PARAM, "name": ALL}, "value"),
+        State({"type": TASK_PARAM, "name": ALL}, "id"),
+        State({"type": SWEEP_PARAM, "name": ALL}, "id"),
         State("task-page", "data"),
         State("session", "data"),
         background=True,
@@ -292,10 +295,10 @@ def register(app: Dash) -> None:
         running=[(Output("task-status", "className"), "status running", "status"),
                  (Output("task-cancel", "disabled"), False, True)],
         cancel=[Input("task-cancel", "n_clicks")],
-        prevent_initial_call=True,
     )
-    def run(set_progress, wanted, page, session):
-        if not wanted:
+    def run(set_progress, values, sweep_texts, ids, sweep_ids, page, session):
+        wanted, errors, sweep_errors = wanted_case(values, sweep_texts, ids, sweep_ids)
+        if errors or sweep_errors:
             raise PreventUpdate
         try:
             view = compute(get_system("align"), page, wanted["case"], wanted["sweep"],
@@ -311,14 +314,18 @@ def register(app: Dash) -> None:
         Output({"type": "csv-download", "figure": MATCH}, "data"),
         Input({"type": "csv-export", "figure": MATCH}, "n_clicks"),
         State({"type": "csv-export", "figure": MATCH}, "id"),
-        State("task-typed", "data"),
+        State({"type": TASK_PARAM, "name": ALL}, "value"),
+        State({"type": SWEEP_PARAM, "name": ALL}, "value"),
+        State({"type": TASK_PARAM, "name": ALL}, "id"),
+        State({"type": SWEEP_PARAM, "name": ALL}, "id"),
         State("task-page", "data"),
         State("session", "data"),
         background=True,
         interval=4 * POLL_MS,
         prevent_initial_call=True,
     )
-    def csv(clicks, ident, wanted, page, session):
+    def csv(clicks, ident, values, sweep_texts, ids, sweep_ids, page, session):
+        wanted, _, _ = wanted_case(values, sweep_texts, ids, sweep_ids)
         view = compute(get_system("align"), page, wanted["case"], wanted["sweep"])
         frame = next(frame for stem, _, frame in view.figures if stem == ident["figure"])
         return dcc.send_data_frame(frame.to_csv, f"{ident['figure']}.csv", index=False)
