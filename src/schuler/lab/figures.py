@@ -15,6 +15,7 @@ from __future__ import annotations
 import base64
 import tempfile
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,7 @@ from dash import dcc, html
 from schuler.contract import System
 from schuler.units import to_unit
 
-MAX_POINTS = 500
+MAX_POINTS = 400
 """Points per trace sent to the browser (histories are thinned evenly, first and last point kept)."""
 
 SETTLING_TIMES_SHOWN = 4.0
@@ -176,11 +177,23 @@ def sweep_curves(x, x_label: str, columns: dict, constraints, title: str = "Accu
     return fig
 
 
-def block(stem: str, fig: dict, csv: bool = False) -> html.Div:
+GRAPH = "lab-graph"
+"""Component-id type of a system page's interactive graphs: ``{"type": GRAPH, "figure": STEM}``."""
+
+
+def empty(note: str) -> dict:
+    """A figure with nothing drawn but a note (before the first run, or when a run has no histories)."""
+    return {"data": [], "layout": {"height": 200, "template": "plotly_white", "xaxis": {"visible": False},
+                                   "yaxis": {"visible": False},
+                                   "annotations": [{"text": note, "showarrow": False, "font": {"size": 14}}]}}
+
+
+def block(stem: str, fig: dict, csv: bool = False, graph_id: dict | None = None) -> html.Div:
     """A figure with its export buttons: PNG and SVG (drawn by the browser), and CSV of its data if ``csv``.
 
     The CSV button (``{"type": "csv-export", "figure": stem}``) needs a
-    callback of the page that knows the figure's data.
+    callback of the page that knows the figure's data. ``graph_id`` gives the
+    graph an id, so that a callback can replace its figure in place.
     """
     buttons = [html.Button(fmt.upper(), id={"type": "image-export", "figure": stem, "format": fmt},
                            className="export", title=f"save the figure as {fmt.upper()}") for fmt in ("png", "svg")]
@@ -188,28 +201,41 @@ def block(stem: str, fig: dict, csv: bool = False) -> html.Div:
         buttons += [html.Button("CSV", id={"type": "csv-export", "figure": stem}, className="export",
                                 title="download the figure's data as CSV"),
                     dcc.Download(id={"type": "csv-download", "figure": stem})]
-    return html.Div([dcc.Graph(figure=fig, config=GRAPH_CONFIG),
-                     html.Div([html.Span("export:", className="hint"), *buttons], className="exports")],
+    graph = dcc.Graph(figure=fig, config=GRAPH_CONFIG) if graph_id is None else \
+        dcc.Graph(id=graph_id, figure=fig, config=GRAPH_CONFIG)
+    return html.Div([graph, html.Div([html.Span("export:", className="hint"), *buttons], className="exports")],
                     className="figure", **{"data-figure": stem})
 
 
-def _alignment_figures(result) -> list[tuple[str, dict]]:
+@dataclass(frozen=True)
+class Interactive:
+    """The interactive figures the lab draws for one system: their names and how to build them from a result."""
+
+    stems: tuple[str, ...]
+    build: Callable[[object], list[dict]]
+
+
+def _alignment_figures(result) -> list[dict]:
     if result.run is None:
-        return []
+        return [empty("no histories: the closed form computes none")] * 2
     runs = {f"{result.model} model": result.run}
     if result.model != "simplified" and result.simplified_run is not None:
         runs["simplified (1.19)"] = result.simplified_run
-    return [("align_time_history", time_history(runs)), ("align_phase_trajectory", phase_trajectory(runs))]
+    return [time_history(runs), phase_trajectory(runs)]
 
 
-INTERACTIVE: dict[str, Callable[[object], list[tuple[str, dict]]]] = {"align": _alignment_figures}
-"""System name -> interactive figures of its ``run`` result (name, figure)."""
+INTERACTIVE = {"align": Interactive(("align_time_history", "align_phase_trajectory"), _alignment_figures)}
+"""System name -> the interactive figures of its ``run`` result."""
 
 
-def interactive_figures(system: System, result) -> list[tuple[str, dict]] | None:
-    """The interactive figures of a result, or None when the lab draws none for this system."""
-    builder = INTERACTIVE.get(system.name)
-    return None if builder is None else builder(result)
+def interactive_stems(system: System) -> tuple[str, ...]:
+    """Names of the interactive figures of a system's page (empty: it shows its own files' figures)."""
+    return INTERACTIVE[system.name].stems if system.name in INTERACTIVE else ()
+
+
+def interactive_figures(system: System, result) -> list[dict] | None:
+    """The interactive figures of a result (in the order of :func:`interactive_stems`), or None."""
+    return INTERACTIVE[system.name].build(result) if system.name in INTERACTIVE else None
 
 
 def file_figures(system: System, result) -> list[tuple[str, str]]:

@@ -25,7 +25,7 @@ from schuler.contract import RUN_OPTIONS, System
 from schuler.exceptions import SchulerError
 from schuler.lab import views
 from schuler.lab.controls import ERROR, PARAM, controls, error_owner, parse_typed, typed_values
-from schuler.lab.figures import block, file_figures, interactive_figures
+from schuler.lab.figures import GRAPH, block, empty, file_figures, interactive_figures, interactive_stems
 from schuler.params import Parameter, ParameterSet
 from schuler.registry import get_system
 
@@ -80,10 +80,11 @@ def layout(system: System) -> html.Div:
                 html.Div(id="run-message", className="page-error", role="alert"),
                 html.Div(id="run-notes", className="notes"),
                 html.H2("Headline numbers"),
-                html.Div(views.headline(system, {}), id="headline"),
+                views.headline(system, {}, with_ids=True),
                 html.Div(id="monte-carlo"),
                 html.H2("Figures"),
-                html.Div(id="figures", className="figures"),
+                html.Div([block(stem, empty("running..."), graph_id={"type": GRAPH, "figure": stem})
+                          for stem in interactive_stems(system)], id="figures", className="figures"),
                 html.Div([html.Button("Download figures and data (PNG, SVG, CSV)", id="download-files"),
                           html.Span(id="download-status", className="hint"), dcc.Download(id="download")],
                          className="exports"),
@@ -123,9 +124,9 @@ def register(app: Dash) -> None:
     # The run starts from the inputs themselves (not after the check above): one round trip less. A case that
     # does not parse changes nothing; the check shows why.
     @app.callback(
-        Output("headline", "children"),
+        Output({"type": views.RESULT, "key": ALL}, "children"),
         Output("monte-carlo", "children"),
-        Output("figures", "children"),
+        Output({"type": GRAPH, "figure": ALL}, "figure"),
         Output("figure-request", "data"),
         Output("run-error", "data"),
         Output("run-message", "children"),
@@ -162,12 +163,9 @@ def register(app: Dash) -> None:
         summary = getattr(result, "monte_carlo", None)
         statistics = views.monte_carlo_table(system, summary.statistics, summary.members) if summary else None
         figures = interactive_figures(system, result)
-        if figures is None:
-            shown, request = html.P("rendering the figures...", className="hint"), typed
-        else:
-            shown, request = [block(stem, fig) for stem, fig in figures] or html.P("no histories (closed form)"), \
-                no_update
-        return views.headline(system, values), statistics, shown, request, None, "", notes(caught)
+        request = typed if figures is None else no_update
+        return (views.headline_texts(system, values), statistics, figures or [], request, None, "",
+                notes(caught))
 
     @app.callback(
         Output("figures", "children", allow_duplicate=True),

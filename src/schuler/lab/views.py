@@ -57,17 +57,30 @@ def quantity_text(value_si, output: Output) -> str:
     return f"{number_text(shown)} {unit}".strip()
 
 
-def headline(system: System, values: Mapping[str, object]) -> html.Table:
-    """The system's outputs as a table of ``data-result`` numbers (values: SI, keyed as in ``to_dict``)."""
+RESULT = "result"
+"""Component-id type of a headline number: ``{"type": RESULT, "key": KEY}`` (with ``data-result="KEY"``)."""
+
+
+def headline(system: System, values: Mapping[str, object], with_ids: bool = False) -> html.Table:
+    """The system's outputs as a table of ``data-result`` numbers (values: SI, keyed as in ``to_dict``).
+
+    ``with_ids`` gives each number an id, so that a callback can replace its text in place.
+    """
     rows = []
     for output in system.outputs:
+        ident = {"id": {"type": RESULT, "key": output.name}} if with_ids else {}
         rows.append(html.Tr([
             html.Th(output.description or output.name, scope="row"),
-            html.Td(html.Span(quantity_text(values.get(output.name), output), **{"data-result": output.name}),
-                    className="number"),
+            html.Td(html.Span(quantity_text(values.get(output.name), output), **ident,
+                              **{"data-result": output.name}), className="number"),
             html.Td(output.name, className="key"),
         ]))
     return html.Table(html.Tbody(rows), className="headline")
+
+
+def headline_texts(system: System, values: Mapping[str, object]) -> list[str]:
+    """The texts of :func:`headline`'s numbers, in the order of the system's outputs."""
+    return [quantity_text(values.get(output.name), output) for output in system.outputs]
 
 
 def monte_carlo_table(system: System, statistics: Mapping[str, Mapping[str, float | None]], members: int) -> html.Div:
