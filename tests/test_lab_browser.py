@@ -151,6 +151,8 @@ def test_align_page_follows_latitude_and_drift_as_the_command_line_does(server, 
 
     target = ROOT / "docs" / "lab-screenshot.png" if os.environ.get("SCHULER_UPDATE_SCREENSHOT") \
         else tmp_path / "lab-screenshot.png"
+    watched.page.set_viewport_size({"width": 1280, "height": 1400})  # controls, numbers and the first figure
+    watched.page.wait_for_timeout(500)
     watched.page.screenshot(path=str(target))
     assert target.stat().st_size > 20_000
     print(f"screenshot: {target}")
