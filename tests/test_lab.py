@@ -22,7 +22,7 @@ from dash import html
 import schuler.lab
 import test_study_fake_system as fake
 from schuler.exceptions import InvalidParameter
-from schuler.lab import controls, system_page, tasks, views
+from schuler.lab import controls, figures, system_page, tasks, views
 from schuler.lab.app import MAX_REQUEST_BYTES, create_app, systems_available
 from schuler.lab.server import check_host, check_port
 from schuler.registry import get_system
@@ -301,6 +301,14 @@ def test_the_download_holds_the_systems_files():
     names = zipfile.ZipFile(BytesIO(system_page.files_archive(ALIGN, result))).namelist()
     assert sorted(names) == ["align_phase_trajectory.png", "align_phase_trajectory.svg", "align_time_history.csv",
                              "align_time_history.png", "align_time_history.svg"]
+
+
+def test_systems_without_interactive_figures_show_their_own_files():
+    result = system_page.run_typed(ALIGN, {"duration": "600"})
+    images = figures.file_figures(ALIGN, result)
+    assert [name for name, _ in images] == ["align_time_history.png", "align_phase_trajectory.png"]
+    assert all(uri.startswith("data:image/png;base64,iVBORw0KGgo") for _, uri in images)  # the PNG signature
+    assert figures.interactive_stems(fake.FAKE) == () and figures.interactive_figures(fake.FAKE, result) is None
 
 
 # --- the KPI tasks ----------------------------------------------------------------------------------------------

@@ -80,7 +80,8 @@ class Watched:
         start = time.perf_counter()
         while not condition():
             if time.perf_counter() - start > timeout:
-                raise AssertionError(f"timed out waiting for {what}")
+                numbers = self.page.locator("[data-result]").all_inner_texts()[:3]
+                raise AssertionError(f"timed out waiting for {what}; the page shows {numbers}")
             self.page.wait_for_timeout(25)
         return time.perf_counter() - start
 

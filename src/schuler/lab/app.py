@@ -21,6 +21,7 @@ import tempfile
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from dash import Dash, DiskcacheManager, Input, Output, dcc, html
 
@@ -101,7 +102,7 @@ def create_app() -> Lab:
     app = Dash(
         __name__,
         title="schuler lab",
-        update_title=None,
+        update_title="",  # the tab keeps its title while a page updates
         assets_folder=str(ASSETS),
         serve_locally=True,
         suppress_callback_exceptions=True,
@@ -120,7 +121,7 @@ def create_app() -> Lab:
 
 def _shell(available: list[Availability]) -> html.Div:
     """The frame of every page; a new session token per page load keeps sessions' jobs apart."""
-    links = []
+    links: list[Any] = []
     for item in available:
         if item.system is None:
             links.append(html.Span(item.name, className="unavailable", title=f"not available: {item.reason}"))

@@ -15,6 +15,7 @@ from collections.abc import Iterable, Mapping
 from dash import dcc, html
 
 from schuler.exceptions import InvalidParameter, SchulerError
+from schuler.lab.views import data_attributes
 from schuler.params import Case, Parameter, ParameterSet
 
 MAX_VALUE_CHARS = 200
@@ -66,7 +67,7 @@ def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM
     unit = unit_label(parameter)
     options = None
     if parameter.kind in ("choice", "flag"):
-        choices = parameter.choices if parameter.kind == "choice" else ("true", "false")
+        choices = (parameter.choices or ()) if parameter.kind == "choice" else ("true", "false")
         options = html.Datalist(id=f"{id_type}-{name}-choices", children=[html.Option(value=c) for c in choices])
     placeholder = "not set" if parameter.default is None else ""
     field = dcc.Input(
@@ -86,7 +87,7 @@ def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM
     children = [label, field, options, html.Div(describe(parameter), className="hint", title=parameter.help),
                 html.Div(id={"type": ERROR if id_type == PARAM else f"{id_type}-error", "name": name},
                          className="error", role="alert")]
-    return html.Div([c for c in children if c is not None], className="control", **{"data-param": name})
+    return html.Div([c for c in children if c is not None], className="control", **data_attributes(param=name))
 
 
 def controls(parameters: Iterable[Parameter], id_type: str = PARAM, values: Mapping[str, str] | None = None
@@ -100,10 +101,10 @@ def typed_values(parameters: ParameterSet, ids: list[dict], values: list) -> dic
 
     An emptied field goes back to its default ("not set" where there is none).
     """
-    typed = {}
+    typed: dict[str, str] = {}
     for ident, value in zip(ids, values):
         name = ident.get("name") if isinstance(ident, Mapping) else None
-        if name not in parameters:
+        if not isinstance(name, str) or name not in parameters:
             continue
         text = "" if value is None else str(value)
         if text.strip() and text.strip() != initial_text(parameters[name]):

@@ -17,11 +17,13 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from dash import dcc, html
 
 from schuler.contract import System
+from schuler.lab.views import data_attributes
 from schuler.units import to_unit
 
 MAX_POINTS = 400
@@ -30,7 +32,7 @@ MAX_POINTS = 400
 SETTLING_TIMES_SHOWN = 4.0
 """The time axis of a history spans this many analytic settling times (or the whole run if shorter)."""
 
-GRAPH_CONFIG = {"displaylogo": False, "responsive": True,
+GRAPH_CONFIG: Any = {"displaylogo": False, "responsive": True,
                 "modeBarButtonsToRemove": ["select2d", "lasso2d", "autoScale2d"],
                 "toImageButtonOptions": {"format": "png", "scale": 2}}
 """dcc.Graph config: the camera button saves a PNG (rendered in the browser, no server involved)."""
@@ -108,9 +110,9 @@ def time_history(runs: dict, title: str = "Azimuth and level errors (Fig. 1.4)")
         window = shown_window(run)
         minutes, delta, beta = thin(run.time[window] / 60.0, to_unit(run.delta[window], "arcmin"),
                                     to_unit(run.beta[window], "arcsec"))
-        style = {"line": {"dash": DASHES[number % len(DASHES)]}}
-        traces += [_line(minutes, delta, f"delta, {label}", **style),
-                   _line(minutes, beta, f"beta, {label}", row=2, **style)]
+        line = {"dash": DASHES[number % len(DASHES)]}
+        traces += [_line(minutes, delta, f"delta, {label}", line=line),
+                   _line(minutes, beta, f"beta, {label}", row=2, line=line)]
     steady = float(to_unit(next(iter(runs.values())).analytic["azimuth_error_analytic_rad"], "arcmin"))
     shape, note = _level(steady, 1, "delta_y (1.21)")
     return _figure(traces, title, ["delta [arcmin]", "beta [arcsec]"], "time [min]", 520, [shape], [note])
@@ -195,16 +197,16 @@ def block(stem: str, fig: dict, csv: bool = False, graph_id: dict | None = None)
     callback of the page that knows the figure's data. ``graph_id`` gives the
     graph an id, so that a callback can replace its figure in place.
     """
-    buttons = [html.Button(fmt.upper(), id={"type": "image-export", "figure": stem, "format": fmt},
+    buttons: list[Any] = [html.Button(fmt.upper(), id={"type": "image-export", "figure": stem, "format": fmt},
                            className="export", title=f"save the figure as {fmt.upper()}") for fmt in ("png", "svg")]
     if csv:
         buttons += [html.Button("CSV", id={"type": "csv-export", "figure": stem}, className="export",
                                 title="download the figure's data as CSV"),
                     dcc.Download(id={"type": "csv-download", "figure": stem})]
-    graph = dcc.Graph(figure=fig, config=GRAPH_CONFIG) if graph_id is None else \
-        dcc.Graph(id=graph_id, figure=fig, config=GRAPH_CONFIG)
+    identity: dict[str, Any] = {} if graph_id is None else {"id": graph_id}
+    graph = dcc.Graph(figure=fig, config=GRAPH_CONFIG, **identity)
     return html.Div([graph, html.Div([html.Span("export:", className="hint"), *buttons], className="exports")],
-                    className="figure", **{"data-figure": stem})
+                    className="figure", **data_attributes(figure=stem))
 
 
 @dataclass(frozen=True)

@@ -111,7 +111,7 @@ class LabServer:
                 pass
 
         self._server = make_server(host, port, wsgi_app, threaded=True, request_handler=QuietHandler)
-        self._server.daemon_threads = True
+        self._server.daemon_threads = True  # type: ignore[attr-defined]  # threaded: a ThreadingMixIn server
         self.host = host
         self.port = int(self._server.server_port)
         self._on_stop = on_stop

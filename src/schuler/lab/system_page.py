@@ -61,6 +61,8 @@ def layout(system: System) -> html.Div:
         dcc.Store(id="system-name", data=name),
         dcc.Store(id="run-error"),
         dcc.Store(id="figure-request"),
+        dcc.Store(id="shown-case"),
+        dcc.Store(id="rerun", data=0),
         html.Div([
             html.H1(system.title),
             html.P(["Source: ", system.reference], className="source"),
@@ -131,7 +133,9 @@ def register(app: Dash) -> None:
         Output("run-error", "data"),
         Output("run-message", "children"),
         Output("run-notes", "children"),
+        Output("shown-case", "data"),
         Input({"type": PARAM, "name": ALL}, "value"),
+        Input("rerun", "data"),
         State({"type": PARAM, "name": ALL}, "id"),
         State("system-name", "data"),
         State("session", "data"),
@@ -142,7 +146,7 @@ def register(app: Dash) -> None:
                  (Output("run-cancel", "disabled"), False, True)],
         cancel=[Input("run-cancel", "n_clicks")],
     )
-    def run(set_progress, values, ids, name, session):
+    def run(set_progress, values, rerun, ids, name, session):
         system = get_system(name)
         typed = typed_values(page_parameters(system), ids, values)
         if parse_typed(page_parameters(system), typed)[0] is None:
@@ -155,9 +159,9 @@ def register(app: Dash) -> None:
             except SchulerError as error:
                 owner, message = error_owner(page_parameters(system), error)
                 return (*unchanged, {"typed": typed, "name": owner, "message": message}, "" if owner else message,
-                        no_update)
+                        no_update, typed)
             except Exception as error:  # a bug must not leave the page waiting: say it in one line
-                return *unchanged, None, internal_error(error), no_update
+                return *unchanged, None, internal_error(error), no_update, typed
         data = result.to_dict()
         values = {o.name: getattr(result, o.name, data.get(o.name)) for o in system.outputs}
         summary = getattr(result, "monte_carlo", None)
@@ -165,7 +169,25 @@ def register(app: Dash) -> None:
         figures = interactive_figures(system, result)
         request = typed if figures is None else no_update
         return (views.headline_texts(system, values), statistics, figures or [], request, None, "",
-                notes(caught))
+                notes(caught), typed)
+
+    # When a result arrives for other values than the fields now hold (a change made while an earlier run
+    # was starting can lose its own run), run again: the page always ends showing what its fields say.
+    @app.callback(
+        Output("rerun", "data"),
+        Input("shown-case", "data"),
+        State({"type": PARAM, "name": ALL}, "value"),
+        State({"type": PARAM, "name": ALL}, "id"),
+        State("system-name", "data"),
+        State("rerun", "data"),
+        prevent_initial_call=True,
+    )
+    def follow(shown, values, ids, name, rerun):
+        parameters = page_parameters(get_system(name))
+        typed = typed_values(parameters, ids, values)
+        if shown == typed or parse_typed(parameters, typed)[0] is None:
+            raise PreventUpdate
+        return (rerun or 0) + 1
 
     @app.callback(
         Output("figures", "children", allow_duplicate=True),
@@ -184,7 +206,7 @@ def register(app: Dash) -> None:
             raise PreventUpdate
         system = get_system(name)
         images = file_figures(system, run_typed(system, typed))
-        return [html.Figure([html.Img(src=uri, alt=stem), html.Figcaption(stem)], **{"data-figure": stem})
+        return [html.Figure([html.Img(src=uri, alt=stem), html.Figcaption(stem)], **views.data_attributes(figure=stem))
                 for stem, uri in images] or html.P("this run has no figures")
 
     @app.callback(

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -84,7 +85,7 @@ def layout(system: System, page: str) -> html.Div:
     number = PAGES[page]
     sweeps = number in (1, 2)
     questions = [html.Li([html.Span(manual.QUESTIONS[q], className="question"),
-                          html.Span(manual.HINTS.get(q, ""), className="hint")], value=q)
+                          html.Span(manual.HINTS.get(q, ""), className="hint")], value=str(q))
                  for q in manual.TASK_QUESTIONS[number]]
     aside = [html.H2("Parameters"), *controls(system.parameters, id_type=TASK_PARAM, values=STARTING_CASE)]
     if sweeps:
@@ -178,8 +179,8 @@ def constraint_panel(result) -> html.Table:
                              html.Td(f"{views.number_text(value)} {unit}" if value is not None else "-",
                                      className="number"),
                              html.Td("holds" if holds else "VIOLATED", className="ok" if holds else "violated")],
-                            **{"data-constraint": key.removeprefix("max_abs_").removesuffix("_rad_s")
-                               .removesuffix("_rad")}))
+                            **views.data_attributes(constraint=key.removeprefix("max_abs_").removesuffix("_rad_s")
+                                                    .removesuffix("_rad"))))
     return html.Table([html.Caption("Constraints over the run (KPI manual, task 1)"), html.Tbody(rows)],
                       className="constraints")
 
@@ -208,7 +209,7 @@ def compute(system: System, page: str, typed: dict[str, str], sweep_typed: dict[
     view = TaskView()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result = system.run(**values)
+        result: Any = system.run(**values)  # the align system's AlignmentResult (histories in run)
         runs = {f"{result.model} model": result.run}
         if result.model != "simplified":
             runs["simplified (1.19)"] = result.simplified_run

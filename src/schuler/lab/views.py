@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from typing import Any
 
 from dash import html
 
@@ -57,6 +58,11 @@ def quantity_text(value_si, output: Output) -> str:
     return f"{number_text(shown)} {unit}".strip()
 
 
+def data_attributes(**values) -> dict[str, Any]:
+    """``data-*`` attributes for a Dash component: ``data_attributes(param="x")`` -> ``{"data-param": "x"}``."""
+    return {f"data-{key.replace('_', '-')}": value for key, value in values.items()}
+
+
 RESULT = "result"
 """Component-id type of a headline number: ``{"type": RESULT, "key": KEY}`` (with ``data-result="KEY"``)."""
 
@@ -68,11 +74,11 @@ def headline(system: System, values: Mapping[str, object], with_ids: bool = Fals
     """
     rows = []
     for output in system.outputs:
-        ident = {"id": {"type": RESULT, "key": output.name}} if with_ids else {}
+        ident: dict[str, Any] = {"id": {"type": RESULT, "key": output.name}} if with_ids else {}
         rows.append(html.Tr([
             html.Th(output.description or output.name, scope="row"),
             html.Td(html.Span(quantity_text(values.get(output.name), output), **ident,
-                              **{"data-result": output.name}), className="number"),
+                              **data_attributes(result=output.name)), className="number"),
             html.Td(output.name, className="key"),
         ]))
     return html.Table(html.Tbody(rows), className="headline")
