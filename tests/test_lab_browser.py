@@ -171,6 +171,20 @@ def test_align_page_follows_latitude_and_drift_as_the_command_line_does(server, 
     assert problems == {"console": [], "page": [], "failed": [], "outside": []}
 
 
+def test_the_reproduction_table_is_one_click_away(server, browser):
+    watched = Watched(browser, server)
+    watched.open("align")
+    watched.page.locator("#reproduction-link").click()
+    rows = watched.page.locator("table.reproduction tbody tr")
+    watched.wait_for(lambda: rows.count() > 0, "the reproduction table")
+    assert watched.page.url == server + "align/reproduction"
+    reproduction = get_system("align").reproduce()
+    assert rows.count() == len(reproduction.rows)
+    verdicts = watched.page.locator("table.reproduction td.verdict").all_inner_texts()
+    assert [v.strip() for v in verdicts] == [row.verdict for row in reproduction.rows]
+    assert watched.close() == {"console": [], "page": [], "failed": [], "outside": []}
+
+
 def test_two_sessions_do_not_disturb_each_other(server, browser):
     first, second = Watched(browser, server), Watched(browser, server)
     for watched in (first, second):
