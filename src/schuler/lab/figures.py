@@ -122,7 +122,8 @@ def phase_trajectory(runs: dict, title: str = "Phase trajectory in the (delta, b
     """The platform's path in the (delta [arcmin], beta [arcsec]) plane, start marked, steady state starred."""
     traces = []
     for number, (label, run) in enumerate(runs.items()):
-        delta, beta = thin(to_unit(run.delta, "arcmin"), to_unit(run.beta, "arcsec"))
+        window = shown_window(run)  # past a few settling times the path sits on the steady point
+        delta, beta = thin(to_unit(run.delta[window], "arcmin"), to_unit(run.beta[window], "arcsec"))
         traces += [_line(delta, beta, label, line={"dash": DASHES[number % len(DASHES)]}),
                    _line(delta[:1], beta[:1], f"start, {label}", mode="markers", marker={"size": 9})]
     first = next(iter(runs.values())).analytic
