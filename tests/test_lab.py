@@ -80,6 +80,19 @@ def test_the_command_refuses_a_remote_host_in_one_line_before_listening(run_cli)
     assert out.stderr.count("\n") == 1 and out.stdout == ""
 
 
+def test_a_port_in_use_is_one_line_before_the_lab_is_built(run_cli):
+    import socket
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen(1)
+        port = taken.getsockname()[1]
+        out = run_cli("lab", "--port", port, "--no-browser")
+    assert out.code == 2
+    assert out.stderr.startswith(f"schuler: error: --port: cannot listen on 127.0.0.1:{port}: ")
+    assert out.stderr.count("\n") == 1
+
+
 @pytest.mark.parametrize("port", [-1, 65536, True])
 def test_ports_outside_the_tcp_range_are_refused(port):
     with pytest.raises(InvalidParameter, match="--port"):

@@ -13,7 +13,7 @@ import webbrowser
 
 import click
 
-from schuler.lab.server import LabServer, check_host, check_port, serve_until_signal
+from schuler.lab.server import LabServer, check_host, check_port, listen, serve_until_signal
 
 
 @click.command("lab", context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
@@ -31,16 +31,15 @@ def lab(port: int, host: str, allow_remote: bool, no_browser: bool) -> None:
     pages. Everything runs on this machine: the pages need no internet.
     Stop with Ctrl-C.
     """
-    host = check_host(host, allow_remote)
-    port = check_port(port)
+    sock = listen(check_host(host, allow_remote), check_port(port))
     from schuler.lab.app import create_app
 
     bench = create_app()
     try:
-        server = LabServer(bench.server, host, port, on_stop=bench.close)
-    except OSError as error:
-        bench.close()
-        raise click.ClickException(f"cannot listen on {host}:{port}: {error.strerror or error}") from None
+        server = LabServer(bench.server, sock, on_stop=bench.close)
+    except BaseException:
+        bench.close()  # the job cache folder goes with it
+        raise
     click.echo(f"schuler lab: serving on {server.url} (Ctrl-C to stop)")
     sys.stdout.flush()
     if not no_browser:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import shutil
 import tempfile
+import time
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
@@ -90,7 +91,11 @@ class Lab:
                 pass
         psutil.wait_procs(psutil.Process().children(recursive=True), timeout=3)
         self._manager.handle.close()
-        shutil.rmtree(self.cache_dir, ignore_errors=True)
+        for _ in range(3):  # a job ending just now may still be closing its files in the folder
+            shutil.rmtree(self.cache_dir, ignore_errors=True)
+            if not self.cache_dir.exists():
+                break
+            time.sleep(0.2)
 
 
 def create_app() -> Lab:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import ipaddress
 import signal
+import socket
 import threading
 from collections.abc import Callable
 
@@ -88,6 +89,26 @@ def url_of(host: str, port: int) -> str:
     return f"http://{shown}:{port}/"
 
 
+def listen(host: str, port: int) -> socket.socket:
+    """A socket listening on ``host:port`` (port 0: a free one), or a one-line error when that is impossible.
+
+    Bound here, before the application is built, so that a port in use is
+    reported at once and in one line (the HTTP server would print several and
+    exit by itself).
+    """
+    address = host.strip("[]")
+    family = socket.AF_INET6 if ":" in address else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind((address, port))
+        sock.listen(64)
+    except OSError as error:
+        sock.close()
+        raise InvalidParameter("--port", f"cannot listen on {host}:{port}: {error.strerror or error}") from None
+    return sock
+
+
 class LabServer:
     """A threaded WSGI server for the lab, stoppable from a signal handler or another thread.
 
@@ -95,25 +116,26 @@ class LabServer:
     ----------
     wsgi_app : callable
         The WSGI application (the Dash app's Flask server).
-    host : str
-        Address to bind (checked by :func:`check_host` beforehand).
-    port : int
-        Port; 0 picks a free one (see :attr:`port` after construction).
+    sock : socket.socket
+        The listening socket (:func:`listen`); the server takes it over.
     on_stop : callable, optional
         Called once after the server stopped (ends jobs, removes the job cache).
     """
 
-    def __init__(self, wsgi_app, host: str, port: int, on_stop: Callable[[], None] | None = None):
+    def __init__(self, wsgi_app, sock: socket.socket, on_stop: Callable[[], None] | None = None):
         from werkzeug.serving import WSGIRequestHandler, make_server
 
         class QuietHandler(WSGIRequestHandler):
             def log_request(self, code="-", size="-"):  # one line per request would flood the terminal
                 pass
 
-        self._server = make_server(host, port, wsgi_app, threaded=True, request_handler=QuietHandler)
+        host, port = sock.getsockname()[:2]
+        self._server = make_server(host, port, wsgi_app, threaded=True, request_handler=QuietHandler,
+                                   fd=sock.fileno())
+        sock.close()  # the server holds its own duplicate of the descriptor
         self._server.daemon_threads = True  # type: ignore[attr-defined]  # threaded: a ThreadingMixIn server
         self.host = host
-        self.port = int(self._server.server_port)
+        self.port = int(port)
         self._on_stop = on_stop
         self._stopped = threading.Event()
 
