@@ -299,6 +299,19 @@ def test_systems_that_fail_to_import_are_listed_as_not_available(request):
         bench.close()
 
 
+def test_the_lab_starts_without_the_task_pages_when_they_cannot_be_imported(monkeypatch):
+    monkeypatch.setitem(sys.modules, "schuler.lab.tasks", None)  # importing it now raises ImportError
+    monkeypatch.delattr(schuler.lab, "tasks")
+    bench = create_app()
+    try:
+        client = bench.server.test_client()
+        assert client.get("/align").status_code == 200
+        outputs = [d["output"] for d in client.get("/_dash-dependencies").get_json()]
+        assert not any("task" in output for output in outputs) and any("param-error" in o for o in outputs)
+    finally:
+        bench.close()
+
+
 def test_a_run_error_naming_a_parameter_goes_beside_its_control():
     parameters = system_page.page_parameters(ALIGN)
     owner, message = controls.error_owner(parameters, InvalidParameter("latitude", "beyond max_latitude"))

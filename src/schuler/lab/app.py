@@ -28,13 +28,16 @@ from dash import Dash, DiskcacheManager, Input, Output, dcc, html
 
 from schuler import __version__
 from schuler.contract import System
-from schuler.lab import system_page, tasks
+from schuler.lab import manual, system_page
 from schuler.registry import SYSTEM_MODULES, get_system
 
 MAX_REQUEST_BYTES = 256 * 1024
 """Largest request body the lab accepts, bytes (a page's callbacks send a few kB)."""
 
 ASSETS = Path(__file__).parent / "assets"
+
+TASK_PAGES = {f"task{n}" for n in manual.TASK_TITLES}
+"""The KPI task pages under ``/align/``."""
 
 CONTENT_SECURITY_POLICY = ("default-src 'self'; connect-src 'self'; img-src 'self' data: blob:; "
                            "style-src 'self' 'unsafe-inline'; font-src 'self' data:; object-src 'none'; "
@@ -117,9 +120,8 @@ def create_app() -> Lab:
     )
     available = systems_available()
     app.layout = lambda: _shell(available)
-    _routing(app, {a.name: a for a in available})
     system_page.register(app)
-    tasks.register(app)
+    _routing(app, {a.name: a for a in available}, _task_pages(app))
     _limits(app)
     return Lab(app, cache_dir, manager)
 
@@ -132,7 +134,7 @@ def _shell(available: list[Availability]) -> html.Div:
             links.append(html.Span(item.name, className="unavailable", title=f"not available: {item.reason}"))
         else:
             links.append(dcc.Link(item.name, href=f"/{item.name}", title=item.system.title))
-    task_links = [dcc.Link(f"task {n}", href=f"/align/task{n}") for n in tasks.TASKS]
+    task_links = [dcc.Link(f"task {n}", href=f"/align/task{n}") for n in manual.TASK_TITLES]
     return html.Div([
         dcc.Location(id="url"),
         dcc.Store(id="session", data=uuid.uuid4().hex),
@@ -146,7 +148,22 @@ def _shell(available: list[Availability]) -> html.Div:
     ])
 
 
-def _routing(app: Dash, by_name: dict[str, Availability]) -> None:
+def _task_pages(app: Dash):
+    """The KPI task pages' layout function, or None when they cannot be offered.
+
+    They are built on the gyrocompassing system; imported here, so that a
+    gyrocompassing module that fails to import makes them (and its own page)
+    "not available" instead of stopping the lab.
+    """
+    try:
+        from schuler.lab import tasks
+    except Exception:  # the align page says why
+        return None
+    tasks.register(app)
+    return tasks.layout
+
+
+def _routing(app: Dash, by_name: dict[str, Availability], task_layout) -> None:
     @app.callback(Output("page", "children"), Input("url", "pathname"))
     def route(pathname):
         parts = [p for p in (pathname or "/").split("/") if p]
@@ -161,8 +178,8 @@ def _routing(app: Dash, by_name: dict[str, Availability]) -> None:
             return system_page.layout(item.system)
         if len(parts) == 2 and parts[1] == "reproduction":
             return system_page.reproduction_layout(item.system)
-        if item.name == "align" and len(parts) == 2 and parts[1] in tasks.PAGES:
-            return tasks.layout(item.system, parts[1])
+        if item.name == "align" and len(parts) == 2 and parts[1] in TASK_PAGES and task_layout is not None:
+            return task_layout(item.system, parts[1])
         return _not_found(pathname)
 
 
@@ -179,7 +196,8 @@ def _index(available: list[Availability]) -> html.Div:
         html.P("Every system's parameters are controls; the numbers and figures follow as they change."),
         html.H2("Systems"), html.Ul(rows),
         html.H2("KPI lab tasks (gyrocompassing)"),
-        html.Ul([html.Li(dcc.Link(f"Task {n}: {title}", href=f"/align/task{n}")) for n, title in tasks.TASKS.items()]),
+        html.Ul([html.Li(dcc.Link(f"Task {n}: {title}", href=f"/align/task{n}"))
+                 for n, title in manual.TASK_TITLES.items()]),
     ])
 
 
