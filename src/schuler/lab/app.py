@@ -198,6 +198,8 @@ def _index(available: list[Availability]) -> html.Div:
         html.H2("KPI lab tasks (gyrocompassing)"),
         html.Ul([html.Li(dcc.Link(f"Task {n}: {title}", href=f"/align/task{n}"))
                  for n, title in manual.TASK_TITLES.items()]),
+        html.P("Task 4 (the MIS-2 system) is left out: the manual does not give that system's parameters.",
+               className="hint"),
     ])
 
 
