@@ -157,7 +157,7 @@ def parse_quantity(value, unit: str, *, name: str) -> float:
             spelled = _standard_gravity_spelling(text) if _gravity_units_expected(target) else _square_roots(text)
             try:
                 quantity = ureg.Quantity(spelled)
-            except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError, KeyError):
+            except Exception:  # pint raises many kinds on malformed text: "()" asserts, "deg (" fails to tokenize
                 raise InvalidParameter(name, f"cannot read {shown} as a quantity in {unit or 'plain numbers'}")
             if not isinstance(quantity, ureg.Quantity):
                 quantity = ureg.Quantity(float(quantity), "")
