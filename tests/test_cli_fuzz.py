@@ -116,7 +116,7 @@ COMMAND_NAMES = sorted({(system, command) for system, command, _ in COMMANDS})
 
 
 @pytest.mark.parametrize(("system", "command"), COMMAND_NAMES, ids=lambda x: str(x))
-@settings(max_examples=10, deadline=None, phases=[Phase.generate], derandomize=True,
+@settings(max_examples=6, deadline=None, phases=[Phase.generate], derandomize=True,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=st.data())
 def test_every_command_under_careless_input(system, command, data, run_cli, budget, tmp_path_factory):
