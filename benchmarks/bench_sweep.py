@@ -34,8 +34,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from schuler.study.scenario import parse_scenario
 from schuler.gyrocompassing.case import DegradedAccuracyWarning
+from schuler.study.scenario import parse_scenario
 from schuler.study.sweep import run_sweep
 
 # the grid reaches 80 deg latitude on purpose: the accuracy warning is expected there

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 import pytest
-import test_study_fake_system as fake
 
+import test_study_fake_system as fake
 from schuler.exceptions import ScenarioError
 from schuler.study.scenario import load_scenario, parse_scenario
 

@@ -8,13 +8,13 @@ import os
 import numpy as np
 import pandas as pd
 import pytest
-import test_study_fake_system as fake
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import test_study_fake_system as fake
 from schuler.exceptions import ScenarioError
-from schuler.study.scenario import parse_scenario
 from schuler.study.plan import grid_values, parse_axis, plan_sweep
+from schuler.study.scenario import parse_scenario
 from schuler.study.store import chunk_path
 from schuler.study.summary import histograms
 from schuler.study.sweep import run_sweep

@@ -19,7 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.core.geometry import time_grid
 from schuler.ground_gyrocompass import motion
+from schuler.ground_gyrocompass.estimate import NorthEstimate, identify
 from schuler.ground_gyrocompass.grid import (
     AXES,
     STEP_ALPHA0,
@@ -30,8 +32,6 @@ from schuler.ground_gyrocompass.grid import (
     run_stage,
     source_boxes,
 )
-from schuler.ground_gyrocompass.estimate import NorthEstimate, identify
-from schuler.core.geometry import time_grid
 from schuler.ground_gyrocompass.results import NorthIdentification, ReproductionFigures
 from schuler.params import Parameter, ParameterSet
 from schuler.references import FEDOROV_2020

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from schuler import __version__
+from schuler.contract import ReportSection, System
 from schuler.exceptions import SchulerError
 from schuler.io import MIN_FONT_KEY, write_text
-from schuler.contract import ReportSection, System
 from schuler.registry import SYSTEM_MODULES
 from schuler.study.systems import load_system
 

@@ -50,17 +50,26 @@ from pathlib import Path
 from typing import Any, Literal, Union
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr, ValidationError
-from pydantic import create_model
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+    create_model,
+)
 from scipy.special import ndtri
 
-from schuler.exceptions import InvalidParameter, ScenarioError
 from schuler.contract import System
 from schuler.core.random import RandomStreams
+from schuler.exceptions import InvalidParameter, ScenarioError
 from schuler.params import Case, Parameter
 from schuler.registry import SYSTEM_MODULES, get_system
-from schuler.units import to_unit
 from schuler.study.systems import load_system
+from schuler.units import to_unit
 
 SIMULATION_KEYS = ("duration", "output_step")
 """Parameters that may also be set in the ``[simulation]`` table (where the system has them)."""

@@ -22,6 +22,7 @@ from schuler.results import Result
 from schuler.study.plan import SweepPlan
 from schuler.study.store import _text_columns, chunk_path, column_name
 
+
 @dataclass
 class SweepSummary(Result):
     """What a sweep did and the statistics of each result over all cases.
