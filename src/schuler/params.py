@@ -161,7 +161,7 @@ class Parameter:
             try:
                 number = int(str(value).strip()) if not isinstance(value, int) or isinstance(value, bool) else value
             except ValueError:
-                raise InvalidParameter(label, f"{value!r} is not a whole number")
+                raise InvalidParameter(label, f"{value!r} is not a whole number") from None
             self._check_range(number, number, value, label)
             return number
         si = parse_quantity(value, self.unit, name=label)

@@ -158,7 +158,9 @@ def parse_quantity(value, unit: str, *, name: str) -> float:
             try:
                 quantity = ureg.Quantity(spelled)
             except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError, KeyError):
-                raise InvalidParameter(name, f"cannot read {shown} as a quantity in {unit or 'plain numbers'}")
+                raise InvalidParameter(
+                    name, f"cannot read {shown} as a quantity in {unit or 'plain numbers'}"
+                ) from None
             if not isinstance(quantity, ureg.Quantity):
                 quantity = ureg.Quantity(float(quantity), "")
             if not str(quantity.units) and str(target):
@@ -172,7 +174,7 @@ def parse_quantity(value, unit: str, *, name: str) -> float:
     try:
         magnitude = float(si.magnitude)
     except TypeError:
-        raise InvalidParameter(name, f"{shown} is not a single number")
+        raise InvalidParameter(name, f"{shown} is not a single number") from None
     if not math.isfinite(magnitude):
         raise InvalidParameter(name, f"{shown} is not a finite number")
     return magnitude

@@ -118,7 +118,7 @@ def _read_rows(path: Path):
                 try:
                     value = float(text)
                 except ValueError:
-                    raise InvalidParameter(f"{path} line {line}", f"{column} {text!r} is not a number")
+                    raise InvalidParameter(f"{path} line {line}", f"{column} {text!r} is not a number") from None
                 if not math.isfinite(value):
                     raise InvalidParameter(f"{path} line {line}", f"{column} is {text} (not a finite number)")
                 values.append(value)

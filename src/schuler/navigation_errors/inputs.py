@@ -212,7 +212,7 @@ def earth_constants(earth: str = "default", radius: float | None = None, gravity
 
 def earth_constant_arrays(earth: np.ndarray, radius: np.ndarray, gravity: np.ndarray):
     """:func:`earth_constants` for arrays of cases (NaN radius or gravity: not set), m and m/s^2."""
-    earth = np.where(earth == None, "default", earth)
+    earth = np.where(np.equal(earth, None), "default", earth)
     R, g = radius.astype(float).copy(), gravity.astype(float).copy()
     for name in set(earth.tolist()):
         chosen = earth == name

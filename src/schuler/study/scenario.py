@@ -47,7 +47,7 @@ import difflib
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, Union
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import (
@@ -85,7 +85,7 @@ def simulation_keys(parameters) -> dict[str, str]:
     names = {spec.name for spec in parameters}
     return {key: key for key in SIMULATION_KEYS if key in names}
 
-Value = Union[StrictBool, StrictInt, StrictFloat, StrictStr]
+Value = StrictBool | StrictInt | StrictFloat | StrictStr
 """What a TOML scalar can be; the Parameter decides what it means."""
 
 _STRICT = ConfigDict(extra="forbid")
