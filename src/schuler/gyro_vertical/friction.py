@@ -159,12 +159,12 @@ class AccelerationInput:
 
     @classmethod
     def constant(cls, W_x: float = 0.0, W_y: float = 0.0) -> AccelerationInput:
-        return cls([0.0], [W_x], [W_y])
+        return cls(np.zeros(1), np.array([W_x], dtype=float), np.array([W_y], dtype=float))
 
     @classmethod
     def ramp(cls, W_x_final: float, W_y_final: float, duration: float) -> AccelerationInput:
         """From zero to the final values over ``duration`` (s), then held."""
-        return cls([0.0, duration], [0.0, W_x_final], [0.0, W_y_final])
+        return cls(np.array([0.0, duration]), np.array([0.0, W_x_final]), np.array([0.0, W_y_final]))
 
     def piece(self, index: int):
         """Start (s), values (m/s^2) and slopes (m/s^3) of piece ``index``."""
