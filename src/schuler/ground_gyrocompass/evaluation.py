@@ -64,8 +64,9 @@ INSTRUMENT_PARAMETERS = (
     Parameter("decay_rate", "1/s", motion.SOURCE_LAMBDA,
               "Decay rate lambda of the rotor's angular momentum, H = H_m exp(-lambda t) (known, or the nominal "
               "start when identified).", minimum=0, exclusive_minimum=True),
-    Parameter("hm", "N*m*s", motion.SOURCE_HM, "Initial rotor angular momentum H_m (known, or nominal when identified).",
-              minimum=0, exclusive_minimum=True),
+    Parameter("hm", "N*m*s", motion.SOURCE_HM,
+              "Initial rotor angular momentum H_m (known, or nominal when identified).", minimum=0,
+              exclusive_minimum=True),
     Parameter("inertia", "kg*m^2", motion.SOURCE_INERTIA, "Moment of inertia J about the suspension axis.",
               minimum=0, exclusive_minimum=True),
     Parameter("latitude", "deg", None, "Latitude of the site: Omega_h = Omega cos(latitude) (not set: --omega-h).",
@@ -98,7 +99,8 @@ EXCLUSIVE = (("latitude", "omega_h"),)
 
 PARAMETERS = ParameterSet(
     (*MOTION_PARAMETERS, *INSTRUMENT_PARAMETERS, *OBSERVATION_PARAMETERS, READING_PARAMETER, *FIT_PARAMETERS),
-    owner="north", exclusive=EXCLUSIVE, renamed={"lambda": "decay_rate", "step": "output_step", "noise": "readout_noise"})
+    owner="north", exclusive=EXCLUSIVE,
+    renamed={"lambda": "decay_rate", "step": "output_step", "noise": "readout_noise"})
 """Every option of ``schuler north run`` (and key of a ``north`` scenario)."""
 
 OUTPUTS = (
@@ -164,7 +166,7 @@ def fit_bytes(samples: int, method: str, unknowns: int) -> int:
 
 def member_bytes(case: Case) -> int:
     """Memory one Monte Carlo member holds while its record is made (the fits run one at a time)."""
-    return sample_count(case["duration"], case["output_step"]) * RECORD_BYTES_PER_SAMPLE
+    return int(sample_count(case["duration"], case["output_step"]) * RECORD_BYTES_PER_SAMPLE)
 
 
 def omega_h_of(cases: Cases) -> np.ndarray:

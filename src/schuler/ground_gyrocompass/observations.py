@@ -96,7 +96,8 @@ def read_record(path):
 
 
 def _read_rows(path: Path):
-    times, angles = [], []
+    times: list[float] = []
+    angles: list[float] = []
     with path.open(newline="", encoding="utf-8-sig") as handle:
         reader = csv.reader(handle)
         header = next(reader, None)
