@@ -126,7 +126,8 @@ def run_sweep(
         _report_warnings(caught)
     seconds = time.perf_counter() - began
     statistics, per_axis, files = gather(plan, out_dir, write_csv=write_csv)
-    files.append(write_json(out_dir / "summary.json", json_safe({"manifest": plan.manifest(), "statistics": statistics})))
+    summary = json_safe({"manifest": plan.manifest(), "statistics": statistics})
+    files.append(write_json(out_dir / "summary.json", summary))
     if plots:
         files.extend(plot_sweep_summary(plan, statistics, per_axis, histograms(plan, out_dir, statistics), out_dir))
     computed_cases = sum(plan.chunk_range(i)[1] - plan.chunk_range(i)[0] for i in todo)
