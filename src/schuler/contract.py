@@ -142,7 +142,8 @@ class Cases:
         """A numeric parameter as a float array (NaN where not set)."""
         array = self._values[name]
         if array.dtype == object:
-            unset = np.equal(array, None)  # type: ignore[call-overload]  # numpy's stubs omit None, compared elementwise in object arrays
+            # numpy's stubs leave out None, which object arrays compare elementwise
+            unset = np.equal(array, None)  # type: ignore[call-overload]
             return np.where(unset, np.nan, array).astype(float) if unset.any() else array.astype(float)
         return array.astype(float)
 
@@ -155,7 +156,8 @@ class Cases:
         """Which cases set the parameter (bool array)."""
         array = self._values[name]
         if array.dtype == object:
-            return ~np.equal(array, None)  # type: ignore[call-overload]  # numpy's stubs omit None, compared elementwise in object arrays
+            # numpy's stubs leave out None, which object arrays compare elementwise
+            return ~np.equal(array, None)  # type: ignore[call-overload]
         if array.dtype.kind == "f":
             return ~np.isnan(array)
         return np.ones(self.n, dtype=bool)

@@ -212,7 +212,8 @@ def earth_constants(earth: str = "default", radius: float | None = None, gravity
 
 def earth_constant_arrays(earth: np.ndarray, radius: np.ndarray, gravity: np.ndarray):
     """:func:`earth_constants` for arrays of cases (NaN radius or gravity: not set), m and m/s^2."""
-    earth = np.where(np.equal(earth, None), "default", earth)  # type: ignore[call-overload]  # numpy's stubs omit None, compared elementwise in object arrays
+    # numpy's stubs leave out None, which object arrays compare elementwise
+    earth = np.where(np.equal(earth, None), "default", earth)  # type: ignore[call-overload]
     R, g = radius.astype(float).copy(), gravity.astype(float).copy()
     for name in set(earth.tolist()):
         chosen = earth == name
