@@ -229,6 +229,9 @@ def record_window(cases: Cases, bytes_per_sample: int) -> np.ndarray:
 
 def true_motion(time: np.ndarray, truth: dict[str, np.ndarray], fidelity: str) -> np.ndarray:
     """alpha(t_k) of each case, shape (cases, samples), rad: closed form (9) or numerical integration."""
+    # the estimator fits the closed form (9), whichever way the record is made: a decay so slow that
+    # its Bessel arguments lose their phase is refused
+    motion.check_closed_form_reach(truth["decay_rate"], truth["coefficient"])
     # the closed form, which the estimator fits, needs z(t) = z0 exp(-lambda t / 2) > 0 (eq. (5)): after
     # lambda t of about 1500 it underflows, Y0(z) is infinite, and neither record nor fit can be computed
     z_end, _ = motion.bessel_argument(time[-1], truth["decay_rate"], truth["coefficient"])
