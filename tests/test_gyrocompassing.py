@@ -271,7 +271,8 @@ def test_batched_sweep_equals_single_runs():
                                                     damping=[0.5, 0.8, 1.3][i]), "full", duration=3000)
         assert batch["azimuth_error_simulated_rad"][i] == pytest.approx(single.delta[-1], rel=1e-10)
         assert batch["settling_time_simulated_s"][i] == single.simulated.settling_time[0]
-        assert batch["max_abs_delta_rate_rad_per_s"][i] == pytest.approx(single.simulated.max_abs_delta_rate[0], rel=1e-10)
+        assert batch["max_abs_delta_rate_rad_per_s"][i] == pytest.approx(single.simulated.max_abs_delta_rate[0],
+                                                                         rel=1e-10)
         assert batch["azimuth_error_simulated_rad"][i] == pytest.approx(batch["azimuth_error_rad"][i], rel=1e-9)
 
 
@@ -320,8 +321,8 @@ def test_near_the_pole():
     values = [run_.simulated.azimuth_error[0], run_.analytic["azimuth_error_analytic_rad"], run_.analytic["c_a"]]
     assert np.all(np.isfinite(values))
     # accuracy degrades as 1/cos(latitude): 0.01 deg/h east gives 1/cos(89.5 deg) times the equator's
-    assert run_.simulated.azimuth_error[0] == pytest.approx(0.01 * DEG_PER_H / (EARTH_RATE * math.cos(math.radians(89.5))),
-                                                            rel=1e-8)
+    expected = 0.01 * DEG_PER_H / (EARTH_RATE * math.cos(math.radians(89.5)))
+    assert run_.simulated.azimuth_error[0] == pytest.approx(expected, rel=1e-8)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         run_case(AlignmentCase(latitude=math.radians(60)), duration=300)
@@ -364,7 +365,8 @@ def test_system_evaluate_is_vectorised_and_matches_run():
     mixed = SYSTEM.evaluate_values({"latitude": np.radians([40.0, 40.0]), "accel_bias_x": np.full(2, 100 * MICRO_G),
                                     "model": np.array(["simplified", "full"])}, fidelity="closed")
     assert mixed["azimuth_error_rad"][0] == 0.0
-    assert mixed["azimuth_error_rad"][1] / ARCSEC == pytest.approx(-100e-6 * math.tan(math.radians(40)) / ARCSEC, rel=3e-3)
+    assert mixed["azimuth_error_rad"][1] / ARCSEC == pytest.approx(-100e-6 * math.tan(math.radians(40)) / ARCSEC,
+                                                                   rel=3e-3)
     assert SYSTEM.name == "align"
 
 

@@ -121,8 +121,9 @@ def write_files(result: Result, out_dir: Path) -> list[Path]:
         figures["align_time_history"] = plots.time_history(runs)
         figures["align_phase_trajectory"] = plots.phase_trajectory(runs)
         columns = {"t_s": run.time, "delta_rad": run.delta, "beta_rad": run.beta, "delta_rate_rad_s": run.delta_rate}
-        if run.alpha is not None:
-            columns.update({"alpha_rad": run.alpha, "mu_rad": run.mu, "nu_rad": run.nu})
+        # the level angles of the full models (None on the simplified one)
+        level = {"alpha_rad": run.alpha, "mu_rad": run.mu, "nu_rad": run.nu}
+        columns.update({name: values for name, values in level.items() if values is not None})
         files.append(write_dataframe_csv(pd.DataFrame(columns), out_dir / "align_time_history.csv"))
     if result.monte_carlo is not None:
         samples = to_unit(result.monte_carlo.samples["azimuth_error_rad"], "arcmin")

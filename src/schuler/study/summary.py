@@ -17,10 +17,12 @@ from typing import ClassVar
 import numpy as np
 
 from schuler.core.stats import StreamingStatistics
+from schuler.exceptions import ScenarioError
 from schuler.io import atomic_path
 from schuler.results import Result
 from schuler.study.plan import SweepPlan
 from schuler.study.store import _text_columns, chunk_path, column_name
+
 
 @dataclass
 class SweepSummary(Result):
@@ -143,11 +145,11 @@ class _Accumulator:
                 np.minimum.at(slot["min"], where, kept)
                 np.maximum.at(slot["max"], where, kept)
 
-    def statistics(self) -> dict[str, dict[str, float]]:
+    def statistics(self) -> dict[str, dict[str, float | None]]:
         summary = {}
         for name, stats in self.overall.items():
             empty = stats.count == 0
-            entry = {"count": int(stats.count), "nan_count": self.nan_count[name]}
+            entry: dict[str, float | None] = {"count": int(stats.count), "nan_count": self.nan_count[name]}
             for key, value in (("mean", stats.mean), ("std", stats.std), ("min", stats.min), ("max", stats.max)):
                 entry[key] = None if empty else float(value[0])
             for q in (5, 50, 95):
@@ -219,8 +221,12 @@ def gather(plan: SweepPlan, out_dir: Path, *, write_csv: bool = True) -> tuple[d
             if csv_tmp is not None:
                 if csv_writer is None:
                     options = pa_csv.WriteOptions(quoting_style="needed")
-                    csv_writer = stack.enter_context(pa_csv.CSVWriter(str(csv_tmp), writer.schema, write_options=options))
+                    csv_writer = stack.enter_context(
+                        pa_csv.CSVWriter(str(csv_tmp), writer.schema, write_options=options)
+                    )
                 csv_writer.write_table(table)
+        if accumulator is None:  # raised inside, so that no empty results file is left behind
+            raise ScenarioError(f"{out_dir}: the sweep has no cases to gather")
     return accumulator.statistics(), accumulator.per_axis(), targets
 
 

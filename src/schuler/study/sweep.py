@@ -48,9 +48,9 @@ import numpy as np
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from schuler.results import json_safe
 from schuler.io import remove_stale_parts, write_json
 from schuler.memory import format_bytes
+from schuler.results import json_safe
 from schuler.study.executors import InProcess, make_executor
 from schuler.study.plan import DEFAULT_CHUNK_SIZE, SweepPlan, plan_sweep
 from schuler.study.scenario import Scenario
