@@ -229,7 +229,8 @@ def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
         with warnings.catch_warnings():
             # evaluate has warned about the latitude already; the histories are the same case
             warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")
-            histories = simulate_case(single, model, duration=outputs["simulated_duration_s"], time_step=case["output_step"])
+            histories = simulate_case(single, model, duration=outputs["simulated_duration_s"],
+                                      time_step=case["output_step"])
             simplified = histories
             if model != "simplified":
                 # (1.19) beside the model for the comparison figures; the model's own run has warned already

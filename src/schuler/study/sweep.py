@@ -43,10 +43,10 @@ from __future__ import annotations
 
 import time
 import warnings
-
-import numpy as np
 from collections.abc import Callable, Iterable
 from pathlib import Path
+
+import numpy as np
 
 from schuler.io import remove_stale_parts, write_json
 from schuler.memory import format_bytes
