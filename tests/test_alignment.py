@@ -47,7 +47,8 @@ def static_batch(latitude, roll, pitch, heading, *, seconds=300.0, dt=0.01, gyro
     return StaticBatch(np.tile(gyro * dt, (1, n, 1)), np.tile(accel * dt, (1, n, 1)), dt, latitude, G)
 
 
-SIMPLE = ErrorModel(gyro=SensorErrors(bias=np.full(3, 0.01 * DEG_H), random_walk=np.full(3, 0.002 * math.radians(1) / 60)),
+SIMPLE = ErrorModel(gyro=SensorErrors(bias=np.full(3, 0.01 * DEG_H),
+                                      random_walk=np.full(3, 0.002 * math.radians(1) / 60)),
                     accel=SensorErrors(bias=np.full(3, 25e-6 * G), random_walk=np.full(3, 10e-6 * G)), name="test")
 
 
@@ -146,7 +147,8 @@ def test_inertial_frame_tilt_impulse_responses(fraction):
     k = int(fraction * clean.samples)
     roll_kernel = 2 * fraction if fraction < 0.5 else 1.0
     pitch_kernel = -fraction if fraction < 0.5 else 3 * fraction - 2
-    for axis, expected, read in ((0, roll_kernel, lambda e: e.roll_rad[0]), (1, pitch_kernel, lambda e: e.pitch_rad[0])):
+    cases = ((0, roll_kernel, lambda e: e.roll_rad[0]), (1, pitch_kernel, lambda e: e.pitch_rad[0]))
+    for axis, expected, read in cases:
         gyro = clean.gyro_increment.copy()
         gyro[0, k, axis] += amplitude
         estimate = align_inertial(StaticBatch(gyro, clean.accel_increment, 0.1, latitude, G))

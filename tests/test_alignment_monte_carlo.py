@@ -30,7 +30,8 @@ TACTICAL = preset("tactical")
 def white(gyro_bias: float, accel_bias: float, name: str) -> ErrorModel:
     """Constant biases and white noise only: what the limits model (tactical-grade N of both triads)."""
     return ErrorModel(gyro=SensorErrors(bias=np.full(3, gyro_bias), random_walk=TACTICAL.gyro.random_walk),
-                      accel=SensorErrors(bias=np.full(3, accel_bias), random_walk=TACTICAL.accel.random_walk), name=name)
+                      accel=SensorErrors(bias=np.full(3, accel_bias), random_walk=TACTICAL.accel.random_walk),
+                      name=name)
 
 
 # noise-dominated: 0.01 deg/h leaves 0.9 mrad of heading, the tactical ARW 35 mrad over 300 s

@@ -389,11 +389,10 @@ def accuracy_limit(method: str, errors, *, latitude: float, heading: float, dura
     AccuracyLimit
         Bias part from :func:`static_errors` for independent axes, noise part from
         :func:`random_walk_factor` (or :func:`gyrocompass_noise`); the coarse level noise is
-        N_a / (g sqrt(T)), the Kalman filter's its tracking noise (:func:`kalman_level_noise`); the inertial-frame level noise adds the gyro-propagated tilt
-        (north N sqrt(2 T / 3), east N sqrt(T / 6)) and takes its specific-force direction over T / 2
-        (sqrt(2) N_a / (g sqrt(T))),
-        and its bias part the gyro drift to the window's end: (3/4) b_gN T in the north tilt, b_gD T / 2 in
-        heading.
+        N_a / (g sqrt(T)), the Kalman filter's its tracking noise (:func:`kalman_level_noise`); the
+        inertial-frame level noise adds the gyro-propagated tilt (north N sqrt(2 T / 3), east N sqrt(T / 6))
+        and takes its specific-force direction over T / 2 (sqrt(2) N_a / (g sqrt(T))), and its bias part the
+        gyro drift to the window's end: (3/4) b_gN T in the north tilt, b_gD T / 2 in heading.
     """
     if method not in METHODS:
         raise InvalidParameter("method", f"{method!r} is not one of {', '.join(METHODS)}")
