@@ -133,17 +133,22 @@ def _resolved(sigma_body, heading: np.ndarray) -> np.ndarray:
 
 def _initial_covariance(model, tuning: KalmanTuning, batch: StaticBatch, heading: np.ndarray,
                         initial_window_s: float) -> np.ndarray:
-    """P0 (m, 12, 12): the start's error is M b (correlated with the bias states) plus its noise, inflated."""
-    limit = accuracy_limit("inertial_frame", model, latitude=batch.latitude_rad, heading=float(np.median(heading)),
-                           duration=initial_window_s, gravity=batch.gravity)
-    tilt_noise = max(limit.roll_noise_rad, limit.pitch_noise_rad)
+    """P0 (m, 12, 12): the start's error is M b (correlated with the bias states) plus its noise, inflated.
+
+    The noise part is the larger of the start's limits at headings 0 and 90 deg (the axes' noise may differ),
+    the same for every record: a record's estimate does not depend on the others of its batch.
+    """
+    limits = [accuracy_limit("inertial_frame", model, latitude=batch.latitude_rad, heading=psi,
+                             duration=initial_window_s, gravity=batch.gravity) for psi in (0.0, math.pi / 2)]
+    tilt_noise = max(max(limit.roll_noise_rad, limit.pitch_noise_rad) for limit in limits)
+    heading_noise = max(limit.heading_noise_rad for limit in limits)
     biases = np.zeros((heading.size, 6, 6))
     biases[:, 0:3, 0:3] = _resolved(tuning.gyro_bias, heading)
     biases[:, 3:6, 3:6] = _resolved(tuning.accel_bias, heading)
     M = coarse_error_map(batch.latitude_rad, batch.gravity)
     P = np.zeros((heading.size, STATES, STATES))
     P[:, 0:3, 0:3] = M @ biases @ M.T + INFLATION * np.diag(
-        [tilt_noise**2, tilt_noise**2, limit.heading_noise_rad**2])
+        [tilt_noise**2, tilt_noise**2, heading_noise**2])
     P[:, 0:3, 6:12] = M @ biases
     P[:, 6:12, 0:3] = np.swapaxes(P[:, 0:3, 6:12], 1, 2)
     P[:, 3:6, 3:6] = np.eye(3) * tuning.velocity_noise**2
