@@ -28,9 +28,14 @@ from schuler.alignment.six_position import SixPositionPlan, calibrate_six_positi
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.simulate import ImuSimulator
 from schuler.imu.spec import preset
+from schuler.memory import require
 from schuler.results import Result
 
 OFF_DIAGONAL = [(0, 1), (0, 2), (1, 0), (1, 2), (2, 0), (2, 1)]
+
+BYTES_PER_SAMPLE = 400
+"""Held per sample of a simulated procedure: truth, samples, the simulator's and the fits' temporaries
+(measured: about 160 bytes; the rest is margin)."""
 
 
 def calibration_model(grade: str) -> ErrorModel:
@@ -109,6 +114,8 @@ class CalibrationComparison(Result):
 
 def _six_position(model: ErrorModel, latitude_rad: float, dwell_s: float, turn_s: float, dt: float, seed: int):
     plan = SixPositionPlan(latitude_rad=latitude_rad, dwell_s=dwell_s, turn_s=turn_s, sample_interval_s=dt)
+    require(plan.samples * BYTES_PER_SAMPLE, f"the six-position record of {plan.samples:,} samples",
+            "--dwell, --turn or --imu-rate")
     gyro_truth, accel_truth = plan.truth()
     gyro, accel, constants = _record(model, gyro_truth, accel_truth, dt, seed)
     fit = calibrate_six_position(gyro, accel, plan, model.gyro.random_walk, model.accel.random_walk)
@@ -128,6 +135,9 @@ def _six_position(model: ErrorModel, latitude_rad: float, dwell_s: float, turn_s
 
 def _multi_static(model: ErrorModel, latitude_rad: float, positions: int, static_s: float, dt: float, seed: int):
     plan = MultiStaticPlan(positions=positions, static_s=static_s, sample_interval_s=dt, latitude_rad=latitude_rad)
+    samples = (plan.initial_s + positions * (static_s + plan.move_s)) / dt
+    require(samples * BYTES_PER_SAMPLE, f"the multi-static record of {samples:,.0f} samples",
+            "--positions, --static or --imu-rate")
     gyro_truth, accel_truth = plan.truth(seed)
     gyro, accel, constants = _record(model, gyro_truth, accel_truth, dt, seed)
     fit = calibrate_multi_static(gyro, accel, dt, initial_s=plan.initial_s, gravity_m_s2=plan.gravity,

@@ -93,8 +93,8 @@ NORTH_COMPARE_PARAMETERS = ParameterSet((
 CALIBRATE_COMPARE_PARAMETERS = ParameterSet((
     Parameter("imu", "", "industrial", "IMU grade of the simulated IMU.", choices=GRADES, kind="choice"),
     Parameter("latitude", "deg", SIMULATED_LATITUDE_DEG, "Site latitude.", minimum=-89, maximum=89),
-    Parameter("dwell", "s", 60.0, "Six-position dwell per position.", minimum=1),
-    Parameter("turn", "s", 36.0, "Six-position rate-test turn (one revolution).", minimum=1),
+    Parameter("dwell", "s", 60.0, "Six-position dwell per position.", minimum=1, maximum=3600),
+    Parameter("turn", "s", 36.0, "Six-position rate-test turn (one revolution).", minimum=1, maximum=600),
     Parameter("positions", "", 36, "Multi-static orientations after the initial static period.", minimum=9,
               maximum=1000, kind="integer"),
     Parameter("static", "s", 3.0, "Multi-static hold per orientation.", minimum=1.5, maximum=600),
