@@ -122,15 +122,15 @@ def test_calibration_round_trip_within_the_predicted_accuracy(seed):
     """Known errors of one industrial IMU in, estimates out: z = (estimate - true) / predicted 1-sigma.
 
     Six positions: the rms of its 24 z is 1 within the spread of a chi distribution of 24 degrees of freedom
-    (0.6-1.4 is beyond 2.5 standard deviations); no |z| above 4.5. Multi-static: its covariance is the
-    residual variance times (J^T J)^-1 and the threshold is picked by the smallest residual, so it states less
-    than it makes (rms z 1.2-1.7 over seeds 0-2): no |z| above 5 and rms z below 2.5.
+    (0.6-1.4 is beyond 2.5 standard deviations); no |z| above 4.5. Multi-static: it states less than it makes
+    (rms z 1.0-1.6 over seeds 0-2 and two grades; accelerometer biases 1.5-1.9, see multi_static's notes):
+    no |z| above 5 and rms z below 2.
     """
     result = compare_calibration("industrial", latitude_rad=LATITUDE, seed=seed)
     six, multi = _z(result.six_position), _z(result.multi_static)
     assert 0.6 < np.sqrt(np.mean(six**2)) < 1.4
     assert np.abs(six).max() < 4.5
-    assert np.sqrt(np.mean(multi**2)) < 2.5
+    assert np.sqrt(np.mean(multi**2)) < 2.0
     assert np.abs(multi).max() < 5.0
     assert result.multi_static["static_intervals"] >= 37   # every orientation and the initial period found
 
