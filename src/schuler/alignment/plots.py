@@ -68,25 +68,27 @@ def north_figure(result: NorthComparison):
     plt = _pyplot()
     fig, (left, right) = plt.subplots(1, 2, figsize=(WIDTH_IN, 3.8), dpi=DPI, width_ratios=(3, 2))
     times = np.asarray(result.versus_time["duration_s"])
+    styles = ("-", "--", ":")   # four positions and carousel share a closed form with one gyro: dashes keep both seen
     for index, method in enumerate(NORTH_METHODS):
-        left.loglog(times, np.asarray(result.versus_time[method]) * ARCMIN, color=f"C{index}", label=LABELS[method])
+        left.loglog(times, np.asarray(result.versus_time[method]) * ARCMIN, styles[index], color=f"C{index}",
+                    label=LABELS[method])
         sigma = result.methods[method]["monte_carlo_sigma_rad"]
         if sigma is not None:
             left.loglog([result.duration_s], [sigma * ARCMIN], "o", color=f"C{index}")
     if "ground_gyrocompass" in result.versus_time:
-        left.loglog(times, np.asarray(result.versus_time["ground_gyrocompass"]) * ARCMIN, "k--",
+        left.loglog(times, np.asarray(result.versus_time["ground_gyrocompass"]) * ARCMIN, "k-.",
                     label=LABELS["ground_gyrocompass"])
     left.set_xlabel("observation time, s")
     left.set_ylabel("north 1-sigma, arcmin")
     left.set_title(f"{result.grade} grade (dots: Monte Carlo)")
     left.grid(alpha=0.3, which="both")
-    left.legend(loc="lower left")
+    left.legend(loc="center left")
     grades = list(result.versus_grade)
     positions = np.arange(len(grades))
     for index, method in enumerate(NORTH_METHODS):
         values = [result.versus_grade[g][method] * ARCMIN for g in grades]
         right.semilogy(positions, values, "o-", color=f"C{index}")
-    right.set_xticks(positions, grades, rotation=30)
+    right.set_xticks(positions, grades, rotation=30, ha="right")
     right.set_ylabel("north 1-sigma, arcmin")
     right.set_title(f"per grade, {result.duration_s:g} s")
     right.grid(alpha=0.3, which="both")
