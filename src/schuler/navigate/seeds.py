@@ -41,9 +41,9 @@ from schuler.core.earth import (
     transverse_radius,
 )
 from schuler.gyro_vertical.model import GyroVertical
-from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, SpeedProfile
 from schuler.gyro_vertical.quasi_steady import quasi_steady_response
 from schuler.gyro_vertical.reproduction import worked_example
+from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, SpeedProfile
 from schuler.navigate.errors import InitialErrors, SensorErrors
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.trajectory import GreatCircle, WaypointProfile
