@@ -32,6 +32,7 @@ QUICK = {
     "align": ["--duration", "600"],
     "north": ["--duration", "600"],
     "calibrate": [],
+    "navigate": ["--duration", "600", "--imu-rate", "10", "--output-step", "60"],
 }
 """Options that keep each system's base case short; the fuzzed option comes after them."""
 

@@ -115,7 +115,7 @@ def plot_bollay(comparison):
 
 def plot_drozdovich(comparison):
     """Source 000's worked example on the nonlinear platform: velocity error along track beside (29)."""
-    fig, axis = _figure(figsize=(WIDTH, 4.5))
+    fig, axis = _figure(figsize=(WIDTH, 5.2))
     hours = comparison.t_s / 3600.0
     axis.plot(hours, comparison.nonlinear_dv_along_m_s, color="C0", lw=0.9, label="nonlinear platform, along track")
     axis.plot(hours, comparison.nonlinear_dv_across_m_s, color="C2", lw=0.9, label="nonlinear platform, across track")
@@ -125,7 +125,7 @@ def plot_drozdovich(comparison):
     axis.set_ylabel("velocity error [m/s]")
     axis.set_title("10 m/s due west at 60 deg, W* uncompensated")
     axis.grid(True, alpha=0.3)
-    axis.legend(loc="lower right")
+    axis.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
     fig.tight_layout()
     return fig
 
