@@ -181,7 +181,7 @@ def test_navigate_bad_input(kwargs, name):
 ])
 def test_error_models_bad_input(factory, name):
     with pytest.raises(InvalidParameter) as error:
-        factory().members  # noqa: B018 - building and sizing the batch is what is tested
+        factory().members
     assert error.value.name == name
 
 

@@ -8,7 +8,7 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from schuler.contract import Cases, monte_carlo
+from schuler.contract import Cases
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY, radii_of_curvature, somigliana_gravity
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
