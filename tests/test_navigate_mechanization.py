@@ -28,7 +28,7 @@ def _north_channel():
     return float(meridian_radius(LATITUDE)), float(somigliana_gravity(LATITUDE))
 
 
-# Source 002's closed forms (single_channel.spherical_error) in the small-error limit. On a non-rotating
+# Bollay's (1966) closed forms (single_channel.spherical_error) in the small-error limit. On a non-rotating
 # Earth the north channel at rest is exactly Bollay's: x'' + (g / R_N) x = g theta + Delta_a. Heading 0:
 # a pitch error -theta is psi_E = theta, an accelerometer bias on body x reads north, a gyro bias -eps on
 # body y is a drift eps about east (spec 06: epsilon = -C b_g). The nonlinear residual is second order
@@ -52,7 +52,7 @@ def test_single_error_sources_follow_bollays_closed_forms(source, magnitude, err
 
 
 def test_free_vertical_channel_diverges_as_the_hover_problem():
-    # source 002 Problem 4 on WGS-84: delta_h'' - k1 g0 delta_h = b, k1 g0 = -dg/dh, from rest
+    # Bollay (1966), Problem 4 on WGS-84: delta_h'' - k1 g0 delta_h = b, k1 g0 = -dg/dh, from rest
     bias = -1e-5  # the accelerometer reads low along body z (down): the computed vertical acceleration is b up
     result = navigate(AT_REST, 3000.0, imu_rate=10.0, output_step=30.0, vertical_channel="free", earth_rate=0.0,
                       sensor_errors=SensorErrors(accel_bias=[0.0, 0.0, bias]))

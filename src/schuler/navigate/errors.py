@@ -194,10 +194,9 @@ class SensorErrors:
     def rows(self, sensor: str, members: int, invert: bool = False) -> np.ndarray:
         """Kernel rows (members, 12): the matrix I + S + M (or its inverse), row-major, then the bias."""
         scale = np.broadcast_to(getattr(self, f"{sensor}_scale_factor"), (members, 3))
-        matrix = np.broadcast_to(getattr(self, f"{sensor}_misalignment"), (members, 3, 3)) + \
+        forward = np.broadcast_to(getattr(self, f"{sensor}_misalignment"), (members, 3, 3)) + \
             np.eye(3) * (1.0 + scale)[:, None, :]
-        if invert:
-            matrix = np.linalg.inv(matrix)
+        matrix = np.linalg.inv(forward) if invert else forward
         bias = np.broadcast_to(getattr(self, f"{sensor}_bias"), (members, 3))
         return np.ascontiguousarray(np.concatenate([matrix.reshape(members, 9), bias], axis=1))
 

@@ -89,7 +89,7 @@ def plot_final_errors(horizontal_m):
 
 
 def plot_bollay(comparison):
-    """Source 002's five error sources: nonlinear WGS-84 beside the closed forms.
+    """Bollay's (1966) five error sources: nonlinear WGS-84 beside the closed forms.
 
     ``comparison`` is :func:`~schuler.navigate.seeds.bollay_error_sources`'s.
     """
@@ -114,7 +114,7 @@ def plot_bollay(comparison):
 
 
 def plot_drozdovich(comparison):
-    """Source 000's worked example on the nonlinear platform: velocity error along track beside (29)."""
+    """The worked example of Drozdovich (1959) on the nonlinear platform: velocity error along track beside (29)."""
     fig, axis = _figure(figsize=(WIDTH, 5.2))
     hours = comparison.t_s / 3600.0
     axis.plot(hours, comparison.nonlinear_dv_along_m_s, color="C0", lw=0.9, label="nonlinear platform, along track")

@@ -2,16 +2,16 @@
 
 Three sources, one table (:func:`reproduce`):
 
-* Bollay (source 002), Problem 3's five error sources, flown by the nonlinear
+* Bollay (1966), Problem 3's five error sources, flown by the nonlinear
   strapdown INS on WGS-84 (:func:`~schuler.navigate.seeds.bollay_error_sources`):
   beside his printed numbers (his R = 3960 mi, T = 5060 s) and beside his
   closed forms evaluated with the flight's own radius R_E and effective gravity
   g_eff = g - 2 Omega V - V^2 / R_E;
-* Drozdovich (source 000), the worked example, 10 m/s due west at 60 deg with
+* Drozdovich (1959), the worked example, 10 m/s due west at 60 deg with
   the Coriolis and centripetal terms W* uncompensated, on the nonlinear
   platform (:func:`~schuler.navigate.seeds.drozdovich_worked_example`): beside
   (29) and its forced solution (26) along the same path;
-* the KPI manual (source 003), the gyrocompassing models (1.17) and (1.19)
+* the KPI manual (Meleshko, n.d.), the gyrocompassing models (1.17) and (1.19)
   beside the nonlinear platform under the control law (1.6), for initial
   azimuth errors from 1 arcmin to 0.4 rad
   (:func:`~schuler.navigate.alignment.kpi_gyrocompassing`).
@@ -108,7 +108,7 @@ def bollay_rows(rotating: BollayComparison, still: BollayComparison) -> list[Rep
             why = ("the closed form lets the level axes follow the frame's turn V/R at once; the Schuler loop "
                    "lags it, by terms of order (V / (R w_s))^2 = 1 %")
         rows.append(compare(f"{label}: nonlinear against the closed form with the flight's R_E and g_eff, {earth}",
-                            nonlinear, "m", printed=form, value=local, where="source 002, solutions (2), (4), "
+                            nonlinear, "m", printed=form, value=local, where="Bollay (1966), solutions (2), (4), "
                             "Problem 2", tolerance=LINEAR, note=_note(nonlinear, local, why)))
     i = rotating.sources.index("azimuth")
     final, closed = float(rotating.nonlinear_m[i][-1]), float(rotating.closed_local_m[i][-1])

@@ -1,6 +1,6 @@
 """The linearised 3-D INS error model on a rotating spherical Earth, in psi-angle form.
 
-Beyond source 002, whose single channel is this model's non-rotating limit.
+Beyond Bollay (1966), whose single channel is this model's non-rotating limit.
 Frame: local-level North-East-Down (n frame) of the computed position; Earth
 rate Omega_n = Omega (cos L, 0, -sin L), transport rate
 rho = (V_E / R, -V_N / R, -V_E tan L / R) for a vehicle flying at constant
@@ -455,7 +455,8 @@ def propagate_along(time, latitude, height, velocity_ned, specific_force_ned, in
         raise InvalidParameter("initial_state", f"expected shape ({n},) or (N, {n}), got {x0.shape}")
     u = np.zeros(6) if inputs is None else np.asarray(inputs, dtype=float)
     if u.shape[-1] != 6 or not np.all(np.isfinite(u)):
-        raise InvalidParameter("inputs", f"expected finite values of shape (6,), ({K}, 6) or (N, {K}, 6), got {u.shape}")
+        raise InvalidParameter("inputs",
+                               f"expected finite values of shape (6,), ({K}, 6) or (N, {K}, 6), got {u.shape}")
     u = np.broadcast_to(u, (*x0.shape[:-1], K, 6)) if u.ndim < 3 else u
     out = np.empty((*x0.shape[:-1], K + 1, n))
     x = x0.copy()
