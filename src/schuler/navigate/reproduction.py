@@ -224,12 +224,12 @@ def _kpi_note(comparison: GyrocompassingComparison) -> str:
 
 
 def reproduce() -> Reproduction:
-    """The seeds' linear models against the nonlinear INS (a few seconds).
+    """The seeds' linear models against the nonlinear INS (a few seconds; run by the system tests).
 
     Examples
     --------
     >>> r = reproduce()  # doctest: +SKIP
-    >>> r.failures
+    >>> r.failures  # doctest: +SKIP
     []
     """
     rotating = bollay_error_sources()
