@@ -7,6 +7,9 @@ import math
 import pandas as pd
 import pytest
 
+from schuler.study.scenario import parse_scenario
+from schuler.study.sweep import run_sweep
+
 ARRAYS = ("t_s", "position_error_north_m", "position_error_east_m", "velocity_error_north_m_s",
           "velocity_error_east_m_s", "roll_error_rad", "pitch_error_rad", "heading_error_rad")
 """The histories of issue 15, item 7, in ``--json``."""
@@ -193,12 +196,22 @@ def _sweep(run_cli, tmp_path, name, *args, rate=20, duration=120, step=20):
     return pd.read_parquet(out_dir / "results.parquet")
 
 
-def test_a_monte_carlo_sweep_does_not_depend_on_the_chunks(run_cli, tmp_path):
-    """The members draw the scenario's distributions and the IMU noise by their case numbers."""
-    small = _sweep(run_cli, tmp_path, "small", "--monte-carlo", "5", "--param", "mode=strapdown,platform",
-                   "--chunk-size", "3")
-    large = _sweep(run_cli, tmp_path, "large", "--monte-carlo", "5", "--param", "mode=strapdown,platform",
-                   "--chunk-size", "10")
+def test_a_monte_carlo_sweep_does_not_depend_on_the_chunks(tmp_path):
+    """The members draw the scenario's distributions and the IMU noise by their case numbers.
+
+    The sweep machinery without its summary plots (their drawing would be most of the time; the command
+    line's sweep is the slow test below).
+    """
+    spec = tmp_path / "noisy.toml"
+    spec.write_text(NOISY_SPEC)
+    scenario = parse_scenario(SCENARIO.format(spec=spec, rate=20, duration=120, step=20))
+
+    def sweep(name, chunk_size):
+        run_sweep(scenario, tmp_path / name, ("mode=strapdown,platform",), monte_carlo=5, chunk_size=chunk_size,
+                  progress=False, write_csv=False, plots=False)
+        return pd.read_parquet(tmp_path / name / "results.parquet")
+
+    small, large = sweep("small", 3), sweep("large", 10)
     assert len(small) == 10 and small["final_horizontal_position_error_m"].nunique() == 10
     pd.testing.assert_frame_equal(small, large, check_exact=False, rtol=1e-12)
 
@@ -211,7 +224,9 @@ def test_a_monte_carlo_sweep_on_a_dask_cluster_is_the_same(run_cli, tmp_path):
     pd.testing.assert_frame_equal(local, alone, check_exact=False, rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_reproduce(run_cli, tmp_path):
+    """Through the command line (the system test runs the same reproduction in the default suite)."""
     out = run_cli("navigate", "reproduce", "--json", "--out", tmp_path)
     assert out.code == 0, out.stderr
     data = out.json()
