@@ -192,7 +192,7 @@ def imu_monte_carlo(imu: str, members: int, hours: float) -> tuple[float, float,
     spent = {"wall": 0.0, "cpu": 0.0}
     original = imu_noise.ImuNoise
 
-    class TimedNoise(original):  # type: ignore[misc, valid-type]
+    class TimedNoise(original):
         def increments(self, members, start, stop, dt):
             wall, cpu = time.perf_counter(), time.process_time()
             try:
@@ -203,11 +203,11 @@ def imu_monte_carlo(imu: str, members: int, hours: float) -> tuple[float, float,
 
     case = SYSTEM.case(imu=imu, duration=hours * 3600.0, imu_rate=IMU_RATE, output_step=60.0)
     cases = Cases.from_case(case, members, random=RandomStreams(1))
-    imu_noise.ImuNoise = TimedNoise  # type: ignore[misc]
+    imu_noise.ImuNoise = TimedNoise
     try:
         _, wall, cpu = timed(lambda: SYSTEM.evaluate(cases))
     finally:
-        imu_noise.ImuNoise = original  # type: ignore[misc]
+        imu_noise.ImuNoise = original
     return wall, cpu, spent["wall"], spent["cpu"]
 
 

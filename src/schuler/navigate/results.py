@@ -170,14 +170,16 @@ class NavigateResult(RunResult):
         return data
 
     def render(self):
-        from rich.console import Group
+        from rich.console import Group, JustifyMethod
         from rich.table import Table
 
         title = (f"{self.mode} INS on a {self.trajectory} trajectory, vertical channel {self.vertical_channel}, "
                  f"IMU {self.imu or 'ideal but for the biases given'}: errors at {self.duration_s:,.0f} s")
         table = Table(title=title)
-        for heading, justify in (("channel", "left"), ("final", "right"), ("largest |error|", "right")):
-            table.add_column(heading, justify=justify)  # type: ignore[arg-type]
+        columns: tuple[tuple[str, JustifyMethod], ...] = (("channel", "left"), ("final", "right"),
+                                                          ("largest |error|", "right"))
+        for heading, justify in columns:
+            table.add_column(heading, justify=justify)
         for name in (*shown_channels(self.vertical_channel), "horizontal_position_error_m"):
             unit = DISPLAY_UNITS[suffix(name)]
             final = self.errors[f"final_{name}"]
