@@ -32,6 +32,7 @@ QUICK = {
     "align": ["--duration", "600"],
     "north": ["--duration", "600"],
     "calibrate": [],
+    "imu": ["--duration", "300"],
 }
 """Options that keep each system's base case short; the fuzzed option comes after them."""
 
@@ -98,7 +99,7 @@ def test_a_careless_value_gives_exit_0_or_2(system, command, option, value, run_
     args = [system, command]
     if command == "run":
         args += QUICK[system]
-    if command in ("identify",):
+    if command in ("identify", "info", "allan"):
         record = workdir / "record.csv"
         record.write_bytes(b"\x00\x01binary\xff\xfe")
         args.append(record)

@@ -163,7 +163,8 @@ def align_inputs(model: ErrorModel, *, heading_rad: float = 0.0, window_s: float
     rotation = _level_rotation(heading_rad)
     drift_ned = -rotation @ gyro
     spread_ned = np.sqrt((rotation**2) @ gyro**2)
-    values = {"drift_east": float(drift_ned[1]), "drift_north": float(drift_ned[0]), "drift_z": float(-drift_ned[2]),
+    values = {"drift_east": float(drift_ned[1]) + 0.0, "drift_north": float(drift_ned[0]) + 0.0,
+              "drift_z": float(-drift_ned[2]) + 0.0,  # + 0.0: no negative zero in tables and JSON
               "accel_bias_x": float(accel[1]), "accel_bias_y": float(accel[0]),
               "sigma_drift": _horizontal_rms(gyro), "sigma_drift_z": float(gyro[2]),
               "sigma_accel": _horizontal_rms(accel)}
