@@ -157,6 +157,11 @@ class _TimeCheck:
             self.dt = float(np.median(steps))
             if not self.dt > 0:
                 raise ImuFileError(self.path, "time does not increase", line=self.line, column=1)
+            # a regular chunk's span over its steps is exact to rounding; single differences of
+            # time stamps written as decimals are not (0.02 - 0.01 = 0.009999999999999998...)
+            span = float(series[-1] - series[0]) / steps.size
+            if abs(span - self.dt) <= 1e-6 * self.dt:
+                self.dt = span
         offset = self.line - (0 if self.last is None else 1)  # line of series[0]
         backwards = np.flatnonzero(steps <= 0)
         gaps = np.flatnonzero(steps > 1.5 * self.dt)
