@@ -32,7 +32,7 @@ QUICK = {
     "align": ["--duration", "600"],
     "north": ["--duration", "600"],
     "calibrate": [],
-    "imu": ["--duration", "300"],
+    "imu": ["--duration", "120"],
 }
 """Options that keep each system's base case short; the fuzzed option comes after them."""
 

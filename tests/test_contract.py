@@ -36,7 +36,7 @@ LIGHT = {
     "calibrate": {},
     "align": {"duration": 600.0},
     "north": {"duration": 600.0, "readout_noise": math.radians(1 / 3600)},
-    "imu": {"duration": 300.0},
+    "imu": {"duration": 120.0},
 }
 """SI values that keep a system's default case quick (short durations)."""
 

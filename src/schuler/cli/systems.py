@@ -82,8 +82,7 @@ def _with_instrument(system: System, case: Case, options: Case) -> tuple[Case, C
         raise InvalidParameter("--" + extra.replace("_", "-"), "applies with --imu only")
     with options_named(system.parameters + instrument_options(system.name)):
         case, _ = apply_instrument(system.name, system.parameters, case, options["imu"],
-                                   window_s=options["imu_window"] if "imu_window" in options else None,
-                                   latitude_rad=options["imu_latitude"] if "imu_latitude" in options else None)
+                                   window_s=options.get("imu_window"), latitude_rad=options.get("imu_latitude"))
     return case, options
 
 

@@ -37,7 +37,7 @@ import numpy as np
 
 from schuler.contract import Cases, Output
 from schuler.exceptions import InvalidParameter
-from schuler.imu.characterise import round_trip
+from schuler.imu.characterise import round_trip, true_terms
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.results import CHANNELS, DISPLAY_UNITS, TERM_UNITS, RoundTripResult, sensor_of
 from schuler.imu.run_results import ImuRunResult
@@ -162,15 +162,12 @@ def run_case(case: Case, fidelity: str | None = None) -> ImuRunResult:
     1.0
     """
     model, trip = _round_trip(case, NOMINAL_SEED, 0, {})
-    true_terms = {channel: {term: 0.0 for term in OUTPUT_TERMS} for channel in CHANNELS}
-    for check in trip.checks:
-        true_terms[check.channel][check.term] = check.true
+    truth = {}
     for channel in CHANNELS:
         errors = model.gyro if sensor_of(channel) == "gyro" else model.accel
-        axis = "xyz".index(channel[-1])
-        true_terms[channel].update(N=float(errors.random_walk[axis]), K=float(errors.rate_random_walk[axis]),
-                                   Q=float(errors.quantization[axis]), B=float(errors.bias_instability[axis]))
-    return ImuRunResult(model=model, round_trip=trip, outputs=outputs_of(trip), true_terms=true_terms,
+        terms = true_terms(errors, "xyz".index(channel[-1]))
+        truth[channel] = {term: float(terms[term]) for term in OUTPUT_TERMS}
+    return ImuRunResult(model=model, round_trip=trip, outputs=outputs_of(trip), true_terms=truth,
                         latitude_rad=case["latitude"], azimuth_rad=case["azimuth"])
 
 

@@ -419,8 +419,7 @@ def _with_instrument(system: System, values: Case, written: dict[str, Any], sour
     try:
         parsed = options.parse(written)
         case, _ = apply_instrument(system.name, system.parameters, values, parsed["imu"],
-                                   window_s=parsed["imu_window"] if "imu_window" in parsed else None,
-                                   latitude_rad=parsed["imu_latitude"] if "imu_latitude" in parsed else None,
+                                   window_s=parsed.get("imu_window"), latitude_rad=parsed.get("imu_latitude"),
                                    base=folder)
     except (InvalidParameter, ScenarioError) as error:
         raise ScenarioError(f"{source}: [instrument] {error}") from None
