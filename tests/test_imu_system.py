@@ -149,7 +149,8 @@ def test_reproduction_without_the_recording(monkeypatch):
 @pytest.mark.skipif(not HAS_PSINS, reason=f"set {PSINS_ENVIRONMENT} to the PSINS lasergyro.imu file to run")
 def test_reproduction_of_the_psins_recording():
     reproduction = reproduce(recording=PSINS)
-    rows = {row.quantity.split(":")[1].strip()[:20]: row for row in reproduction.rows if row.quantity.startswith("PSINS")}
+    rows = {row.quantity.split(":")[1].strip()[:20]: row
+            for row in reproduction.rows if row.quantity.startswith("PSINS")}
     assert not reproduction.failures and len(rows) == 3
     latitude = rows["latitude from the me"]
     # header line 2: 34.246048 deg; the double-vector latitude of the whole record: 34.62 deg

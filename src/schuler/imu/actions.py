@@ -58,7 +58,8 @@ FILE_ARGUMENT = Argument("file", "IMU file: the project's CSV (or any CSV with -
                                  "or .parquet")
 
 CSV_OPTIONS = (
-    Parameter("kind", "", None, "CSV only: what the sensor columns hold (not set: rate).", choices=KINDS, kind="choice"),
+    Parameter("kind", "", None, "CSV only: what the sensor columns hold (not set: rate).", choices=KINDS,
+              kind="choice"),
     Parameter("axes", "", None, "CSV only: where the file's x, y, z axes point, three of F B R L D U (not set: FRD).",
               kind="text"),
     Parameter("columns", "", None, "CSV only: the file's column of each channel, e.g. 'time=t,gyro_x=wx,gyro_y=wy,"

@@ -1,4 +1,4 @@
-"""What ``schuler imu run`` and ``simulate`` return and write: :class:`ImuRunResult`, :class:`SimulationResult`, :func:`write_files`.
+"""What ``schuler imu run`` and ``simulate`` return and write: the result types and :func:`write_files`.
 
 JSON of a run (``to_dict``): the flat outputs of ``evaluate`` (``noise_gyro_x_N``
 ... SI, null where not resolved), then the nested ``noise.<channel>.<term>``
@@ -126,7 +126,8 @@ class SimulationResult(Result):
         rows = [("model", self.model), ("samples", f"{self.samples:,}"),
                 ("sample rate", f"{1 / self.sample_interval_s:.6g} Hz"),
                 ("duration", f"{self.duration_s:.6g} s ({self.duration_s / 3600:.4g} h)"), ("seed", str(self.seed)),
-                ("latitude, heading", f"{math.degrees(self.latitude_rad):g} deg, {math.degrees(self.azimuth_rad):g} deg"),
+                ("latitude, heading",
+                 f"{math.degrees(self.latitude_rad):g} deg, {math.degrees(self.azimuth_rad):g} deg"),
                 ("file size", f"{self.file_size_bytes / 1e6:.3g} MB")]
         for name, value in rows:
             table.add_row(name, value)

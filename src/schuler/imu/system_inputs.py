@@ -227,7 +227,8 @@ def errors_inputs(model: ErrorModel, *, latitude_rad: float, window_s: float = D
     gyro = residual_bias(model.gyro, window_s, include_turn_on=False)
     accel = residual_bias(model.accel, window_s, include_turn_on=True)
     drift, bias = _horizontal_rms(gyro), _horizontal_rms(accel)
-    azimuth = math.hypot(drift / (EARTH_RATE * math.cos(latitude_rad)), bias * math.tan(latitude_rad) / STANDARD_GRAVITY)
+    azimuth = math.hypot(drift / (EARTH_RATE * math.cos(latitude_rad)),
+                         bias * math.tan(latitude_rad) / STANDARD_GRAVITY)
     values = {"tilt": bias / STANDARD_GRAVITY, "velocity": 0.0, "accelerometer": bias, "drift": drift,
               "azimuth": float(azimuth)}
     units = {"tilt": "rad", "velocity": "m/s", "accelerometer": "m/s^2", "drift": "rad/s", "azimuth": "rad"}
