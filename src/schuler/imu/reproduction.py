@@ -37,7 +37,7 @@ from schuler.core.earth import EARTH_RATE
 from schuler.exceptions import InvalidParameter
 from schuler.imu.characterise import analyse_record, round_trip
 from schuler.imu.files import read_record
-from schuler.imu.results import NOISE_UNITS, RoundTripResult
+from schuler.imu.results import DISPLAY_UNITS, NOISE_UNITS, RoundTripResult, sensor_of, shown_unit
 from schuler.imu.spec import GRADES, PRESET_SPECS, preset
 from schuler.imu.static import static_attitude
 from schuler.params import Parameter, ParameterSet
@@ -167,6 +167,18 @@ def psins_rows(path: Path) -> tuple[list, dict, dict, object]:
     return rows, details, units, analysis
 
 
+def resolved_terms_text(analysis) -> str:
+    """The resolved terms of each channel in display units, one line (channels with none left out)."""
+    parts = []
+    for name, channel in analysis.noise.items():
+        units = DISPLAY_UNITS[sensor_of(name)]
+        terms = [f"{term} = {to_unit(channel.terms.values[term], units[term]):.3g} {shown_unit(units[term])}"
+                 for term in ("N", "B", "K", "Q", "R") if channel.terms.resolved[term]]
+        if terms:
+            parts.append(f"{name} " + ", ".join(terms))
+    return "; ".join(parts) or "none"
+
+
 def reproduce(recording: str | None = None) -> Reproduction:
     """The grade figures round-tripped and, when the file is found, the PSINS recording (see the module notes).
 
@@ -197,6 +209,7 @@ def reproduce(recording: str | None = None) -> Reproduction:
         notes.append(f"PSINS {path.name}: the gyro curves belong to the {analysis.grade or 'no preset'} grade; "
                      "the vehicle's disturbances dominate the longer averaging times, so the identified terms "
                      "describe the curves, not the sensor's data sheet")
+        notes.append(f"PSINS {path.name}, resolved terms: {resolved_terms_text(analysis)}")
     return Reproduction(
         system="imu",
         source="grade presets: Honeywell HG9900 and HG1700 brochures, Xsens MTi 1-series data sheet, InvenSense "
