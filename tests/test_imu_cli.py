@@ -131,6 +131,10 @@ def test_errors_name_the_option_file_line_and_column(run_cli, tmp_path):
     assert out.code == 2 and "--units: unknown channel 'speed'" in out.stderr
     out = run_cli("imu", "info", bad, "--columns", "gyro_x")
     assert out.code == 2 and "--columns: 'gyro_x' is not channel=value" in out.stderr
+    parquet = tmp_path / "r.parquet"
+    assert run_cli("imu", "simulate", "--duration", "10", "-o", parquet).code == 0
+    out = run_cli("imu", "allan", parquet, "--latitude", "45")
+    assert out.code == 2 and "--latitude: applies to CSV files only; r.parquet is .parquet" in out.stderr
 
 
 def test_csv_mapping_options(run_cli, tmp_path):

@@ -88,8 +88,14 @@ def _pairs(text: str, name: str) -> dict[str, str]:
     return pairs
 
 
-def csv_options(kind=None, axes=None, columns=None, units=None, latitude=None) -> dict:
-    """The keyword options of :func:`~schuler.imu.readers.open_csv` the user set (none for other formats)."""
+def csv_options(file: Path, kind=None, axes=None, columns=None, units=None, latitude=None) -> dict:
+    """The keyword options of :func:`~schuler.imu.readers.open_csv` the user set; refused for other formats."""
+    given = [name for name, value in (("kind", kind), ("axes", axes), ("columns", columns), ("units", units),
+                                      ("latitude", latitude)) if value not in (None, "")]
+    suffix = Path(file).suffix.lower()
+    if given and suffix in (".imu", ".parquet"):
+        raise InvalidParameter(given[0], f"applies to CSV files only; {Path(file).name} is {suffix} and states its "
+                               "own layout")
     options: dict = {}
     if kind is not None:
         options["kind"] = kind
@@ -115,12 +121,12 @@ def csv_options(kind=None, axes=None, columns=None, units=None, latitude=None) -
 
 def info(file: Path, **options) -> ImuInfo:
     """What an IMU file holds: samples, rate, duration, mean rates (body x forward, y right, z down), site."""
-    return file_info(file, **csv_options(**options))
+    return file_info(file, **csv_options(file, **options))
 
 
 def allan(file: Path, per_octave: int = 2, **options) -> AllanResult:
     """Allan deviation with confidence intervals and IEEE 952 terms of the six channels of a file, streamed."""
-    source = open_record(file, **csv_options(**options))
+    source = open_record(file, **csv_options(file, **options))
     require(source.estimated_samples * ALLAN_BYTES_PER_SAMPLE + CHUNK_BYTES, "this Allan analysis",
             "the file (analyse a part of it)")
     return analyse_source(source, per_octave=per_octave)
