@@ -1,10 +1,10 @@
-# Quick start: `make demo` builds the report of all five systems; `make test` runs the suite.
+# Quick start: `make demo` builds the report of every system; `make test` runs the guards and the suite.
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV := .venv
 BIN := $(VENV)/bin
 OUT ?= results
 
-.PHONY: demo test bench clean
+.PHONY: demo test lint bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -25,9 +25,19 @@ demo: $(VENV)/.installed
 # the PSINS laser-gyro recording beside the checkout (not part of the project): its tests skip without it
 PSINS_IMU ?= $(abspath $(wildcard ../shared/data/psins/lasergyro.imu))
 
+# the guards: lint, types, and the layers of the import contract (pyproject.toml)
+lint: $(VENV)/.installed-test
+	@echo "== ruff: lint"
+	$(BIN)/ruff check src tests benchmarks
+	@echo "== mypy: types"
+	$(BIN)/mypy
+	@echo "== import-linter: layers cli > study > systems > boundary > core"
+	$(BIN)/lint-imports --no-cache
+
 # one BLAS thread per test process: the models' matrices are small, and two
 # processes already use both cores
-test: $(VENV)/.installed-test
+test: lint
+	@echo "== pytest: the suite (doctests included)"
 	SCHULER_PSINS_IMU="$(PSINS_IMU)" OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2 -q
 
 bench: $(VENV)/.installed-test

@@ -7,14 +7,28 @@ import math
 import numpy as np
 import pytest
 
-from schuler.core.earth import BOLLAY, EARTH_RATE, MEAN_RADIUS, STANDARD_GRAVITY
+from schuler.core.earth import (
+    BOLLAY,
+    EARTH_RATE,
+    MEAN_RADIUS,
+    STANDARD_GRAVITY,
+    earth_rate_ned,
+    gravity_ned,
+    meridian_radius,
+    transport_rate_ned,
+    transverse_radius,
+)
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
 from schuler.navigation_errors.single_channel import flat_error, spherical_error
 from schuler.navigation_errors.three_d import (
     foucault_velocity_response,
+    propagate_along,
     psi_angle_model,
     stationary_modes,
+    wgs84_error_matrices,
+    wgs84_gravity_gradient,
+    wgs84_psi_angle_model,
 )
 from schuler.navigation_errors.three_d_run import THREE_D_PARAMETERS, three_d
 
@@ -186,4 +200,58 @@ def test_action_warns_when_the_latitude_changes_much():
 def test_action_bad_input(values, name):
     with pytest.raises(InvalidParameter) as error:
         _three_d(**values)
+    assert error.value.name == name
+
+
+# --- WGS-84: gravity gradient, models along a trajectory ---------------------------------------------
+
+
+@pytest.mark.parametrize("latitude_deg, height", [(0.0, 0.0), (45.0, 10_000.0), (-70.0, 3000.0)])
+def test_wgs84_gravity_gradient_matches_finite_differences(latitude_deg, height):
+    # delta_g = g(L + dL, h + dh) resolved in the computed frame minus g(L, h): g^n(L+dL, h+dh) + dtheta x g - g
+    L = math.radians(latitude_deg)
+    G = wgs84_gravity_gradient([L], [height])[0]
+    g0 = gravity_ned(L, height)
+    for dr in (np.array([10.0, 0.0, 0.0]), np.array([0.0, 10.0, 0.0]), np.array([0.0, 0.0, 1.0])):
+        dL = dr[0] / (meridian_radius(L) + height)
+        dlon = dr[1] / ((transverse_radius(L) + height) * math.cos(L))
+        dtheta = np.array([dlon * math.cos(L), -dL, -dlon * math.sin(L)])
+        difference = gravity_ned(L + dL, height - dr[2]) + np.cross(dtheta, g0) - g0
+        np.testing.assert_allclose(G @ dr, difference, rtol=1e-5, atol=1e-12)  # second order: ~1e-13
+
+
+def test_wgs84_model_at_rest_holds_the_height_by_dropping_the_vertical_rows():
+    F_free, _ = wgs84_error_matrices([0.6], [100.0], [[0.0, 0.0, 0.0]], [[0.0, 0.0, -9.8]], vertical_channel=True)
+    F_held, _ = wgs84_error_matrices([0.6], [100.0], [[0.0, 0.0, 0.0]], [[0.0, 0.0, -9.8]])
+    keep = [0, 1, 3, 4, 6, 7, 8]
+    np.testing.assert_array_equal(F_held[0], F_free[0][np.ix_(keep, keep)])
+    # the vertical channel diverges with -dg/dh = 2 g / a (1 + f + m - 2 f sin^2 L) ~ 2 g / R
+    growth = np.max(wgs84_psi_angle_model(0.6, vertical_channel=True).eigenvalues().real)
+    assert growth == pytest.approx(math.sqrt(2 * 9.80 / 6.37e6), rel=5e-3)
+
+
+def test_propagation_with_constant_coefficients_is_the_engine_exactly():
+    L, h, v = math.radians(35.0), 500.0, np.array([120.0, -80.0, 0.0])
+    model = wgs84_psi_angle_model(L, h, v)  # steady flight: f = -g + (2 Omega + rho) x v
+    t = np.linspace(0.0, 7200.0, 73)
+    x0 = np.array([100.0, -40.0, 0.2, 0.1, 1e-5, -2e-5, 3e-4])
+    u = np.array([1e-4, 0.0, -2e-4, 1e-8, 0.0, -1e-8])
+    expected = simulate(model, t, initial_state=x0, inputs=u).states
+    K = t.size - 1
+    rho = transport_rate_ned(L, h, v[0], v[1])
+    f = -gravity_ned(L, h) + np.cross(2 * earth_rate_ned(L) + rho, v)
+    states = propagate_along(t, np.full(K, L), np.full(K, h), np.tile(v, (K, 1)), np.tile(f, (K, 1)), x0, u)
+    # the engine builds Phi^k by doubling, this product step by step: rounding differs by ~1e-9
+    np.testing.assert_allclose(states, expected, rtol=0, atol=1e-8 * np.abs(expected).max())
+
+
+@pytest.mark.parametrize("kwargs, name", [({"latitude": [math.pi / 2]}, "latitude"),
+                                          ({"time": [0.0, 1.0, 1.0]}, "time"),
+                                          ({"inputs": [1.0, 2.0]}, "inputs"),
+                                          ({"initial_state": np.zeros(5)}, "initial_state")])
+def test_propagate_along_bad_input(kwargs, name):
+    arguments = {"time": [0.0, 1.0], "latitude": [0.5], "height": [0.0], "velocity_ned": [[0.0, 0.0, 0.0]],
+                 "specific_force_ned": [[0.0, 0.0, -9.8]], "initial_state": np.zeros(7)} | kwargs
+    with pytest.raises(InvalidParameter) as error:
+        propagate_along(**arguments)
     assert error.value.name == name

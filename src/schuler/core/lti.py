@@ -4,19 +4,52 @@ A continuous linear time-invariant model
 
     x' = A x + B u,    y = C x + D u
 
-is discretised exactly for piecewise-constant inputs (zero-order hold) by the
-matrix exponential of the augmented matrix
+is propagated exactly for inputs held constant over each step (zero-order
+hold): with the inputs in the state, z = [x; u], z' = M z with
+M = [[A, B], [0, 0]] and z(t) = expm(M (t - t0)) z(t0) (Van Loan 1978), so
+x(t_k+1) = Ad x(t_k) + Bd u_k with [[Ad, Bd], [0, I]] = expm(M dt) for any step.
+Members of a batch (Monte Carlo samples, sweep cases) are propagated together
+as arrays, even with a different model per member, without a Python loop over
+members or time steps (methods: :mod:`schuler.core.propagation`).
 
-    expm([[A, B], [0, 0]] dt) = [[Ad, Bd], [0, I]],
+Shapes (n states, m inputs, p outputs, N members, T time points):
 
-so that x(t_k+1) = Ad x(t_k) + Bd u_k holds to rounding for any step. Members of
-a batch (Monte Carlo samples, sweep cases) are propagated together as arrays:
-initial states ``(N, n)``, inputs ``(N, n_time, m)``, even a different ``A`` per
-member ``(N, n, n)``, without a Python loop over members.
+* ``initial_state``: (n,) or (N, n);
+* ``inputs``, constant in time: (m,) or (N, m);
+* ``input_series``, varying in time: (T, m) or (N, T, m), ``input_series[..., k, :]``
+  held on [t_k, t_k+1) (the last row is not used). Given both, the input is their sum;
+* a batch of models: A (N, n, n), B (N, n, m), C (N, p, n), D (N, p, m), any subset;
+* responses are time-first per member: (T, n) for one, (N, T, n) for a batch.
 
-Conventions: arrays are time-first per member: a single response's ``states``
-has shape ``(n_time, n_states)``, a batch's ``(n_members, n_time, n_states)``.
-The input ``u[k]`` acts on ``[t_k, t_k+1)``. Everything is SI.
+No shape is guessed: an array is a batch only where its documented shape says
+so, and any other shape is refused with :class:`~schuler.exceptions.InvalidParameter`.
+Everything is SI.
+
+Accuracy: on the 13-state psi-angle INS error model
+(:mod:`schuler.navigation_errors.three_d`, 7 states and 6 constant inputs) at
+latitude 50 deg over 48 h at 1-s and 10-s output, with initial tilt, velocity
+and azimuth errors, accelerometer biases and gyro drifts at once, the engine
+agrees with ``solve_ivp`` (DOP853, rtol 1e-13) to 1.8e-12 of each channel's
+maximum, which is DOP853's own error: against an extended-precision reference
+it agrees to 2e-13 (9e-12 for an input series stepped at 1 s). Balancing the
+augmented matrix is what makes this hold (:mod:`schuler.core.propagation`).
+
+Memory: :func:`simulate` returns full histories (N T (n + p) floats; the
+outputs share the states' array when they are the states; a history may be a
+view whose channels are each contiguous in time) and refuses a request beyond
+:data:`MAX_RESULT_BYTES`. :func:`simulate_reduce` streams chunks of members
+(by default about :data:`CHUNK_BYTES` of history each) into a reducer and keeps
+no history: final values (:class:`FinalOutputs`), statistics
+(:func:`simulate_statistics`: one chunk, 4 T p floats of moments and a
+percentile reservoir of at most :data:`RESERVOIR_BYTES`) or any callable.
+Measured for 1,000 members over 48 h at 10 s (17,281 points, 7 channels):
+``simulate`` peaks at 937 MB traced (1.1 GB resident), ``simulate_statistics``
+at 91 MB (0.3 GB resident, of which 0.16 GB is the interpreter and libraries).
+
+References
+----------
+C. F. Van Loan, "Computing integrals involving the matrix exponential",
+IEEE Transactions on Automatic Control 23(3), 1978.
 
 Examples
 --------
@@ -35,144 +68,26 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg
 
+from schuler.core.propagation import Grid, propagate_constant_input, propagate_steps_exact, zoh_discretize
+from schuler.core.reducers import FinalOutputs, OutputStatistics, Reducer
+from schuler.core.response import Response
+from schuler.core.statespace import StateSpace
 from schuler.core.stats import StreamingStatistics
 from schuler.exceptions import InvalidParameter
 
+__all__ = [
+    "CHUNK_BYTES", "MAX_RESULT_BYTES", "RESERVOIR_BYTES", "FinalOutputs", "OutputStatistics", "Reducer",
+    "Response", "StateSpace", "StatisticsResponse", "simulate", "simulate_reduce", "simulate_statistics",
+    "zoh_discretize",
+]
 
-def _as_matrix(value, name: str, ndim_single: int = 2) -> np.ndarray:
-    array = np.asarray(value, dtype=float)
-    if array.ndim not in (ndim_single, ndim_single + 1):
-        raise InvalidParameter(name, f"expected a {ndim_single}-D array or a batch of them, got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
-        raise InvalidParameter(name, "contains NaN or infinite entries")
-    return array
-
-
-@dataclass(frozen=True)
-class StateSpace:
-    """A linear time-invariant model x' = A x + B u, y = C x + D u (SI units).
-
-    Parameters
-    ----------
-    A : array_like, shape (n, n) or (N, n, n)
-        State matrix; a leading dimension makes a batch of N models.
-    B : array_like, shape (n, m) or (N, n, m), optional
-        Input matrix (default: no inputs).
-    C : array_like, shape (p, n) or (N, p, n), optional
-        Output matrix (default: the identity, outputs = states).
-    D : array_like, shape (p, m) or (N, p, m), optional
-        Feedthrough (default zero).
-    states, inputs, outputs : tuple of str
-        Channel names (defaults ``x0, x1, ...``, ``u0, ...``, the state names).
-    state_units, output_units : tuple of str
-        SI unit of each channel, for labels and tables.
-    """
-
-    A: np.ndarray
-    B: np.ndarray | None = None
-    C: np.ndarray | None = None
-    D: np.ndarray | None = None
-    states: tuple[str, ...] = ()
-    inputs: tuple[str, ...] = ()
-    outputs: tuple[str, ...] = ()
-    state_units: tuple[str, ...] = ()
-    output_units: tuple[str, ...] = ()
-
-    def __post_init__(self):
-        A = _as_matrix(self.A, "A")
-        n = A.shape[-1]
-        if A.shape[-2] != n:
-            raise InvalidParameter("A", f"must be square, got shape {A.shape}")
-        batch = A.shape[:-2]
-        B = np.zeros((*batch, n, 0)) if self.B is None else _as_matrix(self.B, "B")
-        if B.shape[-2] != n:
-            raise InvalidParameter("B", f"must have {n} rows, got shape {B.shape}")
-        m = B.shape[-1]
-        C = np.eye(n) if self.C is None else _as_matrix(self.C, "C")
-        if C.shape[-1] != n:
-            raise InvalidParameter("C", f"must have {n} columns, got shape {C.shape}")
-        p = C.shape[-2]
-        D = np.zeros((p, m)) if self.D is None else _as_matrix(self.D, "D")
-        if D.shape[-2:] != (p, m):
-            raise InvalidParameter("D", f"must have shape ({p}, {m}), got {D.shape}")
-        sizes = {M.shape[0] for M in (A, B, C, D) if M.ndim == 3}
-        if len(sizes) > 1:
-            raise InvalidParameter("A", f"batched matrices disagree in batch size: {sorted(sizes)}")
-        states = tuple(self.states) or tuple(f"x{i}" for i in range(n))
-        inputs = tuple(self.inputs) or tuple(f"u{i}" for i in range(m))
-        outputs = tuple(self.outputs) or (states if self.C is None else tuple(f"y{i}" for i in range(p)))
-        state_units = tuple(self.state_units) or ("",) * n
-        output_units = tuple(self.output_units) or (state_units if self.C is None else ("",) * p)
-        for label, names, size in (
-            ("states", states, n),
-            ("inputs", inputs, m),
-            ("outputs", outputs, p),
-            ("state_units", state_units, n),
-            ("output_units", output_units, p),
-        ):
-            if len(names) != size:
-                raise InvalidParameter(label, f"needs {size} entries, got {len(names)}")
-        for name, value in (
-            ("A", A), ("B", B), ("C", C), ("D", D), ("states", states), ("inputs", inputs),
-            ("outputs", outputs), ("state_units", state_units), ("output_units", output_units),
-        ):
-            object.__setattr__(self, name, value)
-
-    @property
-    def n_states(self) -> int:
-        return self.A.shape[-1]
-
-    @property
-    def n_inputs(self) -> int:
-        return self.B.shape[-1]
-
-    @property
-    def n_outputs(self) -> int:
-        return self.C.shape[-2]
-
-    @property
-    def batch_size(self) -> int | None:
-        """Number of models in a batch, or None for a single model."""
-        sizes = [M.shape[0] for M in (self.A, self.B, self.C, self.D) if M.ndim == 3]
-        return sizes[0] if sizes else None
-
-    def eigenvalues(self) -> np.ndarray:
-        """Eigenvalues of A (rad/s), shape (n,) or (N, n)."""
-        return np.linalg.eigvals(self.A)
-
-    def discretize(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        """Exact zero-order-hold matrices (Ad, Bd) for the step ``dt`` (s)."""
-        return zoh_discretize(self.A, self.B, np.asarray(dt, dtype=float))
-
-
-def zoh_discretize(A: np.ndarray, B: np.ndarray, dt) -> tuple[np.ndarray, np.ndarray]:
-    """Exact zero-order-hold discretisation by the augmented matrix exponential.
-
-    Parameters
-    ----------
-    A : ndarray, shape (..., n, n)
-    B : ndarray, shape (..., n, m)
-    dt : float or ndarray of shape (k,)
-        Step(s), s. With k steps the results gain a leading axis of length k.
-
-    Returns
-    -------
-    Ad : ndarray, shape ([k,] ..., n, n)
-    Bd : ndarray, shape ([k,] ..., n, m)
-    """
-    A = np.asarray(A, dtype=float)
-    B = np.asarray(B, dtype=float)
-    n, m = A.shape[-1], B.shape[-1]
-    batch = np.broadcast_shapes(A.shape[:-2], B.shape[:-2])
-    M = np.zeros((*batch, n + m, n + m))
-    M[..., :n, :n] = A
-    M[..., :n, n:] = B
-    dt = np.asarray(dt, dtype=float)
-    scaled = M * dt.reshape(dt.shape + (1,) * M.ndim)
-    phi = scipy.linalg.expm(scaled)
-    return phi[..., :n, :n], phi[..., :n, n:]
+MAX_RESULT_BYTES = 4 * 2**30
+"""Largest history :func:`simulate` allocates (4 GiB); stream longer runs with :func:`simulate_reduce`."""
+CHUNK_BYTES = 4 * 2**20
+"""Default history per chunk of :func:`simulate_reduce` (4 MiB: a chunk stays in cache while it is reduced)."""
+RESERVOIR_BYTES = 64 * 2**20
+"""Default memory of the members :func:`simulate_statistics` keeps for percentiles (64 MiB)."""
 
 
 def _check_time(time) -> np.ndarray:
@@ -186,246 +101,273 @@ def _check_time(time) -> np.ndarray:
     return t
 
 
-def _prepare(system: StateSpace, t: np.ndarray, initial_state, inputs):
-    """Shape initial states and inputs; return (x0, u, n_members or None, constant inputs or None)."""
-    n, m = system.n_states, system.n_inputs
-    x0 = np.zeros(n) if initial_state is None else np.asarray(initial_state, dtype=float)
-    if x0.shape[-1:] != (n,) or x0.ndim > 2:
-        raise InvalidParameter("initial_state", f"expected shape ({n},) or (N, {n}), got {x0.shape}")
-    if not np.all(np.isfinite(x0)):
-        raise InvalidParameter("initial_state", "contains NaN or infinite entries")
-    constant = None  # inputs constant in time: (m,) or (N, m)
-    if inputs is None:
-        constant = np.zeros(m)
-        u = np.broadcast_to(constant, (t.size, m))
-    else:
-        u = np.asarray(inputs, dtype=float)
-        if not np.all(np.isfinite(u)):  # checked before broadcasting: cheap for constant inputs
-            raise InvalidParameter("inputs", "contains NaN or infinite entries")
-        if u.ndim == 1:
-            constant = u
-            u = np.broadcast_to(u, (t.size, m))
-        elif u.ndim == 2 and x0.ndim == 2 and u.shape == (x0.shape[0], m) and u.shape != (t.size, m):
-            constant = u
-            u = np.broadcast_to(u[:, None, :], (u.shape[0], t.size, m))
-        if u.shape[-2:] != (t.size, m):
-            raise InvalidParameter("inputs", f"expected shape ({m},), ({t.size}, {m}) or (N, {t.size}, {m}), got {u.shape}")
-    sizes = {s for s in (system.batch_size, x0.shape[0] if x0.ndim == 2 else None, u.shape[0] if u.ndim == 3 else None) if s}
-    if len(sizes) > 1:
-        raise InvalidParameter("initial_state", f"batch sizes disagree: {sorted(sizes)}")
-    return x0, u, (sizes.pop() if sizes else None), constant
-
-
-def _apply(M: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """M v for a single (n, k) or batched (N, n, k) matrix and vectors (..., k)."""
-    if M.ndim == 2:
-        return v @ M.T
-    return np.matmul(M, v[..., None])[..., 0]
-
-
-def _uniform_step(t: np.ndarray) -> float | None:
-    """The grid's step if all steps agree to rounding (linspace grids), else None."""
-    dt = np.diff(t)
-    step = (t[-1] - t[0]) / dt.size
-    # a linspace grid's steps scatter by a few ulp of the largest time, not of the step
-    tolerance = 1e-12 * step + 8 * np.finfo(float).eps * max(abs(t[0]), abs(t[-1]))
-    return step if np.all(np.abs(dt - step) <= tolerance) else None
-
-
-def _transition_matrices(M: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """expm(M (t_k - t_0)) for every k, shape (n_time, q, q).
-
-    On a uniform grid the k-th matrix is Phi^k, Phi = expm(M dt), built by
-    doubling: the block of powers 2^j..2^(j+1)-1 is the block 0..2^j-1 times
-    expm(M 2^j dt). That takes log2(n_time) exponentials and batched products;
-    each power is a product of at most log2(n_time) exact exponentials, so
-    rounding stays at a few ulp times log2(n_time).
-    Otherwise one exponential per time point.
-    """
-    q = M.shape[-1]
-    step = _uniform_step(t) if t.size > 2 else None
-    if step is None:
-        return scipy.linalg.expm(M * (t - t[0])[:, None, None])
-    powers = np.empty((t.size, q, q))
-    powers[0] = np.eye(q)
-    filled = 1
-    while filled < t.size:
-        block = min(filled, t.size - filled)
-        # the factor Phi^filled is itself an exact exponential, not a repeated square
-        powers[filled : filled + block] = powers[:block] @ scipy.linalg.expm(M * (step * filled))
-        filled += block
-    return powers
-
-
-def _propagate_constant_input(system: StateSpace, t: np.ndarray, x0: np.ndarray, u0: np.ndarray, members):
-    """States at every time for inputs constant in time, shape ([N,] n_time, n).
-
-    With z = [x; u] and u' = 0, z(t) = expm(M (t - t0)) z(t0), M = [[A, B], [0, 0]]:
-    the transition matrices are computed once per time point (not per member)
-    and applied to all members in a single matrix product.
-    """
-    n, m = system.n_states, system.n_inputs
-    M = np.zeros((n + m, n + m))
-    M[:n, :n] = system.A
-    M[:n, n:] = system.B
-    transition = _transition_matrices(M, t)[:, :n, :].reshape(t.size * n, n + m)
-    lead = () if members is None else (members,)
-    z0 = np.concatenate([np.broadcast_to(x0, (*lead, n)), np.broadcast_to(u0, (*lead, m))], axis=-1)
-    return (z0 @ transition.T).reshape(*lead, t.size, n)
-
-
-def _propagate(system: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray, members: int | None):
-    """States at every time, shape (n_time, [N,] n), by exact ZOH steps."""
-    n = system.n_states
-    lead = () if members is None else (members,)
-    x = np.broadcast_to(x0, (*lead, n)).copy()
-    out = np.empty((t.size, *lead, n))
-    out[0] = x
-    if t.size == 1:
-        return out
-    dt = np.diff(t)
-    step = _uniform_step(t)
-    if step is not None:  # steps equal to rounding share one discretisation
-        unique_dt, step_kind = np.array([step]), np.zeros(dt.size, dtype=int)
-    else:
-        unique_dt, step_kind = np.unique(dt, return_inverse=True)
-    Ad_all, Bd_all = zoh_discretize(system.A, system.B, unique_dt)
-    has_input = system.n_inputs > 0 and np.any(u)
-    # inputs as (n_time, [N,] m) so that u_t[k] is the input on step k
-    u_t = np.moveaxis(u, -2, 0) if u.ndim == 3 else u
-    for k in range(t.size - 1):
-        kind = step_kind[k]
-        x = _apply(Ad_all[kind], x)
-        if has_input:
-            x += _apply(Bd_all[kind], u_t[k])
-        out[k + 1] = x
-    return out
-
-
-def _outputs(system: StateSpace, states: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """y = C x + D u for states (..., n_time, n) and inputs (..., n_time, m)."""
-    C, D = system.C, system.D
-    identity_output = C.ndim == 2 and C.shape[0] == C.shape[1] and np.array_equal(C, np.eye(C.shape[0]))
-    if identity_output and not np.any(D):
-        return states  # outputs are the states: share the array rather than copy a large batch
-    y = states @ np.swapaxes(C, -1, -2) if C.ndim == 2 else np.einsum("bpn,btn->btp", C, states)
-    if system.n_inputs and np.any(D):
-        y = y + (u @ np.swapaxes(D, -1, -2) if D.ndim == 2 else np.einsum("bpm,btm->btp", D, np.broadcast_to(u, (*states.shape[:-1], D.shape[-1]))))
-    return y
+def _finite_array(value, name: str, shapes: str, ndims: tuple[int, ...], tail: tuple[int, ...]) -> np.ndarray:
+    array = np.asarray(value, dtype=float)
+    if array.ndim not in ndims or array.shape[array.ndim - len(tail):] != tail:
+        raise InvalidParameter(name, f"expected shape {shapes}, got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise InvalidParameter(name, "contains NaN or infinite entries")
+    return array
 
 
 @dataclass(frozen=True)
-class Response:
-    """Time response of a (batch of) state-space model(s).
+class _Drive:
+    """Validated initial states and inputs, each with a leading member axis of 1 (shared) or N."""
 
-    Attributes
-    ----------
-    time : ndarray, shape (n_time,)
-        Time points, s.
-    states : ndarray, shape (n_time, n) or (N, n_time, n)
-    outputs : ndarray, shape (n_time, p) or (N, n_time, p)
-    state_names, output_names, state_units, output_units : tuple of str
-    """
-
-    time: np.ndarray
-    states: np.ndarray
-    outputs: np.ndarray
-    state_names: tuple[str, ...]
-    output_names: tuple[str, ...]
-    state_units: tuple[str, ...]
-    output_units: tuple[str, ...]
+    x0: np.ndarray  # (1 or N, n)
+    inputs: np.ndarray | None  # (1 or N, m), constant in time
+    series: np.ndarray | None  # (1 or N, T, m)
+    members: int | None  # N, or None for a single response
 
     @property
-    def batched(self) -> bool:
-        return self.states.ndim == 3
+    def count(self) -> int:
+        return self.members or 1
 
-    def __getitem__(self, name: str) -> np.ndarray:
-        """A named output (or, failing that, state), shape (n_time,) or (N, n_time)."""
-        if name in self.output_names:
-            return self.outputs[..., self.output_names.index(name)]
-        if name in self.state_names:
-            return self.states[..., self.state_names.index(name)]
-        raise KeyError(f"no channel {name!r}; outputs are {self.output_names}, states {self.state_names}")
+    def part(self, start: int, stop: int) -> _Drive:
+        def cut(a):
+            return a if a is None or a.shape[0] == 1 else a[start:stop]
+        return _Drive(cut(self.x0), cut(self.inputs), cut(self.series), stop - start)
 
-    def unit(self, name: str) -> str:
-        if name in self.output_names:
-            return self.output_units[self.output_names.index(name)]
-        return self.state_units[self.state_names.index(name)]
 
-    def to_dataframe(self):
-        """A pandas DataFrame: one row per time (and member for a batch), one column per output."""
-        import pandas as pd
+def _drive(system: StateSpace, t: np.ndarray, initial_state, inputs, input_series) -> _Drive:
+    n, m, T = system.n_states, system.n_inputs, t.size
+    x0 = np.zeros(n) if initial_state is None else _finite_array(
+        initial_state, "initial_state", f"({n},) or (N, {n})", (1, 2), (n,))
+    u = None if inputs is None else _finite_array(
+        inputs, "inputs", f"({m},) or (N, {m}) (a time series goes in input_series)", (1, 2), (m,))
+    series = None if input_series is None else _finite_array(
+        input_series, "input_series", f"({T}, {m}) or (N, {T}, {m})", (2, 3), (T, m))
+    sizes = {}
+    for name, size in (("system", system.batch_size), ("initial_state", x0.shape[0] if x0.ndim == 2 else None),
+                       ("inputs", u.shape[0] if u is not None and u.ndim == 2 else None),
+                       ("input_series", series.shape[0] if series is not None and series.ndim == 3 else None)):
+        if size is not None:
+            sizes[name] = size
+    if len(set(sizes.values())) > 1:
+        raise InvalidParameter(list(sizes)[-1], f"member counts disagree: {sizes}")
+    members = next(iter(sizes.values()), None)
+    def with_members(a, ndim):
+        return a if a is None or a.ndim == ndim else a[None]
 
-        if not self.batched:
-            frame = pd.DataFrame(self.outputs, columns=list(self.output_names))
-            frame.insert(0, "time", self.time)
-            return frame
-        members, n_time, p = self.outputs.shape
-        frame = pd.DataFrame(self.outputs.reshape(-1, p), columns=list(self.output_names))
-        frame.insert(0, "time", np.tile(self.time, members))
-        frame.insert(0, "member", np.repeat(np.arange(members), n_time))
-        return frame
+    return _Drive(with_members(x0, 2), with_members(u, 2), with_members(series, 3), members)
 
-    def plot(self, channels=None, ax=None):
-        """Plot outputs against time (all members of a batch, thinly). Returns the Figure."""
-        import matplotlib.pyplot as plt
 
-        channels = list(channels or self.output_names)
-        if ax is None:
-            fig, axes = plt.subplots(len(channels), 1, sharex=True, squeeze=False, figsize=(8, 2.2 * len(channels)))
-            axes = axes[:, 0]
+def _batched(M: np.ndarray) -> np.ndarray:
+    return M if M.ndim == 3 else M[None]
+
+
+def _times(M: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """M_i v_i for matrices (1 or N, r, c) and vectors (1 or N, c): shape (1 or N, r)."""
+    return np.matmul(M, v[..., None])[..., 0]
+
+
+class _Simulation:
+    """Propagate the members of one request, whole or in chunks, returning the rows asked for.
+
+    The exponentials of a single model are computed once and shared by every chunk.
+    """
+
+    def __init__(self, system: StateSpace, t: np.ndarray, drive: _Drive, rows: list[int], with_states: bool):
+        self.system, self.grid, self.drive, self.rows, self.with_states = system, Grid.of(t), drive, rows, with_states
+        C, D = system.C, system.D
+        self.outputs_are_states = (
+            with_states and C.ndim == 2 and np.array_equal(C, np.eye(system.n_states)) and not np.any(D)
+            and rows == list(range(system.n_outputs))
+        )
+        self.stepped = drive.series is not None
+        n, p = system.n_states, len(rows)
+        rows_computed = (n if with_states else 0) + (0 if self.outputs_are_states else p)
+        # stepping keeps the states beside the outputs; a batch of models on a non-uniform grid steps [x; 1]
+        workspace = n + system.n_inputs + 1 if self.stepped or self.grid.n_uniform == 0 else 0
+        self.floats_per_member = t.size * (rows_computed + workspace)
+        self.shared = None
+        if not self.stepped and system.batch_size is None:
+            self.shared = self._constant(system, drive)
+
+    def _row_matrix(self, system: StateSpace, state_rows: np.ndarray, input_rows: np.ndarray) -> np.ndarray:
+        """Rows of [x; w] wanted: the states (when asked) and the chosen outputs, shape (1 or N, r, q)."""
+        blocks = []
+        if self.with_states:
+            blocks.append(np.concatenate([state_rows, np.zeros((*state_rows.shape[:-1], input_rows.shape[-1]))],
+                                         axis=-1)[None])
+        if not self.outputs_are_states and self.rows:
+            C = _batched(system.C)[:, self.rows]
+            D_part = input_rows
+            batch = max(C.shape[0], D_part.shape[0])
+            blocks.append(np.concatenate([np.broadcast_to(C, (batch, *C.shape[1:])),
+                                          np.broadcast_to(D_part, (batch, *D_part.shape[1:]))], axis=-1))
+        batch = max(b.shape[0] for b in blocks)
+        return np.concatenate([np.broadcast_to(b, (batch, *b.shape[1:])) for b in blocks], axis=1)
+
+    def _constant(self, system: StateSpace, drive: _Drive):
+        """(propagator, z0) for inputs constant in time."""
+        n = system.n_states
+        A, B, D = _batched(system.A), _batched(system.B), _batched(system.D)[:, self.rows]
+        x0 = np.broadcast_to(drive.x0, (drive.count, n))
+        u = drive.inputs
+        if u is None or not np.any(u):
+            M, z0, input_rows = A, x0, np.zeros((D.shape[0], len(self.rows), 0))
+        elif A.shape[0] == 1 and B.shape[0] == 1 and u.shape[0] > 1:
+            # one model, inputs per member: z = [x; u] shares the exponentials
+            m = u.shape[1]
+            M = np.zeros((1, n + m, n + m))
+            M[0, :n, :n], M[0, :n, n:] = A[0], B[0]
+            z0, input_rows = np.concatenate([x0, u], axis=1), D
         else:
-            axes = np.atleast_1d(ax)
-            fig = axes[0].figure
-        for axis, name in zip(axes, channels):
-            data = self[name]
-            axis.plot(self.time, data.T if self.batched else data, lw=0.6 if self.batched else 1.2)
-            axis.set_ylabel(f"{name} [{self.unit(name)}]" if self.unit(name) else name)
-            axis.grid(True, alpha=0.3)
-        axes[-1].set_xlabel("time [s]")
-        return fig
+            # fold the inputs into one column B u: z = [x; 1]
+            Bu = _times(B, u)
+            M = np.zeros((max(A.shape[0], Bu.shape[0]), n + 1, n + 1))
+            M[:, :n, :n], M[:, :n, n] = A, Bu
+            z0, input_rows = np.concatenate([x0, np.ones((drive.count, 1))], axis=1), _times(D, u)[..., None]
+        state_rows = np.eye(n)
+        return propagate_constant_input(M, self._row_matrix(system, state_rows, input_rows), self.grid, n), z0
+
+    def chunk(self, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
+        """States (k, T, n or 0) and outputs (k, T, len(rows)) of members start:stop."""
+        system, drive = self.system.subset(start, stop), self.drive.part(start, stop)
+        n = system.n_states
+        if drive.series is not None:
+            series = drive.series if drive.inputs is None else drive.series + drive.inputs[:, None, :]
+            states = propagate_steps_exact(_batched(system.A), _batched(system.B), self.grid,
+                                           np.broadcast_to(drive.x0, (drive.count, n)), series)
+            outputs = states if self.outputs_are_states else self._outputs(system, states, series)
+        else:
+            if self.shared is not None:
+                propagator, z0 = self.shared
+                z0 = z0[start:stop]
+            else:
+                propagator, z0 = self._constant(system, drive)
+            values = propagator(z0)
+            n_kept = n if self.with_states else 0
+            states = values[..., :n_kept]
+            outputs = states if self.outputs_are_states else values[..., n_kept:]
+        if not self.with_states:
+            states = states[..., :0]
+        return states, outputs
+
+    def _outputs(self, system: StateSpace, states: np.ndarray, u: np.ndarray) -> np.ndarray:
+        C, D = _batched(system.C)[:, self.rows], _batched(system.D)[:, self.rows]
+        y = np.matmul(states, np.swapaxes(C, -1, -2))
+        if np.any(D):
+            y += np.matmul(u, np.swapaxes(D, -1, -2))
+        return y
 
 
-def simulate(system: StateSpace, time, initial_state=None, inputs=None) -> Response:
+def _output_rows(system: StateSpace, outputs) -> list[int]:
+    if outputs is None:
+        return list(range(system.n_outputs))
+    names = [outputs] if isinstance(outputs, str) else list(outputs)
+    unknown = [name for name in names if name not in system.outputs]
+    if unknown or not names:
+        raise InvalidParameter("outputs", f"{unknown or names} not among the model's outputs {system.outputs}")
+    return [system.outputs.index(name) for name in names]
+
+
+def simulate(system: StateSpace, time, initial_state=None, inputs=None, input_series=None) -> Response:
     """Propagate a model exactly on a time grid with piecewise-constant inputs.
 
     Parameters
     ----------
     system : StateSpace
-        The model, or a batch of models.
-    time : array_like, shape (n_time,)
+        The model, or a batch of N models.
+    time : array_like, shape (T,)
         Strictly increasing time points, s; the response starts at ``time[0]``.
     initial_state : array_like, shape (n,) or (N, n), optional
-        State at ``time[0]`` (default zero); 2-D makes a batch.
-    inputs : array_like, optional
-        Shape (m,) constant, (n_time, m) a time series shared by all members,
-        (N, m) constant per member, or (N, n_time, m); ``inputs[k]`` holds on
-        ``[time[k], time[k+1])``.
+        State at ``time[0]`` (default zero).
+    inputs : array_like, shape (m,) or (N, m), optional
+        Inputs constant over the run, shared or per member.
+    input_series : array_like, shape (T, m) or (N, T, m), optional
+        Inputs varying in time, ``input_series[..., k, :]`` held on
+        ``[time[k], time[k+1])``; added to ``inputs`` when both are given.
 
     Returns
     -------
     Response
-        Single if neither system, initial state nor inputs is batched.
+        Shapes (T, .) for a single response, (N, T, .) when the system or any
+        argument carries a member axis.
+
+    Raises
+    ------
+    InvalidParameter
+        A shape other than the ones above, disagreeing member counts, a
+        non-finite value, or a history beyond :data:`MAX_RESULT_BYTES`.
+
+    Examples
+    --------
+    >>> integrator = StateSpace([[0.0]], [[1.0]], states=("x",))
+    >>> simulate(integrator, [0.0, 1.0, 3.0], inputs=[[1.0], [2.0]])["x"]
+    array([[0., 1., 3.],
+           [0., 2., 6.]])
+    >>> simulate(integrator, [0.0, 1.0, 3.0], input_series=[[1.0], [-1.0], [0.0]])["x"]
+    array([ 0.,  1., -1.])
     """
     t = _check_time(time)
-    x0, u, members, constant = _prepare(system, t, initial_state, inputs)
-    if constant is not None and system.batch_size is None:
-        states = _propagate_constant_input(system, t, x0, constant, members)
-    else:
-        states = _propagate(system, t, x0, u, members)
-        if members is not None:
-            states = np.moveaxis(states, 0, 1)
-    if members is not None:
-        u = np.broadcast_to(u, (members, t.size, system.n_inputs))
-    return Response(
-        time=t,
-        states=states,
-        outputs=_outputs(system, states, u),
-        state_names=system.states,
-        output_names=system.outputs,
-        state_units=system.state_units,
-        output_units=system.output_units,
-    )
+    drive = _drive(system, t, initial_state, inputs, input_series)
+    simulation = _Simulation(system, t, drive, list(range(system.n_outputs)), with_states=True)
+    needed = 8 * drive.count * simulation.floats_per_member
+    if needed > MAX_RESULT_BYTES:
+        raise InvalidParameter(
+            "time", f"{drive.count} member(s) x {t.size} points need {needed / 2**30:.1f} GiB of history "
+            f"(limit {MAX_RESULT_BYTES / 2**30:.0f} GiB): stream the members with simulate_reduce")
+    states, outputs = simulation.chunk(0, drive.count)
+    if drive.members is None:
+        states, outputs = states[0], outputs[0]
+    return Response(t, states, outputs, system.states, system.outputs, system.state_units, system.output_units)
+
+
+def simulate_reduce(system: StateSpace, time, initial_state=None, inputs=None, input_series=None, *,
+                    reducer: Reducer, outputs=None, chunk_size: int | None = None) -> Reducer:
+    """Simulate members chunk by chunk and stream each chunk into ``reducer``; keep no history.
+
+    Parameters
+    ----------
+    system, time, initial_state, inputs, input_series
+        As in :func:`simulate`.
+    reducer : callable
+        Called as ``reducer(chunk, members)`` for consecutive chunks, where
+        ``chunk`` is a batched :class:`Response` (k, T, .) of the members
+        ``members`` (a slice of range(N)). See :class:`FinalOutputs` and
+        :class:`OutputStatistics`.
+    outputs : sequence of str, optional
+        Only these outputs, and no states, are computed and passed on (default:
+        all states and outputs).
+    chunk_size : int, optional
+        Members per chunk (default: about :data:`CHUNK_BYTES` of history).
+
+    Returns
+    -------
+    reducer
+        The reducer, after the last chunk.
+
+    Examples
+    --------
+    >>> integrator = StateSpace([[0.0]], [[1.0]], states=("x",))
+    >>> finals = simulate_reduce(integrator, [0.0, 2.0], inputs=[[1.0], [3.0], [5.0]],
+    ...                          reducer=FinalOutputs(3, 1), chunk_size=2)
+    >>> finals.values[:, 0]
+    array([ 2.,  6., 10.])
+    """
+    t = _check_time(time)
+    drive = _drive(system, t, initial_state, inputs, input_series)
+    rows = _output_rows(system, outputs)
+    simulation = _Simulation(system, t, drive, rows, with_states=outputs is None)
+    if chunk_size is None:
+        chunk_size = max(1, CHUNK_BYTES // (8 * simulation.floats_per_member))
+    elif not (isinstance(chunk_size, (int, np.integer)) and chunk_size >= 1):
+        raise InvalidParameter("chunk_size", f"must be a whole number >= 1, got {chunk_size!r}")
+    if 8 * chunk_size * simulation.floats_per_member > MAX_RESULT_BYTES:
+        raise InvalidParameter("chunk_size", f"{chunk_size} member(s) x {t.size} points exceed "
+                               f"{MAX_RESULT_BYTES / 2**30:.0f} GiB: use fewer members per chunk or fewer points")
+    names = tuple(system.outputs[i] for i in rows)
+    units = tuple(system.output_units[i] for i in rows)
+    with_states = outputs is None
+    for start in range(0, drive.count, chunk_size):
+        stop = min(start + chunk_size, drive.count)
+        states, values = simulation.chunk(start, stop)
+        chunk = Response(t, states, values, system.states if with_states else (), names,
+                         system.state_units if with_states else (), units)
+        reducer(chunk, slice(start, stop))
+    return reducer
 
 
 @dataclass(frozen=True)
@@ -434,10 +376,12 @@ class StatisticsResponse:
 
     Attributes
     ----------
-    time : ndarray, shape (n_time,)
+    time : ndarray, shape (T,)
     statistics : StreamingStatistics
-        Over members, each sample of shape (n_time, p).
+        Over members, each sample of shape (T, p).
     output_names, output_units : tuple of str
+    final_outputs : ndarray, shape (N, p)
+        Every member's outputs at the last time point.
     """
 
     time: np.ndarray
@@ -464,16 +408,31 @@ def simulate_statistics(
     time,
     initial_state,
     inputs=None,
+    input_series=None,
     *,
-    chunk_size: int = 4096,
-    reservoir_size: int = 2048,
+    chunk_size: int | None = None,
+    reservoir_size: int | None = None,
     seed: int = 0,
 ) -> StatisticsResponse:
-    """Monte Carlo statistics of a batch, propagated chunk by chunk of members.
+    """Monte Carlo statistics of a batch, streamed chunk by chunk of members.
 
-    Memory is bounded by ``chunk_size`` full histories plus the statistics, so a
-    100,000-member Monte Carlo needs no 100,000 histories. Inputs as in
-    :func:`simulate`; batched arrays are split along their member axis.
+    Memory: one chunk of histories (:data:`CHUNK_BYTES` by default), the
+    statistics (4 T p floats) and the percentile reservoir, never a history
+    per member: a 1,000-member run over 48 h at 10 s peaks far below
+    :func:`simulate`'s (see ``benchmarks/bench_engine.py``).
+
+    Parameters
+    ----------
+    system, time, initial_state, inputs, input_series
+        As in :func:`simulate`; the members are the batch's.
+    chunk_size : int, optional
+        Members per chunk.
+    reservoir_size : int, optional
+        Members kept, uniformly at random, for percentiles (default: as many
+        as fit in :data:`RESERVOIR_BYTES`, at most 2,048). Percentiles are exact
+        while the members do not outnumber it.
+    seed : int
+        Seed of the reservoir's draw.
 
     Returns
     -------
@@ -482,29 +441,18 @@ def simulate_statistics(
         and the final outputs of every member, shape (N, p).
     """
     t = _check_time(time)
-    x0, u, members, constant = _prepare(system, t, initial_state, inputs)
-    if constant is not None:
-        u = constant  # keep constant inputs compact so each chunk takes the same exact path
-    if members is None:
+    drive = _drive(system, t, initial_state, inputs, input_series)
+    if drive.members is None:
         raise InvalidParameter("initial_state", "simulate_statistics needs a batch (N, n) of members")
-    stats = StreamingStatistics((t.size, system.n_outputs), reservoir_size=reservoir_size, seed=seed)
-    finals = np.empty((members, system.n_outputs))
+    p = system.n_outputs
+    if reservoir_size is None:
+        reservoir_size = min(2048, RESERVOIR_BYTES // (8 * t.size * max(p, 1)))
+    statistics = OutputStatistics((t.size, p), reservoir_size=min(reservoir_size, drive.members), seed=seed)
+    finals = FinalOutputs(drive.members, p)
 
-    def take(array, lo, hi, batched_ndim):
-        return array[lo:hi] if array.ndim == batched_ndim else array
+    def reduce(chunk: Response, members: slice) -> None:
+        statistics(chunk, members)
+        finals(chunk, members)
 
-    for lo in range(0, members, chunk_size):
-        hi = min(lo + chunk_size, members)
-        chunk_system = system
-        if system.batch_size is not None:
-            chunk_system = StateSpace(
-                take(system.A, lo, hi, 3), take(system.B, lo, hi, 3), take(system.C, lo, hi, 3),
-                take(system.D, lo, hi, 3), system.states, system.inputs, system.outputs,
-                system.state_units, system.output_units,
-            )
-        x_chunk = np.broadcast_to(x0, (members, system.n_states))[lo:hi]
-        u_chunk = take(u, lo, hi, 3 if constant is None else 2)
-        response = simulate(chunk_system, t, x_chunk, u_chunk)
-        stats.update(response.outputs)
-        finals[lo:hi] = response.outputs[:, -1, :]
-    return StatisticsResponse(t, stats, system.outputs, system.output_units, finals)
+    simulate_reduce(system, t, initial_state, inputs, input_series, reducer=reduce, chunk_size=chunk_size)
+    return StatisticsResponse(t, statistics.statistics, system.outputs, system.output_units, finals.values)

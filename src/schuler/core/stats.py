@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from schuler.exceptions import InvalidParameter
+
 
 class StreamingStatistics:
     """Mean, standard deviation, extremes and percentiles of streamed samples.
@@ -23,7 +25,8 @@ class StreamingStatistics:
     shape : tuple of int
         Shape of one member's sample, e.g. ``(n_time, n_channels)``.
     reservoir_size : int
-        Members kept for percentiles (memory: reservoir_size x prod(shape) floats).
+        Members kept for percentiles (memory: reservoir_size x prod(shape) floats,
+        allocated up front; 0 keeps none and offers no percentiles).
     seed : int
         Seed of the reservoir's random keys.
 
@@ -43,6 +46,8 @@ class StreamingStatistics:
     """
 
     def __init__(self, shape: tuple[int, ...], reservoir_size: int = 2048, seed: int = 0):
+        if not (isinstance(reservoir_size, (int, np.integer)) and reservoir_size >= 0):
+            raise InvalidParameter("reservoir_size", f"must be a whole number >= 0, got {reservoir_size!r}")
         self.shape = tuple(shape)
         self.count = 0
         self._mean = np.zeros(self.shape)
@@ -51,8 +56,9 @@ class StreamingStatistics:
         self._max = np.full(self.shape, -np.inf)
         self._reservoir_size = int(reservoir_size)
         self._rng = np.random.default_rng(seed)
-        self._keys = np.empty(0)
-        self._reservoir = np.empty((0, *self.shape))
+        self._keys = np.empty(self._reservoir_size)
+        self._reservoir = np.empty((self._reservoir_size, *self.shape))
+        self._kept = 0
 
     def update(self, samples: np.ndarray) -> None:
         """Add a chunk of members, shape ``(k, *shape)``."""
@@ -71,12 +77,24 @@ class StreamingStatistics:
         self.count = total
         np.minimum(self._min, samples.min(axis=0), out=self._min)
         np.maximum(self._max, samples.max(axis=0), out=self._max)
-        keys = np.concatenate([self._keys, self._rng.random(k)])
-        pool = np.concatenate([self._reservoir, samples])
-        if keys.size > self._reservoir_size:
-            keep = np.argpartition(keys, self._reservoir_size - 1)[: self._reservoir_size]
-            keys, pool = keys[keep], pool[keep]
-        self._keys, self._reservoir = keys, pool
+        self._sample(samples)
+
+    def _sample(self, samples: np.ndarray) -> None:
+        """Keep the members with the smallest random keys, replacing others in place (no pool copy)."""
+        size, kept = self._reservoir_size, self._kept
+        keys = np.asarray(self._rng.random(samples.shape[0]))
+        if kept + keys.size <= size:
+            self._reservoir[kept : kept + keys.size] = samples
+            self._keys[kept : kept + keys.size] = keys
+            self._kept += keys.size
+            return
+        chosen = np.argpartition(np.concatenate([self._keys[:kept], keys]), size - 1)[:size]
+        newcomers = chosen[chosen >= kept] - kept
+        # slots of the members that lost their place, then the never-filled ones
+        slots = np.concatenate([np.setdiff1d(np.arange(kept), chosen[chosen < kept]), np.arange(kept, size)])
+        self._reservoir[slots] = samples[newcomers]
+        self._keys[slots] = keys[newcomers]
+        self._kept = size
 
     @property
     def mean(self) -> np.ndarray:
@@ -114,4 +132,6 @@ class StreamingStatistics:
         """Percentile(s) ``q`` (0..100) over members, from the reservoir."""
         if self.count == 0:
             raise ValueError("no samples yet")
-        return np.percentile(self._reservoir, q, axis=0)
+        if self._reservoir_size == 0:
+            raise InvalidParameter("reservoir_size", "is 0: no members were kept for percentiles")
+        return np.percentile(self._reservoir[: self._kept], q, axis=0)

@@ -340,7 +340,7 @@ def simulate_cycle(
             inputs[:, :-1, 2] += densities[0][:, None] * noise[:, phase, 0] / np.sqrt(step)
             inputs[:, :-1, 3] = densities[1][:, None] * noise[:, phase, 1] / np.sqrt(step)
         state[:, 0] = 0.0  # each pulse's ramp part starts from zero
-        states = simulate(model, grid, state, inputs).states
+        states = simulate(model, grid, state, input_series=inputs).states
         measured = states[:, :, i_alpha] - states[:, :, i_theta] + inputs[:, :, 3]
         signal = stabilizer.k1 * (1.0 + kappa)[:, None] * measured
         samples[:, phase] = signal[:, 0]

@@ -22,12 +22,27 @@ import warnings
 import numpy as np
 
 from schuler.contract import Cases, Output
-from schuler.gyrocompassing import analytic, models, study
-from schuler.gyrocompassing.results import AlignmentResult, write_files
+from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.gyrocompassing import analytic, models
+from schuler.gyrocompassing.case import (
+    DEFAULT_DAMPING,
+    DEFAULT_INITIAL_AZIMUTH_ERROR,
+    DEFAULT_MAX_LATITUDE,
+    DEFAULT_TIME_CONSTANT,
+    MAX_DURATION,
+    AlignmentCase,
+    DegradedAccuracyWarning,
+    analytic_results,
+    automatic_duration,
+)
+from schuler.gyrocompassing.results import AlignmentResult
+from schuler.gyrocompassing.simulation import evaluate_cases
+from schuler.gyrocompassing.simulation import run_case as simulate_case
 from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
 
-_ERROR_RANGE = {"minimum": -600.0, "maximum": 600.0}
+_ERROR_LIMIT = 600.0
+"""Largest latitude error and initial level error accepted, arcmin (either sign)."""
 
 PARAMETERS = ParameterSet((
     Parameter("latitude", "deg", 50.0, "Latitude of the site.", minimum=-90, maximum=90,
@@ -38,38 +53,42 @@ PARAMETERS = ParameterSet((
     Parameter("drift_x", "deg/h", 0.0, "Residual drift about the platform x axis (adds to east/north)."),
     Parameter("drift_y", "deg/h", 0.0, "Residual drift about the platform y axis (adds to east/north)."),
     Parameter("drift_z", "deg/h", 0.0, "Residual drift about the platform z axis (up)."),
-    Parameter("latitude_error", "arcmin", 0.0, "Error Delta phi of the latitude entered.", **_ERROR_RANGE),
+    Parameter("latitude_error", "arcmin", 0.0, "Error Delta phi of the latitude entered.",
+              minimum=-_ERROR_LIMIT, maximum=_ERROR_LIMIT),
     Parameter("accel_bias_x", "g", 0.0, "Bias Delta a_x of the x accelerometer (measured - true).",
               minimum=-0.1, maximum=0.1),
     Parameter("accel_bias_y", "g", 0.0, "Bias Delta a_y of the y accelerometer (measured - true).",
               minimum=-0.1, maximum=0.1),
-    Parameter("time_constant", "s", study.DEFAULT_TIME_CONSTANT,
+    Parameter("time_constant", "s", DEFAULT_TIME_CONSTANT,
               "Time constant T of the azimuth loop (gains not given follow from T and zeta).",
               minimum=0.1, maximum=1e5),
-    Parameter("damping", "", study.DEFAULT_DAMPING, "Damping ratio zeta of the azimuth loop.",
+    Parameter("damping", "", DEFAULT_DAMPING, "Damping ratio zeta of the azimuth loop.",
               minimum=0.01, maximum=100),
     Parameter("c_gamma", "1/s", None, "Level correction gain c_Gamma (not set: 2 zeta / T).",
               minimum=1e-6, maximum=100),
     Parameter("c_a", "1/s", None, "Azimuth correction gain c_a (not set: 1 / (T^2 U cos(latitude))).",
               minimum=1e-6, maximum=1e8),
-    Parameter("initial_azimuth_error", "deg", math.degrees(study.DEFAULT_INITIAL_AZIMUTH_ERROR),
+    Parameter("initial_azimuth_error", "deg", math.degrees(DEFAULT_INITIAL_AZIMUTH_ERROR),
               "Initial azimuth misalignment delta0.", minimum=-90, maximum=90),
-    Parameter("initial_beta", "arcmin", 0.0, "Initial level error beta0 (0: levelled).", **_ERROR_RANGE),
-    Parameter("initial_alpha", "arcmin", 0.0, "Initial level error alpha0 (0: levelled).", **_ERROR_RANGE),
+    Parameter("initial_beta", "arcmin", 0.0, "Initial level error beta0 (0: levelled).",
+              minimum=-_ERROR_LIMIT, maximum=_ERROR_LIMIT),
+    Parameter("initial_alpha", "arcmin", 0.0, "Initial level error alpha0 (0: levelled).",
+              minimum=-_ERROR_LIMIT, maximum=_ERROR_LIMIT),
     Parameter("model", "", "full", "Model: full (mu, nu) (1.17), full-ab (beta, alpha) (1.18) or simplified (1.19).",
               choices=models.MODELS, kind="choice"),
     Parameter("duration", "s", None,
               "Simulated time (not set: 2 h, or 3 settling times if longer, at most 48 h).",
-              minimum=0, exclusive_minimum=True, maximum=study.MAX_DURATION),
+              minimum=0, exclusive_minimum=True, maximum=MAX_DURATION),
     Parameter("output_step", "s", 1.0, "Output step (the simulation is exact between outputs).",
               minimum=1e-3, maximum=3600),
-    Parameter("max_latitude", "deg", math.degrees(study.DEFAULT_MAX_LATITUDE),
+    Parameter("max_latitude", "deg", math.degrees(DEFAULT_MAX_LATITUDE),
               "Latitude above which azimuth is reported not observable.", minimum=0, maximum=90,
               exclusive_minimum=True, exclusive_maximum=True),
     Parameter("sigma_drift", "deg/h", 0.01, "Monte Carlo: 1-sigma of the x and y residual drifts.", minimum=0),
     Parameter("sigma_drift_z", "deg/h", 0.01, "Monte Carlo: 1-sigma of the z residual drift.", minimum=0),
     Parameter("sigma_accel", "g", 1e-4, "Monte Carlo: 1-sigma of each accelerometer bias.", minimum=0),
-), owner="align", renamed={"time_step": "output_step", "accel_error_x": "accel_bias_x", "accel_error_y": "accel_bias_y"})
+), owner="align",
+   renamed={"time_step": "output_step", "accel_error_x": "accel_bias_x", "accel_error_y": "accel_bias_y"})
 """Every option of ``schuler align run`` (and key of an ``align`` scenario)."""
 
 OUTPUTS = (
@@ -86,13 +105,13 @@ OUTPUTS = (
     Output("settling_time_simulated_s", "s", "", "last exit from the 1 % band (simulated; inf: not settled)"),
     Output("c_gamma", "1/s", "", "level correction gain used"),
     Output("c_a", "1/s", "", "azimuth correction gain used"),
-    Output("time_constant_s", "s", "", "time constant T of the gains used"),
-    Output("damping", "1", "", "damping ratio zeta of the gains used"),
+    Output("design_time_constant_s", "s", "", "time constant T of the gains used"),
+    Output("design_damping", "1", "", "damping ratio zeta of the gains used"),
     Output("max_abs_delta_rad", "rad", "", "largest |delta| over the run (simulated)"),
     Output("max_abs_beta_rad", "rad", "", "largest |beta| over the run (simulated)"),
     Output("max_abs_delta_rate_rad_s", "rad/s", "", "largest |delta'| over the run (simulated)"),
     Output("constraints_ok", "1", "", "1 when |delta| < 0.4 rad, |beta| < 0.01 rad, |delta'| < 0.2 rad/s throughout"),
-    Output("duration_s", "s", "", "simulated time"),
+    Output("simulated_duration_s", "s", "", "simulated time"),
 )
 
 FIDELITIES = ("simulated", "closed")
@@ -105,8 +124,8 @@ _CASE_FIELDS = ("latitude", "azimuth", "drift_east", "drift_north", "drift_x", "
                 "initial_beta", "initial_alpha")
 
 
-def alignment_case(cases: Cases) -> study.AlignmentCase:
-    """The :class:`~schuler.gyrocompassing.study.AlignmentCase` of a batch, random terms drawn for members."""
+def alignment_case(cases: Cases) -> AlignmentCase:
+    """The :class:`~schuler.gyrocompassing.AlignmentCase` of a batch, random terms drawn for members."""
     arrays = {name: cases.float(name) for name in _CASE_FIELDS}
     arrays["accel_error_x"] = cases.float("accel_bias_x")
     arrays["accel_error_y"] = cases.float("accel_bias_y")
@@ -116,8 +135,10 @@ def alignment_case(cases: Cases) -> study.AlignmentCase:
                             ("accel_error_x", "sigma_accel"), ("accel_error_y", "sigma_accel")):
             arrays[name] = arrays[name] + cases.float(sigma) * draw(name, cases.members)
     max_latitude = cases.float("max_latitude")
-    return study.AlignmentCase(**arrays, max_latitude=float(max_latitude.max()) if max_latitude.size else
-                               study.DEFAULT_MAX_LATITUDE)
+    # the system has no Earth parameters: the model's constants, named so that only
+    # the per-case arrays go through **arrays
+    return AlignmentCase(**arrays, max_latitude=float(max_latitude.max()) if max_latitude.size else
+                         DEFAULT_MAX_LATITUDE, earth_rate=EARTH_RATE, gravity=STANDARD_GRAVITY)
 
 
 def evaluate(cases: Cases) -> dict[str, np.ndarray]:
@@ -130,8 +151,8 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     fidelity = cases.fidelity or FIDELITIES[0]
     # a duration not set is the case's own automatic one, so a batch gives what each case alone gives
-    settling = study.analytic_results(alignment_case(cases), "simplified")["settling_time_s"]
-    automatic = np.array([study.automatic_duration(t) for t in np.broadcast_to(settling, (n,))])
+    settling = analytic_results(alignment_case(cases), "simplified")["settling_time_s"]
+    automatic = np.array([automatic_duration(t) for t in np.broadcast_to(settling, (n,))])
     resolved = Cases({**{name: cases[name] for name in cases.names}, "duration": cases.value_or("duration", automatic)},
                      members=cases.members, random=cases.random, fidelity=cases.fidelity)
     for index, group in resolved.groups("model", "duration", "output_step", "max_latitude"):
@@ -150,9 +171,9 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
         points = duration / float(cases.float("output_step")[0]) + 2
         require(points * 8 * 6 * min(len(cases), _CHUNK_MEMBERS), "this simulation",
                 "--duration or --output-step (or --fidelity closed)")
-    result = study.evaluate_cases(case, model, simulate_runs=simulate, duration=duration,
+    result = evaluate_cases(case, model, simulate_runs=simulate, duration=duration,
                                   time_step=float(cases.float("output_step")[0]))
-    full = study.analytic_results(case, "full-ab")["azimuth_error_rad"]
+    full = analytic_results(case, "full-ab")["azimuth_error_rad"]
     c_gamma, c_a = result["c_gamma"], result["c_a"]
     system = case.model(model)
     gains = analytic.steady_state_gain_matrix(system.A, system.B)[..., list(system.states).index("delta"), :]
@@ -171,8 +192,8 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
         "settling_time_s": result["settling_time_s"],
         "c_gamma": c_gamma,
         "c_a": c_a,
-        "time_constant_s": result["time_constant_s"],
-        "damping": result["damping"],
+        "design_time_constant_s": result["time_constant_s"],
+        "design_damping": result["damping"],
     }
     if simulate:
         out.update({
@@ -181,7 +202,7 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
             "max_abs_beta_rad": result["max_abs_beta_rad"],
             "max_abs_delta_rate_rad_s": result["max_abs_delta_rate_rad_per_s"],
             "constraints_ok": np.asarray(result["constraints_ok"], dtype=float),
-            "duration_s": np.full(len(cases), duration),
+            "simulated_duration_s": np.full(len(cases), duration),
         })
     return out
 
@@ -199,7 +220,7 @@ def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
     cases = Cases.from_case(case, fidelity=fidelity)
     outputs = {name: float(values[0]) for name, values in evaluate(cases).items()}
     aligned = alignment_case(cases)
-    single = study.AlignmentCase(**{f: (v[0] if isinstance(v, np.ndarray) else v)
+    single = AlignmentCase(**{f: (v[0] if isinstance(v, np.ndarray) else v)
                                     for f, v in vars(aligned).items()})
     model = case["model"]
     histories = simplified = None
@@ -208,26 +229,28 @@ def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
         with warnings.catch_warnings():
             # evaluate has warned about the latitude already; the histories are the same case
             warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")
-            histories = study.run_case(single, model, duration=outputs["duration_s"], time_step=case["output_step"])
+            histories = simulate_case(single, model, duration=outputs["simulated_duration_s"],
+                                      time_step=case["output_step"])
             simplified = histories
             if model != "simplified":
                 # (1.19) beside the model for the comparison figures; the model's own run has warned already
-                warnings.simplefilter("ignore", study.DegradedAccuracyWarning)
-                simplified = study.run_case(single, "simplified", duration=outputs["duration_s"],
+                warnings.simplefilter("ignore", DegradedAccuracyWarning)
+                simplified = simulate_case(single, "simplified", duration=outputs["simulated_duration_s"],
                                             time_step=case["output_step"])
     violations = [] if histories is None else list(histories.violations)
     return AlignmentResult(
         model=model, fidelity=fidelity,
         regime=_regime(outputs["c_gamma"], outputs["c_a"], case["latitude"]),
         constraint_violations=violations, run=histories, simplified_run=simplified,
-        **{name: (None if math.isnan(value) else bool(value)) if name == "constraints_ok" else value
-           for name, value in outputs.items()},
+        constraints_ok=None if math.isnan(outputs["constraints_ok"]) else bool(outputs["constraints_ok"]),
+        monte_carlo=None,  # System.run adds it
+        **{name: value for name, value in outputs.items() if name != "constraints_ok"},
     )
 
 
 def _regime(c_gamma: float, c_a: float, latitude: float) -> str:
     h_sq = (c_gamma / 2) ** 2
-    omega0_sq = c_a * math.cos(latitude) * study.EARTH_RATE
+    omega0_sq = c_a * math.cos(latitude) * EARTH_RATE
     if math.isclose(h_sq, omega0_sq, rel_tol=1e-9):
         return "critical"
     return "oscillatory" if omega0_sq > h_sq else "aperiodic"
@@ -235,7 +258,7 @@ def _regime(c_gamma: float, c_a: float, latitude: float) -> str:
 
 def member_bytes(case: Case) -> int:
     """Memory one member holds while simulated: its history of 3 states and 3 outputs, 8 bytes each."""
-    duration = case["duration"] or study.MAX_DURATION
+    duration = case["duration"] or MAX_DURATION
     return int(6 * 8 * (duration / case["output_step"] + 2))
 
 

@@ -1,0 +1,227 @@
+"""Benchmark: the nonlinear INS against pyins, one trajectory end to end, and batched Monte Carlo throughput.
+
+Case (the issue's): a vehicle at rest at 45 deg for 3 h, IMU at 100 Hz (1,080,000 samples), vertical
+channel held, with the same initial errors (north 10 m, east -5 m; 0.1 and -0.05 m/s; roll 1e-4 rad,
+pitch -5e-5 rad, heading 1e-3 rad) and body-axis biases (gyro 1e-8, -2e-8, 5e-9 rad/s; accelerometer
+1e-4, -2e-4, 0 m/s^2) in both.
+
+* schuler, end to end: trajectory, truth and ideal IMU by inverse mechanization (streamed), strapdown
+  integration and the errors at 1-s output (:func:`schuler.navigate.mechanization.navigate`).
+* pyins 1.0.1 (``python-ins``, a benchmark-only extra), end to end: ``sim.generate_imu`` (increments),
+  biases added, ``strapdown.compute_increments_from_imu``, ``Integrator.integrate``,
+  ``transform.compute_state_difference``; and without its IMU synthesis (integration and errors only).
+  Both warmed up first (numba compilation excluded). Skipped, with a message, when pyins is absent.
+* Agreement of every error channel at the common 1-s times: max |schuler - pyins| / max |schuler|
+  (target <= 1e-4), and each library's own floor (the same run without errors).
+* Batched Monte Carlo: N members with per-member constant errors (initial errors, biases, scale
+  factors, misalignments drawn from RandomStreams), 1 h at 100 Hz, in member-samples per second (target
+  >= 10 M/s); the same through the noise interface with a source of zeros (its own cost) and with white
+  sensor noise from RandomStreams (the generator's cost on top).
+
+Throughputs are printed from wall time and from CPU time (the machine is shared: CPU time shows the
+work, wall time what a user waits); ratios use the same clock on both sides.
+
+Targets: end-to-end ratio >= 10 (issue 15; pyins measured 0.38-0.41 M samples/s here), agreement <= 1e-4,
+batched >= 10 M member-samples/s.
+"""
+
+from __future__ import annotations
+
+import math
+import resource
+import sys
+import time
+import tracemalloc
+
+import numpy as np
+
+from schuler.core.random import RandomStreams
+from schuler.navigate.errors import InitialErrors, SensorErrors, WhiteNoise
+from schuler.navigate.mechanization import estimate_memory, navigate
+from schuler.navigate.trajectory import Stationary
+
+LATITUDE_DEG = 45.0
+HOURS = 3.0
+IMU_RATE = 100.0
+OUTPUT_STEP = 1.0
+INITIAL = {"north": 10.0, "east": -5.0, "velocity_north": 0.1, "velocity_east": -0.05, "roll": 1e-4,
+           "pitch": -5e-5, "heading": 1e-3}
+GYRO_BIAS = np.array([1e-8, -2e-8, 5e-9])
+ACCEL_BIAS = np.array([1e-4, -2e-4, 0.0])
+MEMBERS = 128
+MONTE_CARLO_HOURS = 1.0
+TARGET_RATIO = 10.0
+TARGET_AGREEMENT = 1e-4
+TARGET_BATCH = 10e6
+
+CHANNELS = {  # schuler name: (pyins column, factor to SI)
+    "position_error_north_m": ("north", 1.0),
+    "position_error_east_m": ("east", 1.0),
+    "velocity_error_north_m_s": ("VN", 1.0),
+    "velocity_error_east_m_s": ("VE", 1.0),
+    "roll_error_rad": ("roll", math.pi / 180),
+    "pitch_error_rad": ("pitch", math.pi / 180),
+    "heading_error_rad": ("heading", math.pi / 180),
+}
+
+
+def timed(function):
+    """(result, wall seconds, CPU seconds) of one call."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    result = function()
+    return result, time.perf_counter() - wall, time.process_time() - cpu
+
+
+def peak_memory(function) -> float:
+    """Peak of numpy/Python allocations during one call, MiB (tracemalloc)."""
+    tracemalloc.start()
+    function()
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    return peak / 2**20
+
+
+def run_schuler(hours: float, errors: bool = True):
+    initial = InitialErrors(position_error_north=INITIAL["north"], position_error_east=INITIAL["east"],
+                            velocity_error_north=INITIAL["velocity_north"],
+                            velocity_error_east=INITIAL["velocity_east"], roll_error=INITIAL["roll"],
+                            pitch_error=INITIAL["pitch"], heading_error=INITIAL["heading"]) if errors else None
+    sensors = SensorErrors(gyro_bias=GYRO_BIAS, accel_bias=ACCEL_BIAS) if errors else None
+    return navigate(Stationary(latitude=math.radians(LATITUDE_DEG)), hours * 3600.0, imu_rate=IMU_RATE,
+                    output_step=OUTPUT_STEP, initial_errors=initial, sensor_errors=sensors)
+
+
+def run_pyins(hours: float, errors: bool = True, imu=None):
+    """pyins end to end; returns (errors DataFrame, IMU synthesis seconds wall, CPU) for reuse."""
+    from pyins import sim, strapdown, transform
+
+    dt = 1.0 / IMU_RATE
+    t = np.arange(0.0, hours * 3600.0 + dt / 2, dt)
+    synthesis = (0.0, 0.0)
+    if imu is None:
+        lla = np.tile([LATITUDE_DEG, 0.0, 0.0], (t.size, 1))
+        wall, cpu = time.perf_counter(), time.process_time()
+        imu = sim.generate_imu(t, lla, np.zeros((t.size, 3)), np.zeros((t.size, 3)), sensor_type="increment")
+        synthesis = (time.perf_counter() - wall, time.process_time() - cpu)
+    trajectory, readings = imu
+    readings = readings.copy()
+    if errors:
+        readings[["gyro_x", "gyro_y", "gyro_z"]] += GYRO_BIAS * dt
+        readings[["accel_x", "accel_y", "accel_z"]] += ACCEL_BIAS * dt
+    increments = strapdown.compute_increments_from_imu(readings, "increment")
+    start = trajectory.iloc[0]
+    if errors:
+        error = sim.generate_pva_error(0.0, 0.0, 0.0, 0.0)
+        error[["north", "east", "down"]] = [INITIAL["north"], INITIAL["east"], 0.0]
+        error[["VN", "VE", "VD"]] = [INITIAL["velocity_north"], INITIAL["velocity_east"], 0.0]
+        error[["roll", "pitch", "heading"]] = np.degrees([INITIAL["roll"], INITIAL["pitch"], INITIAL["heading"]])
+        start = sim.perturb_pva(start, error)
+    integrator = strapdown.Integrator(start, with_altitude=False)
+    computed = integrator.integrate(increments)
+    return transform.compute_state_difference(computed, trajectory), imu, synthesis
+
+
+def agreement(ours, theirs) -> dict[str, float]:
+    """max |schuler - pyins| / max |schuler| per channel at the common output times."""
+    step = round(OUTPUT_STEP * IMU_RATE)
+    out = {}
+    for name, (column, factor) in CHANNELS.items():
+        mine = ours.channel(name)
+        other = theirs[column].to_numpy()[::step][: mine.size] * factor
+        out[name] = float(np.abs(mine - other).max() / np.abs(mine).max())
+    return out
+
+
+def batch_errors(members: int):
+    streams = RandomStreams(2024)
+    ids = np.arange(members)
+
+    def normal(stream, scale, size=None):
+        return streams.normal(stream, ids, size) * scale
+
+    misalignment = normal("misalignment", 1e-4, 9).reshape(members, 3, 3) * (1 - np.eye(3))
+    initial = InitialErrors(position_error_north=normal("north", 10.0), position_error_east=normal("east", 10.0),
+                            velocity_error_north=normal("vn", 0.1), velocity_error_east=normal("ve", 0.1),
+                            roll_error=normal("roll", 1e-4), pitch_error=normal("pitch", 1e-4),
+                            heading_error=normal("heading", 1e-3))
+    sensors = SensorErrors(gyro_bias=normal("gyro_bias", 1e-8, 3), accel_bias=normal("accel_bias", 1e-4, 3),
+                           gyro_scale_factor=normal("gyro_scale", 1e-5, 3),
+                           accel_scale_factor=normal("accel_scale", 1e-4, 3),
+                           gyro_misalignment=misalignment, accel_misalignment=misalignment)
+    return initial, sensors
+
+
+class ZeroNoise:
+    """A noise source of zeros: what the noise interface itself costs (allocation, copy, kernel reads)."""
+
+    def increments(self, members, start, stop, dt):
+        return np.zeros((len(members), stop - start, 3)), np.zeros((len(members), stop - start, 3))
+
+
+def run_batch(members: int, hours: float, noise=None):
+    initial, sensors = batch_errors(members)
+    return navigate(Stationary(latitude=math.radians(LATITUDE_DEG)), hours * 3600.0, imu_rate=IMU_RATE,
+                    output_step=60.0, initial_errors=initial, sensor_errors=sensors, noise=noise,
+                    member_ids=np.arange(members))
+
+
+def main() -> int:
+    samples = round(HOURS * 3600 * IMU_RATE)
+    run_schuler(0.01)  # compile (cached after the first run) and warm up
+    result, wall, cpu = timed(lambda: run_schuler(HOURS))
+    floor = run_schuler(HOURS, errors=False)
+    print(f"schuler: {HOURS:g} h at {IMU_RATE:g} Hz ({samples:,} samples) end to end in {wall:.2f} s wall, "
+          f"{cpu:.2f} s CPU: {samples / wall / 1e6:.2f} M samples/s wall, {samples / cpu / 1e6:.2f} M/s CPU; "
+          f"peak allocation {peak_memory(lambda: run_schuler(HOURS)):.0f} MiB")
+    ok = True
+    try:
+        import pyins  # noqa: F401 - presence check
+    except ImportError:
+        print("pyins: not installed (pip install python-ins==1.0.1, the 'bench' extra): comparison skipped")
+    else:
+        run_pyins(0.01)  # numba compilation of pyins's integrator
+        (theirs, imu, synthesis), p_wall, p_cpu = timed(lambda: run_pyins(HOURS))
+        (_, _, _), i_wall, i_cpu = timed(lambda: run_pyins(HOURS, imu=imu))
+        pyins_floor = run_pyins(HOURS, errors=False, imu=imu)[0]
+        print(f"pyins: end to end {p_wall:.2f} s wall, {p_cpu:.2f} s CPU ({samples / p_wall / 1e6:.3f} M samples/s "
+              f"wall; IMU synthesis {synthesis[0]:.2f} s); without synthesis {i_wall:.2f} s wall, {i_cpu:.2f} s CPU "
+              f"({samples / i_wall / 1e6:.3f} M samples/s)")
+        ratio, ratio_cpu = p_wall / wall, p_cpu / cpu
+        print(f"ratio, end to end: {ratio:.1f}x wall, {ratio_cpu:.1f}x CPU; against pyins without its IMU "
+              f"synthesis: {i_wall / wall:.1f}x wall, {i_cpu / cpu:.1f}x CPU (target >= {TARGET_RATIO:g}x)")
+        agree = agreement(result, theirs)
+        print("agreement, max |schuler - pyins| / max |schuler| (target <= 1e-4); floors: max |error| without "
+              "errors, schuler / pyins:")
+        for name, value in agree.items():
+            column, factor = CHANNELS[name]
+            print(f"  {name:26s} {value:.1e}   (max {np.abs(result.channel(name)).max():.4g}; floors "
+                  f"{np.abs(floor.channel(name)).max():.1e} / {np.abs(pyins_floor[column]).max() * factor:.1e})")
+        ok = ratio >= TARGET_RATIO and max(agree.values()) <= TARGET_AGREEMENT
+
+    batch_samples = MEMBERS * round(MONTE_CARLO_HOURS * 3600 * IMU_RATE)
+    run_batch(4, 1.0 / 60.0)  # compile and warm up
+    _, b_wall, b_cpu = timed(lambda: run_batch(MEMBERS, MONTE_CARLO_HOURS))
+    estimate = estimate_memory(MEMBERS, round(MONTE_CARLO_HOURS * 60) + 1, 65_536, False) / 2**20
+    print(f"batch: {MEMBERS} members x {MONTE_CARLO_HOURS:g} h at {IMU_RATE:g} Hz with per-member constant errors in "
+          f"{b_wall:.2f} s wall, {b_cpu:.2f} s CPU: {batch_samples / b_wall / 1e6:.1f} M member-samples/s wall, "
+          f"{batch_samples / b_cpu / 1e6:.1f} M/s per CPU (target >= {TARGET_BATCH / 1e6:g} M/s); "
+          f"planned memory {estimate:.1f} MiB, peak allocation "
+          f"{peak_memory(lambda: run_batch(MEMBERS, MONTE_CARLO_HOURS)):.0f} MiB")
+    noisy_members = MEMBERS // 4
+    noisy_samples = noisy_members * round(MONTE_CARLO_HOURS * 3600 * IMU_RATE)
+    for label, source in (("the noise interface alone (a source returning zeros)", ZeroNoise()),
+                          ("white noise (RandomStreams.normal_series)",
+                           WhiteNoise(angle_random_walk=2.9e-6, velocity_random_walk=1e-4, seed=7))):
+        _, n_wall, n_cpu = timed(lambda source=source: run_batch(noisy_members, MONTE_CARLO_HOURS, source))
+        print(f"batch with {label}: {noisy_members} members in {n_wall:.2f} s wall: "
+              f"{noisy_samples / n_wall / 1e6:.2f} M member-samples/s wall, "
+              f"{noisy_samples / n_cpu / 1e6:.2f} M/s per CPU")
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"peak resident memory of the whole benchmark (pyins's frames included): {peak:.0f} MiB")
+    ok = ok and batch_samples / b_wall >= TARGET_BATCH
+    print("PASS" if ok else "FAIL")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,157 @@
+"""Compiled loops of the linear-systems engine, on plain arrays written in place.
+
+* :func:`propagate_steps`: the recursion x_(k+1) = Ad x_k + Bd u_k with an input
+  that changes every step, sequential by nature, for every member.
+* :func:`fill_blocks`: the samples of the block scheme, y = rows Phi^j Psi^b z0,
+  which numpy would spread over many small matrix products per member.
+
+Everything else (discretisation, balancing, shapes, the choice of method) stays
+in :mod:`schuler.core.propagation`.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+
+@numba.njit(cache=True)
+def propagate_steps(Ad: np.ndarray, Bd: np.ndarray, kind: np.ndarray, x0: np.ndarray, u: np.ndarray,
+                    out: np.ndarray) -> None:
+    """Fill ``out`` with x_(k+1) = Ad[kind[k]] x_k + Bd[kind[k]] u_k for every member.
+
+    Member-last layouts: the innermost loop runs over members, contiguous in
+    memory, so a step of N members is a few vector operations, as a matrix
+    product over members would be, without a Python loop over time.
+
+    Parameters
+    ----------
+    Ad : ndarray, shape (n_kinds, n, n, 1 or N)
+        Exact transition over each distinct step; a last axis of 1 shares it among members.
+    Bd : ndarray, shape (n_kinds, n, m, 1 or N)
+        Exact input matrix over each distinct step.
+    kind : ndarray of int64, shape (n_time - 1,)
+        Which distinct step each grid step is.
+    x0 : ndarray, shape (n, N)
+        States at the first time point.
+    u : ndarray, shape (1 or n_time, m, 1 or N)
+        Inputs held over each step; a time length of 1 holds them over the run.
+    out : ndarray, shape (n_time, n, N)
+        States at every time point (written).
+    """
+    n_time, n, members = out.shape
+    m = u.shape[1]
+    shared_model = Ad.shape[3] == 1
+    shared_input = u.shape[2] == 1
+    out[0] = x0
+    for k in range(n_time - 1):
+        s = kind[k]
+        c = 0 if u.shape[0] == 1 else k
+        for r in range(n):
+            row = out[k + 1, r]
+            row[:] = 0.0
+            for j in range(n):
+                previous = out[k, j]
+                if shared_model:
+                    a = Ad[s, r, j, 0]
+                    for i in range(members):
+                        row[i] += a * previous[i]
+                else:
+                    a_all = Ad[s, r, j]
+                    for i in range(members):
+                        row[i] += a_all[i] * previous[i]
+            for j in range(m):
+                b_all = Bd[s, r, j]
+                held = u[c, j]
+                if shared_model and shared_input:
+                    forced = b_all[0] * held[0]
+                    for i in range(members):
+                        row[i] += forced
+                elif shared_model:
+                    b = b_all[0]
+                    for i in range(members):
+                        row[i] += b * held[i]
+                elif shared_input:
+                    for i in range(members):
+                        row[i] += b_all[i] * held[0]
+                else:
+                    for i in range(members):
+                        row[i] += b_all[i] * held[i]
+
+
+@numba.njit(cache=True)
+def fill_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray, z0: np.ndarray, n_moving: int,
+                substeps: int, out: np.ndarray) -> None:
+    """Fill ``out[i, p, b L + j] = rows[p] Phi^j Psi^b z0[i]`` (Phi = step, Psi = block, L = substeps).
+
+    The samples of block b are the fine rows rows Phi^j (j < L) times the
+    block's start Psi^b z0. Only the first ``n_moving`` entries of a start
+    change from block to block (the states; the rest are constant inputs), so
+    the inputs' share of every sample is computed once per member and each
+    sample costs ``n_moving`` multiply-adds, the inner loop running over
+    contiguous samples. Fine rows are computed once for a shared model and
+    again for every member of a batch.
+
+    Parameters
+    ----------
+    step : ndarray, shape (1 or N, q, q)
+        Transition over one sample step.
+    block : ndarray, shape (1 or N, q, q)
+        Transition over one block of ``substeps`` steps.
+    rows : ndarray, shape (1 or N, r, q)
+        Rows wanted.
+    z0 : ndarray, shape (N, q)
+        Initial vectors.
+    n_moving : int
+        Entries of z that change in time (the rest stay at their initial value).
+    substeps : int
+        L, samples per block.
+    out : ndarray, shape (N, r, n_blocks L)
+        Samples (written).
+    """
+    members, r, capacity = out.shape
+    q = z0.shape[1]
+    L = substeps
+    gains = np.empty((r, q, L))
+    held = np.empty((r, L))  # the constant entries' share of sample j
+    start = np.empty(q)
+    following = np.empty(q)
+    for i in range(members):
+        a = 0 if step.shape[0] == 1 else i
+        g = 0 if rows.shape[0] == 1 else i
+        if i == 0 or step.shape[0] > 1 or rows.shape[0] > 1:
+            for p in range(r):
+                for c in range(q):
+                    gains[p, c, 0] = rows[g, p, c]
+            for j in range(1, L):
+                for p in range(r):
+                    for c in range(q):
+                        total = 0.0
+                        for k in range(q):
+                            total += gains[p, k, j - 1] * step[a, k, c]
+                        gains[p, c, j] = total
+        for p in range(r):
+            for j in range(L):
+                held[p, j] = 0.0
+            for c in range(n_moving, q):
+                s = z0[i, c]
+                for j in range(L):
+                    held[p, j] += s * gains[p, c, j]
+        for c in range(q):
+            start[c] = z0[i, c]
+        for base in range(0, capacity, L):
+            for p in range(r):
+                line = out[i, p, base : base + L]
+                for j in range(L):
+                    line[j] = held[p, j]
+                for c in range(n_moving):
+                    s = start[c]
+                    for j in range(L):
+                        line[j] += s * gains[p, c, j]
+            for c in range(n_moving):
+                total = 0.0
+                for k in range(q):
+                    total += block[a, c, k] * start[k]
+                following[c] = total
+            for c in range(n_moving):
+                start[c] = following[c]
