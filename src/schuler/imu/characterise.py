@@ -93,7 +93,7 @@ def classify_grade(noise: dict) -> tuple[str | None, dict[str, float]]:
             worst = max(worst, float(np.max(expected / upper)))
         margins[grade] = worst
     consistent = [grade for grade in GRADES if margins[grade] <= GRADE_ALLOWANCE]
-    return (max(consistent, key=margins.get) if consistent else None), margins
+    return (max(consistent, key=margins.__getitem__) if consistent else None), margins
 
 
 def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, kind: str = "rate",
@@ -145,7 +145,7 @@ def analyse_source(source: RecordSource, per_octave: int = 2,
         yield first
         yield from chunks
 
-    return analyse_chunks(all_chunks(), sample_interval_s=source.sample_interval_s,
+    return analyse_chunks(all_chunks(), sample_interval_s=source.interval_s(),
                           expected_samples=source.estimated_samples, kind=source.kind, source=source.path.name,
                           per_octave=per_octave, max_fraction=max_fraction)
 

@@ -59,9 +59,9 @@ def file_info(path, **options) -> ImuInfo:
         accel += a.sum(axis=0)
     if samples < 2:
         raise ImuFileError(source.path, f"a record needs at least 2 samples, the file has {samples}")
-    scale = samples * (source.sample_interval_s if source.kind == "increment" else 1.0)
+    scale = samples * (source.interval_s() if source.kind == "increment" else 1.0)
     keys = ("latitude_rad", "longitude_rad", "height_m", "initial_attitude_rad", "gravity_m_s2")
-    return info_from_means(source.path.name, samples, source.kind, source.sample_interval_s, gyro / scale,
+    return info_from_means(source.path.name, samples, source.kind, source.interval_s(), gyro / scale,
                            accel / scale, **{k: source.metadata.get(k) for k in keys})
 
 

@@ -238,7 +238,8 @@ class ImuInfo(Result):
         table.add_row("|specific force|", f"{self.specific_force_m_s2:.5f} m/s^2")
         if self.latitude_rad is not None:
             table.add_row("site latitude", f"{math.degrees(self.latitude_rad):.6f} deg")
-            table.add_row("Omega cos L (expected horizontal)", f"{to_unit(self.earth_rate_horizontal_rad_s, 'deg/h'):.4f} deg/h")
+            horizontal = to_unit(self.earth_rate_horizontal_rad_s, "deg/h")
+            table.add_row("Omega cos L (expected horizontal)", f"{horizontal:.4f} deg/h")
             table.add_row("-Omega sin L (expected down)", f"{to_unit(self.earth_rate_down_rad_s, 'deg/h'):+.4f} deg/h")
         if self.longitude_rad is not None:
             table.add_row("site longitude", f"{math.degrees(self.longitude_rad):.6f} deg")
@@ -289,8 +290,8 @@ def info_from_means(source: str, samples: int, kind: str, sample_interval_s: flo
         sample_interval_s=float(sample_interval_s),
         sample_rate_hz=1.0 / sample_interval_s,
         duration_s=round(samples * sample_interval_s, 12),
-        mean_gyro_rad_s=tuple(float(v) for v in gyro),
-        mean_accel_m_s2=tuple(float(v) for v in accel),
+        mean_gyro_rad_s=(float(gyro[0]), float(gyro[1]), float(gyro[2])),
+        mean_accel_m_s2=(float(accel[0]), float(accel[1]), float(accel[2])),
         horizontal_gyro_rad_s=float(math.hypot(gyro[0], gyro[1])),
         specific_force_m_s2=float(np.linalg.norm(accel)),
         latitude_rad=latitude,

@@ -37,7 +37,7 @@ from schuler.core.earth import EARTH_RATE
 from schuler.exceptions import InvalidParameter
 from schuler.imu.characterise import analyse_record, round_trip
 from schuler.imu.files import read_record
-from schuler.imu.results import DISPLAY_UNITS, NOISE_UNITS, RoundTripResult, sensor_of, shown_unit
+from schuler.imu.results import DISPLAY_UNITS, NOISE_UNITS, AllanResult, RoundTripResult, sensor_of, shown_unit
 from schuler.imu.spec import GRADES, PRESET_SPECS, preset
 from schuler.imu.static import static_attitude
 from schuler.params import Parameter, ParameterSet
@@ -128,9 +128,12 @@ def _quarters(record) -> list:
                             record.accel_m_s2[i * n:(i + 1) * n].mean(axis=0)) for i in range(4)]
 
 
-def psins_rows(path: Path) -> tuple[list, dict, dict, object]:
+def psins_rows(path: Path) -> tuple[list, dict, dict, AllanResult]:
     """Rows, details (SI), their units and the Allan analysis of the PSINS recording."""
     record = read_record(path)
+    if record.latitude_rad is None:
+        raise InvalidParameter("recording", f"{path.name} states no site latitude; the PSINS reproduction reads a "
+                                            "PSINS .imu file (its header gives the site)")
     gyro, accel = record.gyro_rate_rad_s.mean(axis=0), record.accel_m_s2.mean(axis=0)
     attitude = static_attitude(gyro, accel)
     quarters = _quarters(record)

@@ -172,10 +172,10 @@ def write_files(result: Result, out_dir: Path) -> list[Path]:
     if isinstance(result, AllanResult):
         return write_analysis(result, out_dir, "imu_allan")
     if isinstance(result, Reproduction):
-        files: list[Path] = []
+        written: list[Path] = []
         for stem, analysis in (result.data or {}).items():
-            files += write_analysis(analysis, out_dir, stem)
-        return files
+            written += write_analysis(analysis, out_dir, stem)
+        return written
     if isinstance(result, (ImuInfo, SimulationResult)):
         return []
     raise TypeError(f"imu writes no files for {type(result).__name__}")
