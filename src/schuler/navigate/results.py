@@ -170,16 +170,15 @@ class NavigateResult(RunResult):
         return data
 
     def render(self):
-        from rich.console import Group, JustifyMethod
+        from rich.console import Group
         from rich.table import Table
 
         title = (f"{self.mode} INS on a {self.trajectory} trajectory, vertical channel {self.vertical_channel}, "
                  f"IMU {self.imu or 'ideal but for the biases given'}: errors at {self.duration_s:,.0f} s")
         table = Table(title=title)
-        columns: tuple[tuple[str, JustifyMethod], ...] = (("channel", "left"), ("final", "right"),
-                                                          ("largest |error|", "right"))
-        for heading, justify in columns:
-            table.add_column(heading, justify=justify)
+        table.add_column("channel", justify="left")
+        table.add_column("final", justify="right")
+        table.add_column("largest |error|", justify="right")
         for name in (*shown_channels(self.vertical_channel), "horizontal_position_error_m"):
             unit = DISPLAY_UNITS[suffix(name)]
             final = self.errors[f"final_{name}"]
