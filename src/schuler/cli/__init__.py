@@ -29,6 +29,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "calibrate": ("system", "Gyro drift calibration by alternating torque pulses."),
     "align": ("system", "Physical gyrocompassing of a platform INS."),
     "north": ("system", "Ground gyrocompass during rotor run-down."),
+    "mission": ("system", "Calibrate, align, navigate: a mission's error budget."),
     "run": ("schuler.cli.study:run_scenario", "Run a scenario file (TOML)."),
     "sweep": ("schuler.cli.study:sweep", "Sweep parameters or Monte Carlo over a scenario."),
     "report": ("schuler.cli.study:report", "Build the HTML report of all systems."),
