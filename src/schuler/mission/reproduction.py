@@ -58,18 +58,18 @@ def reproduce() -> Reproduction:
     """
     rows = []
     latitude = math.radians(50.0)
-    east = _setup(latitude=math.degrees(latitude), heading=0.0, trajectory="stationary", alignment="kalman")
+    east = _setup(latitude=latitude, heading=0.0, trajectory="stationary", alignment="kalman")
     # heading 0: body y points east, so a y-gyro bias b gives epsilon_E = -b
     index = CONSTANT_SOURCES.index("gyro_bias_y")
     x0 = initial_state_map(east, np.eye(3), 7)
     heading = -x0[index, -1] * EXAMPLE_DRIFT
     rows.append(compare(
         "Kalman alignment heading error from a 0.01 deg/h east gyro bias, 50 deg", to_unit(heading, "arcmin"),
-        "arcmin", printed="b_E / (Omega cos L)", value=float(to_unit(EXAMPLE_DRIFT / (EARTH_RATE * math.cos(latitude)),
-                                                                      "arcmin")),
+        "arcmin", printed="-b_E / (Omega cos L)",
+        value=float(to_unit(-EXAMPLE_DRIFT / (EARTH_RATE * math.cos(latitude)), "arcmin")),
         where="Groves (2013), Sec. 5.6.2", tolerance=Tolerance(relative=1e-9),
-        note="heading error = -psi_D; the tan(L) psi_N term is zero without accelerometer errors"))
-    physical = _setup(latitude=math.degrees(latitude), heading=0.0, trajectory="stationary", alignment="gyrocompass")
+        note="heading error = -psi_D, drift = -bias; the tan(L) psi_N term is zero without accelerometer errors"))
+    physical = _setup(latitude=latitude, heading=0.0, trajectory="stationary", alignment="gyrocompass")
     x0 = initial_state_map(physical, np.eye(3), 7)
     c_gamma, c_a = gains_from_design(30.0, 0.8, latitude)
     rows.append(compare(
