@@ -32,6 +32,7 @@ QUICK = {
     "align": ["--duration", "600"],
     "north": ["--duration", "600"],
     "calibrate": [],
+    "mission": ["--duration", "1200", "--output-step", "600"],
 }
 """Options that keep each system's base case short; the fuzzed option comes after them."""
 

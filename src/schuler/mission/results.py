@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from schuler.mission.covariance import CovarianceBudget
+from schuler.mission.setup import SOURCES
 from schuler.reproduction import Reproduction
 from schuler.results import Result, RunResult
 from schuler.units import to_unit
@@ -38,7 +39,8 @@ class MissionResult(RunResult):
     instrument: str
     history: CovarianceBudget | None = field(default=None, repr=False)
 
-    units: ClassVar[dict[str, str]] = {"dominant_share": "1", "budget": "1"}
+    # the budget's keys are source names whose values are shares (the units map is flat by key)
+    units: ClassVar[dict[str, str]] = {"dominant_share": "1", "budget": "1", **{name: "1" for name in SOURCES}}
 
     def to_dict(self) -> dict[str, Any]:
         data = super().to_dict()
