@@ -19,8 +19,8 @@ from schuler.imu.spec import GRADES
 from schuler.mission.covariance import CovarianceBudget, covariance_budget
 from schuler.mission.monte_carlo import final_horizontal_errors, run_members
 from schuler.mission.results import MissionResult
-from schuler.navigate.mechanization import estimate_memory
 from schuler.mission.setup import ALIGNMENTS, CALIBRATIONS, TRAJECTORIES, VERTICAL_CHANNELS, mission_setup
+from schuler.navigate.mechanization import estimate_memory
 from schuler.params import Case, Parameter, ParameterSet
 
 PARAMETERS = ParameterSet((

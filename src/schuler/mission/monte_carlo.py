@@ -155,11 +155,12 @@ def run_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate: 
     sensors = SensorErrors(gyro_bias=triad("gyro_bias"), accel_bias=triad("accel_bias"),
                            gyro_scale_factor=triad("gyro_scale_factor"),
                            accel_scale_factor=triad("accel_scale_factor"))
-    noise = BlockWhiteNoise(setup.gyro_random_walk, setup.accel_random_walk, streams.seed)
+    noisy = np.any(setup.gyro_random_walk) or np.any(setup.accel_random_walk)
+    noise = BlockWhiteNoise(setup.gyro_random_walk, setup.accel_random_walk, streams.seed) if noisy else None
     return navigate(trajectory, setup.duration, imu_rate=imu_rate, output_step=output_step or setup.output_step,
                     mode="strapdown", vertical_channel=setup.vertical_channel,
                     initial_errors=initial_errors(x0, setup, start_quaternion), sensor_errors=sensors,
-                    noise=noise if np.any(setup.gyro_random_walk) or np.any(setup.accel_random_walk) else None, member_ids=members,
+                    noise=noise, member_ids=members,
                     earth_rate=EARTH_RATE)
 
 

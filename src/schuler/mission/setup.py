@@ -124,9 +124,10 @@ class MissionSetup:
             return GreatCircle(latitude=self.latitude, longitude=self.longitude, height=self.height,
                                heading=self.heading, speed=self.speed, duration=self.duration)
         d = self.duration
-        if d < 4 * (FLIGHT_ACCELERATION_TIME + FLIGHT_TURN_TIME):
-            raise InvalidParameter("duration", f"a flight needs at least {4 * (FLIGHT_ACCELERATION_TIME + FLIGHT_TURN_TIME):g} s "
-                                   f"(take-off run and two turns), got {d:g} s")
+        shortest = 4 * (FLIGHT_ACCELERATION_TIME + FLIGHT_TURN_TIME)
+        if d < shortest:
+            raise InvalidParameter("duration", f"a flight needs at least {shortest:g} s (take-off run and two turns), "
+                                   f"got {d:g} s")
         times = [0.0, FLIGHT_ACCELERATION_TIME, 0.35 * d, 0.35 * d + FLIGHT_TURN_TIME, 0.7 * d,
                  0.7 * d + FLIGHT_TURN_TIME]
         speeds = [0.0] + [self.speed] * 5
