@@ -43,6 +43,8 @@ IEEE Transactions on Aerospace and Electronic Systems AES-11(4), 447-455, 1975.
 
 from __future__ import annotations
 
+import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -60,8 +62,15 @@ from schuler.navigation_errors.three_d import wgs84_error_matrices
 OUTPUT_CHANNELS = ("position_north", "position_east", "velocity_north", "velocity_east", "heading")
 """Outputs whose variance the budget splits by source (SI: m, m/s, rad)."""
 
+LINEAR_LIMIT = np.radians(5.0)
+"""Initial 1-sigma heading error above which the linear error model is warned about (second-order terms grow)."""
+
 MAX_STEPS = 200_000
 """Largest number of steps of one analysis (memory: steps x sources x states)."""
+
+
+class LinearityWarning(UserWarning):
+    """The alignment leaves errors too large for the linear (small-angle) model to be trusted."""
 
 
 @dataclass(frozen=True)
@@ -217,6 +226,12 @@ def covariance_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> Co
             P = Ad[k] @ P @ Ad[k].T + Q[k]
             white[k + 1, :, w] = np.einsum("cn,nm,cm->c", rows[k + 1], P, rows[k + 1])
     contributions.append(white)
+    heading = math.sqrt(float(np.einsum("n,nm,m->", rows[0, 4], total_initial, rows[0, 4])))
+    if heading > LINEAR_LIMIT:
+        warnings.warn(f"the {setup.alignment} alignment over {setup.alignment_duration:g} s leaves a 1-sigma heading "
+                      f"error of {math.degrees(heading):.1f} deg: the small-angle error model is past its validity "
+                      "(align longer, calibrate better, or take north from a ground gyrocompass)",
+                      LinearityWarning, stacklevel=2)
     variance = np.concatenate(contributions, axis=2)
     padded = np.zeros((len(SOURCES), n))
     padded[:len(CONSTANT_SOURCES)] = x0

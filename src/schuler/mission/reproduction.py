@@ -125,5 +125,7 @@ def report(figures_dir: Path) -> ReportSection:
                   "schuler run examples/mission_tactical.toml --json",
                   "schuler mission run --grade navigation --trajectory flight --monte-carlo 1000 --out mission",
                   "schuler sweep examples/mission_tactical.toml --param alignment_duration=300,900,1800"],
-        notes=reproduction.notes,
+        notes=[*reproduction.notes, "budget of the tactical 2-h cruise (share of the final horizontal position "
+               "variance): " + ", ".join(f"{name} {100 * shares[name]:.1f} %" for name in
+                                         sorted(shares, key=lambda name: -shares[name])[:5])],
     )
