@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 OUT ?= results
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test test-slow lint bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -36,9 +36,16 @@ lint: $(VENV)/.installed-test
 
 # one BLAS thread per test process: the models' matrices are small, and two
 # processes already use both cores
+PYTEST := SCHULER_PSINS_IMU="$(PSINS_IMU)" OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2 -q
+
+# the suite without the tests marked slow (long horizons, 1,000-member checks, fuzz per option)
 test: lint
-	@echo "== pytest: the suite (doctests included)"
-	SCHULER_PSINS_IMU="$(PSINS_IMU)" OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2 -q
+	@echo "== pytest: the suite (doctests included; slow tests: make test-slow)"
+	$(PYTEST) -m "not slow"
+
+test-slow: $(VENV)/.installed-test
+	@echo "== pytest: the tests marked slow"
+	$(PYTEST) -m slow
 
 bench: $(VENV)/.installed-test
 	for b in benchmarks/bench_*.py; do OPENBLAS_NUM_THREADS=1 $(BIN)/python $$b || exit 1; done
