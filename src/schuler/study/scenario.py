@@ -38,7 +38,8 @@ Examples
 >>> parse_scenario('system = "compass"', source="s.toml")
 Traceback (most recent call last):
 ...
-schuler.exceptions.ScenarioError: s.toml: system: 'compass' is not one of errors, vertical, calibrate, align, north, mission
+schuler.exceptions.ScenarioError: s.toml: system: 'compass' is not one of errors, vertical, calibrate, align, north,
+mission
 """
 
 from __future__ import annotations
