@@ -46,6 +46,10 @@ NOISE_BLOCK = 256
 """IMU intervals per addressed noise block: short, so that a chunk of the run redraws little."""
 
 
+SCALE_FACTOR_LIMIT = 0.1
+"""Largest scale-factor error a member flies with (the navigate layer's limit); larger draws are clipped."""
+
+
 def _stream_key(seed: int, stream: str) -> int:
     return int(np.random.SeedSequence([seed, zlib.crc32(stream.encode())]).generate_state(1, np.uint64)[0])
 
@@ -150,7 +154,11 @@ def run_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate: 
     column = {name: i for i, name in enumerate(CONSTANT_SOURCES)}
 
     def triad(family: str) -> np.ndarray:
-        return np.stack([draws[:, column[f"{family}_{axis}"]] for axis in "xyz"], axis=1)
+        values = np.stack([draws[:, column[f"{family}_{axis}"]] for axis in "xyz"], axis=1)
+        if "scale_factor" in family:
+            # the navigate layer accepts |S| <= 0.1: a consumer IMU's 3 % draws past it beyond 3.3 sigma
+            values = np.clip(values, -SCALE_FACTOR_LIMIT, SCALE_FACTOR_LIMIT)
+        return values
 
     sensors = SensorErrors(gyro_bias=triad("gyro_bias"), accel_bias=triad("accel_bias"),
                            gyro_scale_factor=triad("gyro_scale_factor"),
