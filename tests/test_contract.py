@@ -27,7 +27,7 @@ NAMES = list(SYSTEM_MODULES)
 
 MISSPELT = {"errors": ("magnitud", "magnitude"), "vertical": ("latitud", "latitude"),
             "calibrate": ("latitud", "latitude"), "align": ("latitud", "latitude"), "north": ("latitud", "latitude"),
-            "mission": ("alignement", "alignment")}
+            "imu": ("latitud", "latitude"), "mission": ("alignement", "alignment")}
 """A misspelt parameter of each system and the name it must suggest (issue 11)."""
 
 LIGHT = {
@@ -36,6 +36,7 @@ LIGHT = {
     "calibrate": {},
     "align": {"duration": 600.0},
     "north": {"duration": 600.0, "readout_noise": math.radians(1 / 3600)},
+    "imu": {"duration": 120.0},
     "mission": {"duration": 1200.0, "output_step": 600.0, "imu_rate": 0.5},
 }
 """SI values that keep a system's default case quick (short durations)."""
@@ -46,6 +47,7 @@ VARIATIONS = {
     "calibrate": [{"latitude": math.radians(40.0), "azimuth": math.radians(200.0)}],
     "align": [{"latitude": math.radians(20.0), "drift_east": 1e-7}, {"model": "simplified", "azimuth": 1.0}],
     "north": [{"latitude": math.radians(30.0)}],
+    "imu": [{"grade": "industrial", "azimuth": 1.0}, {"imu_rate": 200.0, "latitude": math.radians(-30.0)}],
     "mission": [{"grade": "navigation", "trajectory": "stationary"},
                 {"alignment": "gyrocompass", "calibration": "multi-position", "alignment_duration": 600.0}],
 }
