@@ -32,6 +32,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "north": ("system", "Ground gyrocompass during rotor run-down."),
     "imu": ("system", "IMU recordings, spec-sheet error models and Allan variance."),
     "navigate": ("system", "Nonlinear strapdown or platform INS on WGS-84."),
+    "mission": ("system", "Calibrate, align, navigate: a mission's error budget."),
     "run": ("schuler.cli.study:run_scenario", "Run a scenario file (TOML)."),
     "sweep": ("schuler.cli.study:sweep", "Sweep parameters or Monte Carlo over a scenario."),
     "report": ("schuler.cli.study:report", "Build the HTML report of all systems."),
