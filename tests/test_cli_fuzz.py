@@ -32,6 +32,9 @@ QUICK = {
     "align": ["--duration", "600"],
     "north": ["--duration", "600"],
     "calibrate": [],
+    "imu": ["--duration", "120"],
+    "navigate": ["--duration", "600", "--imu-rate", "10", "--output-step", "60"],
+    "mission": ["--duration", "1200", "--output-step", "600"],
 }
 """Options that keep each system's base case short; the fuzzed option comes after them."""
 
@@ -102,7 +105,7 @@ def run_careless(run_cli, system: str, command: str, option: str, value: str, wo
     if command == "run":
         args += QUICK[system]
     args += QUICK_ACTIONS.get((system, command), [])
-    if command in ("identify",):
+    if command in ("identify", "info", "allan"):
         record = workdir / "record.csv"
         record.write_bytes(b"\x00\x01binary\xff\xfe")
         args.append(record)

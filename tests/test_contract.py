@@ -26,7 +26,9 @@ from schuler.study.sweep import run_sweep
 NAMES = list(SYSTEM_MODULES)
 
 MISSPELT = {"errors": ("magnitud", "magnitude"), "vertical": ("latitud", "latitude"),
-            "calibrate": ("latitud", "latitude"), "align": ("latitud", "latitude"), "north": ("latitud", "latitude")}
+            "calibrate": ("latitud", "latitude"), "align": ("latitud", "latitude"), "north": ("latitud", "latitude"),
+            "imu": ("latitud", "latitude"), "navigate": ("latitud", "latitude"),
+            "mission": ("alignement", "alignment")}
 """A misspelt parameter of each system and the name it must suggest (issue 11)."""
 
 LIGHT = {
@@ -35,6 +37,10 @@ LIGHT = {
     "calibrate": {},
     "align": {"duration": 600.0},
     "north": {"duration": 600.0, "readout_noise": math.radians(1 / 3600)},
+    "imu": {"duration": 120.0},
+    "navigate": {"duration": 600.0, "imu_rate": 10.0, "output_step": 60.0, "velocity_error_north": 0.1,
+                 "sigma_gyro_bias": 1e-7},
+    "mission": {"duration": 1200.0, "output_step": 600.0, "imu_rate": 0.5},
 }
 """SI values that keep a system's default case quick (short durations)."""
 
@@ -44,6 +50,12 @@ VARIATIONS = {
     "calibrate": [{"latitude": math.radians(40.0), "azimuth": math.radians(200.0)}],
     "align": [{"latitude": math.radians(20.0), "drift_east": 1e-7}, {"model": "simplified", "azimuth": 1.0}],
     "north": [{"latitude": math.radians(30.0)}],
+    "imu": [{"grade": "industrial", "azimuth": 1.0}, {"imu_rate": 200.0, "latitude": math.radians(-30.0)}],
+    "navigate": [{"mode": "platform", "heading_error": 1e-3, "vertical_channel": "free"},
+                 {"trajectory": "great-circle", "speed": 200.0, "heading": 1.0, "gyro_bias_x": 1e-7,
+                  "imu": "tactical"}],
+    "mission": [{"grade": "navigation", "trajectory": "stationary"},
+                {"alignment": "gyrocompass", "calibration": "multi-position", "alignment_duration": 600.0}],
 }
 """Further cases per system on which run and evaluate must agree."""
 
