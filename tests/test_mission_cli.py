@@ -48,8 +48,12 @@ def test_a_scenario_of_another_system_is_refused_in_one_line(run_cli, tmp_path, 
     assert out.stderr.count("\n") == 1 and "'mission' is a scenario of schuler mission" in out.stderr
 
 
-def test_sweep_under_the_group_gives_the_summary_of_schuler_sweep(run_cli, tmp_path):
-    # a 30-min flight (the shortest the profile allows is 28 min) keeps the 4 covariance analyses quick
+def test_sweep_under_the_group_gives_the_summary_of_schuler_sweep(run_cli, tmp_path, monkeypatch):
+    # a 30-min flight (the shortest the profile allows is 28 min) keeps the 4 covariance analyses quick; the
+    # summary plots (a second each, the same code under both commands) are left out
+    import schuler.study.plots
+
+    monkeypatch.setattr(schuler.study.plots, "plot_sweep_summary", lambda *args, **kwargs: [])
     grid = ("--param", "grade=navigation,tactical", "--param", "alignment_duration=300,600",
             "--param", "duration=1800")
     scenario = EXAMPLES / "mission_tactical.toml"
