@@ -5,6 +5,9 @@ right / z down, errors = computed - true, sensor bias = measured - true, SI.
 
 The life of the instrument, in the order the stages happen:
 
+0. **The instrument**: a grade's preset, a spec file, or a recording's
+   identified noise terms (:func:`error_model`).
+
 1. **Calibration** leaves a residual gyro bias per axis (and, for the
    multi-position method, residual accelerometer biases and scale factors):
 
@@ -45,18 +48,23 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
 from schuler.core.earth import STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel
+from schuler.imu.instrument import resolve_model
 from schuler.imu.spec import load_spec_file, preset
 from schuler.imu.system_inputs import residual_bias
 from schuler.navigate.trajectory import GreatCircle, Stationary, WaypointProfile
 
 CALIBRATIONS = ("pulse", "multi-position")
-ALIGNMENTS = ("kalman", "gyrocompass", "ground-gyrocompass")
+ALIGNMENTS = ("kalman", "strapdown-gyrocompass", "gyrocompass", "ground-gyrocompass")
+SELF_ALIGNMENTS = ("kalman", "strapdown-gyrocompass")
+"""Strapdown self-alignments at rest: to first order, the same residuals (:mod:`schuler.mission.stages`)."""
 TRAJECTORIES = ("stationary", "cruise", "flight")
 VERTICAL_CHANNELS = ("off", "free")
 
@@ -186,17 +194,40 @@ class MissionSetup:
         return np.asarray(self.error_model.accel.random_walk, dtype=float)
 
 
-def error_model(grade: str, imu_spec: str | None) -> ErrorModel:
-    """The instrument: a spec file (TOML, :mod:`schuler.imu.spec`) when given, else the grade's preset."""
+def error_model(grade: str, imu_spec: str | None, instrument: str | None = None) -> ErrorModel:
+    """The instrument's error model.
+
+    ``instrument`` (a grade, a TOML spec file or a recording .csv, .imu,
+    .parquet) when given: a recording's identified noise terms become the model
+    (:func:`~schuler.imu.instrument.resolve_model`, the resolution ``--imu``
+    uses: Allan analysis then :func:`~schuler.imu.characterise.model_from_analysis`).
+    An Allan curve shows noise only, so such a model has no turn-on biases nor
+    scale-factor errors: what calibration leaves of it is the noise floor and
+    the slow terms' change. Else ``imu_spec`` (a TOML spec file), else the
+    grade's preset.
+    """
+    if instrument:
+        path = Path(instrument)
+        # a recording is analysed once per process and file version (sweep chunks and Monte Carlo batches reuse it)
+        stamp = (path.stat().st_mtime_ns, path.stat().st_size) if path.is_file() else None
+        return _resolved(str(instrument), stamp)
     if imu_spec:
         return load_spec_file(imu_spec)
     return preset(grade)
 
 
+@lru_cache(maxsize=8)
+def _resolved(instrument: str, stamp: tuple[int, int] | None) -> ErrorModel:
+    try:
+        return resolve_model(instrument)
+    except InvalidParameter as error:
+        raise InvalidParameter("instrument", error.reason) from None
+
+
 def mission_setup(values) -> MissionSetup:
     """A :class:`MissionSetup` from a case's SI values (a mapping with every parameter of the system)."""
     return MissionSetup(
-        error_model=error_model(values["grade"], values["imu_spec"]),
+        error_model=error_model(values["grade"], values["imu_spec"], values["instrument"]),
         latitude=float(values["latitude"]), longitude=float(values["longitude"]), height=float(values["height"]),
         calibration=str(values["calibration"]), calibration_duration=float(values["calibration_duration"]),
         pulse_relative_error=float(values["pulse_relative_error"]),
