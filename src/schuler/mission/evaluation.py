@@ -52,6 +52,8 @@ PARAMETERS = ParameterSet((
               minimum=0, maximum=36000),
     Parameter("trajectory", "", "cruise", "Mission: stationary, cruise (a geodesic at the speed) or flight "
               "(take-off run, two 90-deg turns).", choices=TRAJECTORIES, kind="choice"),
+    Parameter("profile", "", None, "Waypoint profile FILE.toml (format: schuler.navigate.profile) flown instead of "
+              "the trajectory; its [start] and first heading set the start point and heading.", kind="text"),
     Parameter("duration", "s", 7200.0, "Mission duration (after the alignment).", minimum=60, maximum=10 * 86400),
     Parameter("speed", "m/s", 250.0, "Ground speed of cruise and flight.", minimum=0, maximum=1000),
     Parameter("heading", "deg", 30.0, "Heading at the start.", minimum=-360, maximum=360),
@@ -63,7 +65,9 @@ PARAMETERS = ParameterSet((
               minimum=0, maximum=1e5),
     Parameter("imu_rate", "Hz", 2.0, "IMU rate of the Monte Carlo's nonlinear INS (reduced: exact for the "
               "noise, ample for the smooth trajectories).", minimum=0.1, maximum=1000),
-), owner="mission", exclusive=(("grade", "instrument"), ("imu_spec", "instrument")))
+), owner="mission", exclusive=(("grade", "instrument"), ("imu_spec", "instrument"),
+                                *(("profile", name) for name in ("trajectory", "latitude", "longitude", "height",
+                                                                 "heading", "speed"))))
 """Every option of ``schuler mission run`` (and key of a ``mission`` scenario)."""
 
 OUTPUTS = (
