@@ -34,7 +34,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "navigate": ("system", "Nonlinear strapdown or platform INS on WGS-84."),
     "mission": ("system", "Calibrate, align, navigate: a mission's error budget."),
     "run": ("schuler.cli.study:run_scenario", "Run a scenario file (TOML)."),
-    "sweep": ("schuler.cli.study:sweep", "Sweep parameters or Monte Carlo over a scenario."),
+    "sweep": ("schuler.cli.sweep:sweep", "Sweep parameters or Monte Carlo over a scenario."),
     "report": ("schuler.cli.study:report", "Build the HTML report of all systems."),
     "lab": ("schuler.cli.lab:lab", "Open the interactive lab bench in the browser."),
 }

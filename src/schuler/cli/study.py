@@ -1,4 +1,4 @@
-"""``schuler run``, ``schuler sweep`` and ``schuler report``: studies over the five systems."""
+"""``schuler run`` and ``schuler report``: studies over the systems (``schuler sweep``: :mod:`schuler.cli.sweep`)."""
 
 from __future__ import annotations
 
@@ -8,14 +8,13 @@ from pathlib import Path
 import click
 
 from schuler import __version__
-from schuler.cli.common import emit, folder_not_option, json_option
+from schuler.cli.common import folder_not_option, json_option
+from schuler.cli.sweep import SCENARIO_ARGUMENT
 from schuler.registry import SYSTEM_MODULES
-
-_SCENARIO = click.argument("scenario", metavar="SCENARIO.toml", type=click.Path(dir_okay=False, path_type=Path))
 
 
 @click.command("run")
-@_SCENARIO
+@SCENARIO_ARGUMENT
 @click.option(
     "--out",
     "out_dir",
@@ -42,83 +41,6 @@ def run_scenario(scenario: Path, out_dir: Path | None, as_json: bool):
     execute_run(loaded.definition(), loaded.values, monte_carlo=members, seed=table.seed if table else 0,
                 fidelity=loaded.fidelity, out_dir=out_dir or loaded.out_dir, as_json=as_json or loaded.as_json,
                 draw=loaded.draw if members else None)
-
-
-@click.command("sweep")
-@_SCENARIO
-@click.option(
-    "--param",
-    "params",
-    multiple=True,
-    metavar="NAME=START:STOP:STEP",
-    help="Sweep a run option over a grid (STOP included when on the grid), e.g. "
-    "latitude=0:80:10 or drift_east=0.001:0.01:0.001 deg/h; or a list NAME=V1,V2,... "
-    "Repeat for a cartesian product.",
-)
-@click.option(
-    "--monte-carlo",
-    "monte_carlo",
-    type=int,
-    default=None,
-    metavar="N",
-    help="Random draws per grid point of the parameters in the scenario's [monte_carlo.normal] "
-    "and [monte_carlo.uniform] tables (seed: [monte_carlo] seed).",
-)
-@click.option(
-    "--out",
-    "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
-    callback=folder_not_option,
-    required=True,
-    help="Folder for results.csv, results.parquet, summary.json, plots and the chunk files. "
-    "Re-running into the same folder resumes: finished chunks are skipped.",
-)
-@click.option(
-    "--scheduler",
-    default=None,
-    metavar="local|tcp://HOST:PORT",
-    help="Evaluate on Dask: 'local' starts a LocalCluster, an address uses a running scheduler.",
-)
-@click.option(
-    "--workers",
-    type=int,
-    default=None,
-    metavar="N",
-    help="Local worker processes (without --scheduler), or LocalCluster workers (default 2).",
-)
-@click.option("--chunk-size", type=int, default=None, metavar="N", help="Cases per chunk (default 50000).")
-@click.option("--fidelity", default=None, metavar="NAME",
-              help="The system's evaluation fidelity, e.g. simulated or closed (default: the scenario's, else the "
-                   "system's first).")
-@click.option("--csv/--no-csv", "write_csv", default=True, help="Also write results.csv (large for huge sweeps).")
-@click.option("--progress/--no-progress", default=True, help="Show a progress bar on stderr.")
-@json_option
-def sweep(scenario, params, monte_carlo, out_dir, scheduler, workers, chunk_size, fidelity, write_csv, progress,
-          as_json):
-    """Sweep parameters of a scenario, or run a Monte Carlo, in vectorised chunks.
-
-    One row per case in DIR/results.csv and DIR/results.parquet (a column per
-    parameter, in its display unit, and per result), statistics in
-    DIR/summary.json and plots DIR/summary_*.png. An interrupted sweep resumes
-    where it stopped when run again with the same arguments.
-    """
-    from schuler.study.scenario import load_scenario
-    from schuler.study.sweep import DEFAULT_CHUNK_SIZE, run_sweep
-
-    loaded = load_scenario(scenario)
-    summary = run_sweep(
-        loaded,
-        out_dir,
-        params,
-        monte_carlo,
-        chunk_size=chunk_size or DEFAULT_CHUNK_SIZE,
-        scheduler=scheduler,
-        workers=workers,
-        progress=progress and not as_json,
-        write_csv=write_csv,
-        fidelity=fidelity,
-    )
-    emit(summary, as_json, inputs={"scenario": str(scenario), "params": list(params), "monte_carlo": monte_carlo})
 
 
 @click.command("report")

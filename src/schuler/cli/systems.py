@@ -1,8 +1,10 @@
 """The command line of every system, generated from its :class:`~schuler.contract.System`.
 
-``schuler NAME run`` (the system's parameters, ``--monte-carlo``, ``--seed``,
-``--fidelity`` where offered, ``--imu`` where the IMU layer maps to the system:
-:mod:`schuler.imu.instrument`), ``schuler NAME reproduce`` and the system's own
+``schuler NAME run [SCENARIO.toml]`` (the system's parameters, ``--monte-carlo``,
+``--seed``, ``--fidelity`` where offered, ``--imu`` where the IMU layer maps to
+the system: :mod:`schuler.imu.instrument`; a scenario of the system sets what the
+options do not), ``schuler NAME sweep SCENARIO.toml`` (:mod:`schuler.cli.sweep`
+for the system's scenarios), ``schuler NAME reproduce`` and the system's own
 actions: each parses its options with the system's
 :class:`~schuler.params.ParameterSet`, calls one function of the system and
 hands the result to :func:`~schuler.cli.common.emit`. No numerics here.
@@ -22,6 +24,7 @@ from schuler.cli.common import (
     parameter_options,
     progress_reporter,
 )
+from schuler.cli.sweep import scenario_of, sweep_command
 from schuler.contract import RUN_OPTIONS, Action, System
 from schuler.exceptions import InvalidParameter
 from schuler.imu.instrument import apply_instrument, instrument_options
@@ -39,6 +42,7 @@ def system_group(system: System) -> click.Group:
         context_settings=_CONTEXT,
     )
     group.add_command(_run_command(system))
+    group.add_command(sweep_command(system.name))
     group.add_command(_reproduce_command(system))
     for action in system.actions:
         group.add_command(_action_command(system, action))
@@ -86,22 +90,51 @@ def _with_instrument(system: System, case: Case, options: Case) -> tuple[Case, C
     return case, options
 
 
+def _over_scenario(system: System, loaded, case: Case, *, replace_instrument: bool) -> Case:
+    """The scenario's values with the options the user typed in their place.
+
+    A typed option also displaces the file's values it excludes (the system's
+    exclusive groups); with ``--imu`` typed, the file's ``[instrument]`` is
+    dropped (its values stand only where neither the file nor the options set one).
+    """
+    typed = _given(case)
+    base = system.parameters.parse(loaded.written) if replace_instrument else loaded.values
+    displaced = {name for group in system.parameters.exclusive if typed.keys() & set(group) for name in group}
+    kept = {name: base[name] for name in base.given if name not in typed and name not in displaced}
+    return system.parameters.case({**kept, **typed})
+
+
 def _run_command(system: System) -> click.Command:
     run_options = ParameterSet(RUN_OPTIONS, owner=system.name)
     instrument = instrument_options(system.name)  # --imu where the IMU layer maps to the system
 
-    def run(out_dir: Path | None, as_json: bool, fidelity: str | None = None, **raw):
+    def run(scenario: Path | None, out_dir: Path | None, as_json: bool, fidelity: str | None = None, **raw):
         options = run_options.parse({k: raw.pop(k) for k in run_options.names}, labels="option")
         imu_options = instrument.parse({k: raw.pop(k) for k in instrument.names}, labels="option")
         case = system.parameters.parse(raw, labels="option")
+        draw = None
+        if scenario is not None:
+            loaded = scenario_of(scenario, system.name)
+            case = _over_scenario(system, loaded, case, replace_instrument="imu" in imu_options.given)
+            table = loaded.monte_carlo
+            from_file = {"monte_carlo": table.cases, "seed": table.seed} if table is not None else {}
+            options = run_options.case({**from_file, **_given(options)})
+            draw = loaded.draw if options["monte_carlo"] else None
+            fidelity = fidelity or loaded.fidelity
+            out_dir = out_dir or loaded.out_dir
+            as_json = as_json or loaded.as_json
         case, used = _with_instrument(system, case, imu_options)
         execute_run(system, case, monte_carlo=options["monte_carlo"], seed=options["seed"], fidelity=fidelity,
-                    out_dir=out_dir, as_json=as_json, instrument=used)
+                    out_dir=out_dir, as_json=as_json, draw=draw, instrument=used)
 
     command = click.Command("run", callback=run, context_settings=_CONTEXT,
                             help=f"One case: {system.title}. The headline numbers; figures and data with --out.\n\n"
                                  "Bare numbers are in each option's display unit (shown below); values with "
-                                 "units are converted. --monte-carlo N adds N random members around the case.")
+                                 "units are converted. --monte-carlo N adds N random members around the case.\n\n"
+                                 f"With SCENARIO.toml (a scenario of {system.name}), the options set here win over "
+                                 "the file's values; without options, the result is that of schuler run SCENARIO.toml.")
+    command.params.append(click.Argument(["scenario"], required=False, metavar="[SCENARIO.toml]",
+                                         type=click.Path(dir_okay=False, path_type=Path)))
     decorated = parameter_options(system.parameters + RUN_OPTIONS + instrument)(command.callback)
     for param in reversed(getattr(decorated, "__click_params__", [])):
         command.params.append(param)

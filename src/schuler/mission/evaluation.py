@@ -28,6 +28,9 @@ PARAMETERS = ParameterSet((
               choices=GRADES, kind="choice"),
     Parameter("imu_spec", "", None, "IMU spec file (TOML, as schuler imu writes them); replaces the grade.",
               kind="text"),
+    Parameter("instrument", "", None, "IMU: a grade, a TOML spec file or a recording (.csv, .imu, .parquet) whose "
+              "identified noise terms (Allan analysis) become the model; replaces grade and imu_spec.",
+              kind="text"),
     Parameter("latitude", "deg", 45.0, "Latitude of the start point.", minimum=-80, maximum=80),
     Parameter("longitude", "deg", 0.0, "Longitude of the start point.", minimum=-180, maximum=360),
     Parameter("height", "m", 0.0, "Height of the mission above the ellipsoid.", minimum=-500, maximum=20000),
@@ -37,8 +40,9 @@ PARAMETERS = ParameterSet((
               minimum=1, maximum=86400),
     Parameter("pulse_relative_error", "%", 0.34, "Relative error of the pulse method's drift (the source's 0.34 %).",
               minimum=0, maximum=100),
-    Parameter("alignment", "", "kalman", "Alignment: kalman (strapdown fine alignment), gyrocompass (system 4's "
-              "physical gyrocompassing) or ground-gyrocompass (north from system 5, levelling).",
+    Parameter("alignment", "", "kalman", "Alignment: kalman (strapdown fine alignment), strapdown-gyrocompass "
+              "(analytic, from the averaged rates and forces), gyrocompass (system 4's physical gyrocompassing) "
+              "or ground-gyrocompass (north from system 5, levelling).",
               choices=ALIGNMENTS, kind="choice"),
     Parameter("alignment_duration", "s", 300.0, "Duration of the alignment at rest.", minimum=10, maximum=86400),
     Parameter("gyrocompass_time_constant", "s", 30.0, "Time constant T of system 4's azimuth loop.",
@@ -48,6 +52,8 @@ PARAMETERS = ParameterSet((
               minimum=0, maximum=36000),
     Parameter("trajectory", "", "cruise", "Mission: stationary, cruise (a geodesic at the speed) or flight "
               "(take-off run, two 90-deg turns).", choices=TRAJECTORIES, kind="choice"),
+    Parameter("profile", "", None, "Waypoint profile FILE.toml (format: schuler.navigate.profile) flown instead of "
+              "the trajectory; its [start] and first heading set the start point and heading.", kind="text"),
     Parameter("duration", "s", 7200.0, "Mission duration (after the alignment).", minimum=60, maximum=10 * 86400),
     Parameter("speed", "m/s", 250.0, "Ground speed of cruise and flight.", minimum=0, maximum=1000),
     Parameter("heading", "deg", 30.0, "Heading at the start.", minimum=-360, maximum=360),
@@ -59,7 +65,9 @@ PARAMETERS = ParameterSet((
               minimum=0, maximum=1e5),
     Parameter("imu_rate", "Hz", 2.0, "IMU rate of the Monte Carlo's nonlinear INS (reduced: exact for the "
               "noise, ample for the smooth trajectories).", minimum=0.1, maximum=1000),
-), owner="mission")
+), owner="mission", exclusive=(("grade", "instrument"), ("imu_spec", "instrument"),
+                                *(("profile", name) for name in ("trajectory", "latitude", "longitude", "height",
+                                                                 "heading", "speed"))))
 """Every option of ``schuler mission run`` (and key of a ``mission`` scenario)."""
 
 OUTPUTS = (

@@ -5,6 +5,9 @@ right / z down, errors = computed - true, sensor bias = measured - true, SI.
 
 The life of the instrument, in the order the stages happen:
 
+0. **The instrument**: a grade's preset, a spec file, or a recording's
+   identified noise terms (:func:`error_model`).
+
 1. **Calibration** leaves a residual gyro bias per axis (and, for the
    multi-position method, residual accelerometer biases and scale factors):
 
@@ -45,18 +48,24 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
 from schuler.core.earth import STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel
+from schuler.imu.instrument import resolve_model
 from schuler.imu.spec import load_spec_file, preset
 from schuler.imu.system_inputs import residual_bias
+from schuler.navigate.profile import load_profile
 from schuler.navigate.trajectory import GreatCircle, Stationary, WaypointProfile
 
 CALIBRATIONS = ("pulse", "multi-position")
-ALIGNMENTS = ("kalman", "gyrocompass", "ground-gyrocompass")
+ALIGNMENTS = ("kalman", "strapdown-gyrocompass", "gyrocompass", "ground-gyrocompass")
+SELF_ALIGNMENTS = ("kalman", "strapdown-gyrocompass")
+"""Strapdown self-alignments at rest: to first order, the same residuals (:mod:`schuler.mission.stages`)."""
 TRAJECTORIES = ("stationary", "cruise", "flight")
 VERTICAL_CHANNELS = ("off", "free")
 
@@ -104,6 +113,7 @@ class MissionSetup:
     vertical_channel: str
     output_step: float
     initial_position_error: float
+    profile: WaypointProfile | None = None
 
     @property
     def gravity(self) -> float:
@@ -116,7 +126,11 @@ class MissionSetup:
         the speed and height from the start. ``flight``: at rest at t = 0, a
         take-off run to the speed over 300 s, a 90-deg right turn at 35 % and a
         90-deg left turn at 70 % of the mission (120 s each), level at the height.
+        ``profile``: the waypoint profile file's (:mod:`schuler.navigate.profile`;
+        after its last waypoint it holds that waypoint's values).
         """
+        if self.profile is not None:
+            return self.profile
         if self.trajectory_kind == "stationary":
             return Stationary(latitude=self.latitude, longitude=self.longitude, height=self.height,
                               heading=self.heading)
@@ -186,26 +200,71 @@ class MissionSetup:
         return np.asarray(self.error_model.accel.random_walk, dtype=float)
 
 
-def error_model(grade: str, imu_spec: str | None) -> ErrorModel:
-    """The instrument: a spec file (TOML, :mod:`schuler.imu.spec`) when given, else the grade's preset."""
+def error_model(grade: str, imu_spec: str | None, instrument: str | None = None) -> ErrorModel:
+    """The instrument's error model.
+
+    ``instrument`` (a grade, a TOML spec file or a recording .csv, .imu,
+    .parquet) when given: a recording's identified noise terms become the model
+    (:func:`~schuler.imu.instrument.resolve_model`, the resolution ``--imu``
+    uses: Allan analysis then :func:`~schuler.imu.characterise.model_from_analysis`).
+    An Allan curve shows noise only, so such a model has no turn-on biases nor
+    scale-factor errors: what calibration leaves of it is the noise floor and
+    the slow terms' change. Else ``imu_spec`` (a TOML spec file), else the
+    grade's preset.
+    """
+    if instrument:
+        path = Path(instrument)
+        # a recording is analysed once per process and file version (sweep chunks and Monte Carlo batches reuse it)
+        stamp = (path.stat().st_mtime_ns, path.stat().st_size) if path.is_file() else None
+        return _resolved(str(instrument), stamp)
     if imu_spec:
         return load_spec_file(imu_spec)
     return preset(grade)
 
 
+@lru_cache(maxsize=8)
+def _resolved(instrument: str, stamp: tuple[int, int] | None) -> ErrorModel:
+    try:
+        return resolve_model(instrument)
+    except InvalidParameter as error:
+        raise InvalidParameter("instrument", error.reason) from None
+
+
 def mission_setup(values) -> MissionSetup:
-    """A :class:`MissionSetup` from a case's SI values (a mapping with every parameter of the system)."""
+    """A :class:`MissionSetup` from a case's SI values (a mapping with every parameter of the system).
+
+    With a ``profile`` file, its ``[start]`` table and first waypoint's heading
+    are the start point and heading (where the alignment happens).
+    """
+    if values["profile"]:
+        profile = _profile(values["profile"])
+        start = {"latitude": profile.latitude, "longitude": profile.longitude, "height": profile.height,
+                 "heading": float(profile.headings[0])}
+        kind = "profile"
+    else:
+        profile = None
+        start = {name: float(values[name]) for name in ("latitude", "longitude", "height", "heading")}
+        kind = str(values["trajectory"])
     return MissionSetup(
-        error_model=error_model(values["grade"], values["imu_spec"]),
-        latitude=float(values["latitude"]), longitude=float(values["longitude"]), height=float(values["height"]),
+        error_model=error_model(values["grade"], values["imu_spec"], values["instrument"]),
         calibration=str(values["calibration"]), calibration_duration=float(values["calibration_duration"]),
         pulse_relative_error=float(values["pulse_relative_error"]),
         alignment=str(values["alignment"]), alignment_duration=float(values["alignment_duration"]),
         gyrocompass_time_constant=float(values["gyrocompass_time_constant"]),
         gyrocompass_damping=float(values["gyrocompass_damping"]),
         north_reference_error=float(values["north_reference_error"]),
-        trajectory_kind=str(values["trajectory"]), duration=float(values["duration"]),
-        speed=float(values["speed"]), heading=float(values["heading"]),
+        duration=float(values["duration"]), speed=float(values["speed"]),
         vertical_channel=str(values["vertical_channel"]), output_step=float(values["output_step"]),
-        initial_position_error=float(values["initial_position_error"]),
+        initial_position_error=float(values["initial_position_error"]), trajectory_kind=kind, profile=profile,
+        **start,
     )
+
+
+def _profile(path: str) -> WaypointProfile:
+    """The waypoint profile file, its problems named by the ``profile`` parameter."""
+    try:
+        return load_profile(path)
+    except InvalidParameter as error:
+        # the reader names unreadable files as "trajectory" (navigate's option) and bad keys by their table
+        reason = error.reason if error.name == "trajectory" else f"{path}: {error}"
+        raise InvalidParameter("profile", reason) from None

@@ -24,6 +24,20 @@ Heading (psi_D; the heading error is -phi_D):
   epsilon_E / (Omega cos L)). Its noise-limited part is the white rate noise
   averaged over T_a, sigma = N_E / (Omega cos L sqrt(T_a)), and the tilts'
   sigma = N_a / (g sqrt(T_a)).
+* ``strapdown-gyrocompass`` (analytic, double-vector alignment, Groves 2013,
+  Sec. 5.6.2; Britting 1971, Sec. 10): the means of f^b and omega^b over T_a
+  give C_b^n by TRIAD with gravity first: the tilts level the averaged
+  specific force (as above) and the heading puts the averaged Earth rate's
+  east component, computed through the tilted frame, at zero:
+  -(Omega x psi)_E + epsilon_E = 0. That is the Kalman fine alignment's
+  steady-state equation, so to first order (small angles, the vehicle at
+  rest, constant sensor errors) both leave the same residuals, heading error
+  -b_gE / (Omega cos L) + (b_aE / g) tan L; the averages of the white noises
+  over T_a are the least-squares estimates of constants from white noise,
+  which is also the limit the Kalman filter reaches, so the noise-limited
+  terms are the same too. The methods differ beyond this model: the
+  analytic alignment takes disturbances (sway) into its averages, which a
+  Kalman filter with a motion model rejects.
 * ``gyrocompass`` (system 4, physical gyrocompassing of a platform under the
   control law (1.6)): the steady state (1.21) of the KPI manual, azimuth error
   delta = Dw_xi / (U cos phi) + c_Gamma Dw_z / (c_a U cos phi) with the platform
@@ -60,7 +74,7 @@ from schuler.core.earth import EARTH_RATE, earth_rate_ned, radii_of_curvature
 from schuler.exceptions import InvalidParameter
 from schuler.gyrocompassing.analytic import gains_from_design, settling_time, steady_state
 from schuler.gyrocompassing.models import simplified_model
-from schuler.mission.setup import AXES, CONSTANT_SOURCES, MissionSetup
+from schuler.mission.setup import AXES, CONSTANT_SOURCES, SELF_ALIGNMENTS, MissionSetup
 
 
 def sensor_inputs(setup: MissionSetup, body_to_ned, body_rate, body_force) -> np.ndarray:
@@ -106,7 +120,7 @@ def initial_state_map(setup: MissionSetup, body_to_ned: np.ndarray, n_states: in
     nabla, epsilon = inputs[:, :3], inputs[:, 3:]
     psi_n, psi_e = _levelling(nabla, g)
     cos_l = EARTH_RATE * math.cos(L)
-    if setup.alignment == "kalman":
+    if setup.alignment in SELF_ALIGNMENTS:
         psi_d = -(epsilon[:, 1] + EARTH_RATE * math.sin(L) * psi_n) / cos_l
     elif setup.alignment == "gyrocompass":
         c_gamma, c_a = gyrocompass_gains(setup)
@@ -138,11 +152,11 @@ def alignment_noise(setup: MissionSetup, body_to_ned: np.ndarray, n_states: int)
     # tilts from the accelerometer noise averaged over T: psi_N from east, psi_E from north
     tilt = np.zeros((n_states, 2))
     tilt[down, 0] = tilt[down + 1, 1] = 1.0
-    if setup.alignment == "kalman":
+    if setup.alignment in SELF_ALIGNMENTS:
         tilt[down + 2, 0] = -math.tan(L)
     accel = tilt @ np.diag([ned_accel[1], ned_accel[0]]) @ tilt.T / (g**2 * T)
     gyro = np.zeros((n_states, n_states))
-    if setup.alignment == "kalman":
+    if setup.alignment in SELF_ALIGNMENTS:
         gyro[down + 2, down + 2] = ned_gyro[1] / ((EARTH_RATE * math.cos(L))**2 * T)
     elif setup.alignment == "gyrocompass":
         # the loop's azimuth answers to both noises; its correlation with the levelling tilt is left out

@@ -1,0 +1,71 @@
+"""``schuler NAME run SCENARIO`` and ``schuler NAME sweep SCENARIO``: a system's scenario under its own group."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+
+@pytest.mark.parametrize("system, scenario", [("mission", "mission_tactical.toml"),
+                                              ("align", "align_gyrocompassing.toml")])
+def test_run_with_a_scenario_gives_the_json_of_schuler_run(run_cli, system, scenario):
+    path = EXAMPLES / scenario
+    under_group = run_cli(system, "run", path, "--json")
+    assert under_group.code == 0, under_group.stderr
+    assert under_group.json() == run_cli("run", path, "--json").json()
+
+
+def test_options_typed_win_over_the_scenario(run_cli):
+    out = run_cli("align", "run", EXAMPLES / "align_gyrocompassing.toml", "--latitude", "30", "--duration", "600",
+                  "--json")
+    assert out.code == 0, out.stderr
+    inputs = out.json()["inputs"]
+    assert inputs["latitude"] == pytest.approx(math.radians(30)) and inputs["duration"] == 600.0  # typed
+    assert inputs["drift_east"] == pytest.approx(math.radians(0.01) / 3600)  # the file's 0.01 deg/h
+    assert inputs["time_constant"] == 300.0 and inputs["model"] == "full"
+
+
+def test_a_typed_imu_replaces_the_scenarios_instrument(run_cli):
+    # the file: latitude 50 deg, full model, 1 h at 1 s, [instrument] tactical; --imu navigation replaces the table
+    over_file = run_cli("align", "run", EXAMPLES / "imu_align_tactical.toml", "--imu", "navigation", "--json")
+    typed = run_cli("align", "run", "--latitude", "50", "--model", "full", "--duration", "1 h", "--output-step", "1",
+                    "--imu", "navigation", "--json")
+    assert over_file.code == 0, over_file.stderr
+    assert over_file.json() == typed.json()
+    assert over_file.json() != run_cli("run", EXAMPLES / "imu_align_tactical.toml", "--json").json()
+
+
+@pytest.mark.parametrize("command", ["run", "sweep"])
+def test_a_scenario_of_another_system_is_refused_in_one_line(run_cli, tmp_path, command):
+    out = run_cli("align", command, EXAMPLES / "mission_tactical.toml", *(("--out", tmp_path) if command == "sweep"
+                                                                          else ()))
+    assert out.code == 2 and out.stdout == ""
+    assert out.stderr.count("\n") == 1 and "'mission' is a scenario of schuler mission" in out.stderr
+
+
+def test_sweep_under_the_group_gives_the_summary_of_schuler_sweep(run_cli, tmp_path, monkeypatch):
+    # a 30-min flight (the shortest the profile allows is 28 min) keeps the 4 covariance analyses quick; the
+    # summary plots (a second each, the same code under both commands) are left out
+    import schuler.study.plots
+
+    monkeypatch.setattr(schuler.study.plots, "plot_sweep_summary", lambda *args, **kwargs: [])
+    grid = ("--param", "grade=navigation,tactical", "--param", "alignment_duration=300,600",
+            "--param", "duration=1800")
+    scenario = EXAMPLES / "mission_tactical.toml"
+    under_group = run_cli("mission", "sweep", scenario, *grid, "--out", tmp_path / "group", "--json")
+    plain = run_cli("sweep", scenario, *grid, "--out", tmp_path / "plain", "--json")
+    assert under_group.code == 0, under_group.stderr
+    group_summary = json.loads((tmp_path / "group" / "summary.json").read_text())
+    plain_summary = json.loads((tmp_path / "plain" / "summary.json").read_text())
+    assert group_summary["manifest"]["cases"] == 4
+    assert group_summary == plain_summary
+    # the printed JSON differs only by the folder and the timings
+    varying = ("out_dir", "files", "cases_per_second", "seconds_total", "seconds")
+    group_printed, plain_printed = ({k: v for k, v in out.json().items() if k not in varying}
+                                    for out in (under_group, plain))
+    assert group_printed == plain_printed
