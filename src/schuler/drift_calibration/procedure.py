@@ -306,8 +306,8 @@ def run_procedure(
     -------
     ProcedureOutcome
 
-    Example
-    -------
+    Examples
+    --------
     >>> from schuler.drift_calibration.pulses import rectangular
     >>> stab = Stabilizer(57.3, 0.02, 0.1, 1e-3, 5.0, rectangular())
     >>> out = run_procedure(stab, np.radians(70), np.radians(80), np.radians(0.1) / 3600)

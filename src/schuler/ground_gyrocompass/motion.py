@@ -14,7 +14,7 @@ moment of inertia (zero in the source; the abstract names it as identifiable).
 The substitution z = (2 / lambda) sqrt(B exp(-lambda t)) (eq. (5)) turns the
 homogeneous equation into Bessel's equation of order zero (eq. (6)), so the motion
 is a combination of J0(z) and Y0(z) (eq. (7)); with the initial angle and angular
-rate at t = 0 it is eq. (9) written in time:
+rate at t = 0 it is eq. (9) written in time::
 
     alpha(t) = alpha0 u1(t) + alpha0_dot u2(t) + m u3(t),
 
@@ -114,7 +114,9 @@ def bessel_argument(time, decay_rate, coefficient):
 class Basis:
     """Fundamental solutions of eq. (4) and their derivatives w.r.t. lambda and B.
 
-    Attributes (arrays broadcast from ``time`` and the parameters)
+    The arrays broadcast from ``time`` and the parameters.
+
+    Attributes
     ----------
     angle : ndarray, shape (3, ...)
         u1 (alpha0 = 1 rad), u2 (alpha0_dot = 1 rad/s), u3 (m = 1 rad/s^2); rad per unit.

@@ -262,14 +262,22 @@ def settling_time(c_gamma, c_a, latitude, earth_rate=EARTH_RATE) -> np.ndarray:
 def transient(time, delta0, delta_rate0, delta_y, c_gamma, c_a, latitude, earth_rate=EARTH_RATE) -> np.ndarray:
     """Solution of (1.20) delta'' + c_gamma delta' + c_a U_eta delta = const, tending to delta_y.
 
-    Oscillatory (omega0 > h), (1.22):
+    Oscillatory (omega0 > h), (1.22)::
+
         delta = e^(-h t) [(delta0 - delta_y) cos(w t) + (delta'0 + h (delta0 - delta_y)) / w sin(w t)] + delta_y,
         w = sqrt(omega0^2 - h^2).
-    Aperiodic (h > omega0), (1.24): delta = C1 e^(p1 t) + C2 e^(p2 t) + delta_y,
+
+    Aperiodic (h > omega0), (1.24)::
+
+        delta = C1 e^(p1 t) + C2 e^(p2 t) + delta_y,
         p1,2 = -h +- sqrt(h^2 - omega0^2), C2 = (delta'0 - (delta0 - delta_y) p1) / (p2 - p1),
         C1 = delta0 - delta_y - C2 (printed with "delta_2" for delta_y).
-    Critical (h = omega0): delta = (C1 + C2 t) e^(-h t) + delta_y, C1 = delta0 - delta_y,
+
+    Critical (h = omega0)::
+
+        delta = (C1 + C2 t) e^(-h t) + delta_y, C1 = delta0 - delta_y,
         C2 = delta'0 + h (delta0 - delta_y) (printed with delta'0 in place of delta0).
+
     The same form holds for beta with its own initial values and beta_y (1.25).
 
     Parameters
