@@ -10,7 +10,8 @@ example scripts at every build and puts their figures on their pages, so a
 broken example breaks the build; myst-parser reads the Markdown pages
 (``conventions.md``, ``architecture.md``, the change notes) as they are;
 pydata-sphinx-theme is the maintained theme of that ecosystem. The build is
-offline: no intersphinx, MathJax served from the build (sphinx-mathjax-offline),
+offline: no intersphinx, MathJax served from the build (the files of
+sphinx-mathjax-offline, copied by ``_ext/schuler_docs.py``),
 and the theme's fonts and icons are its own files. ``make docs`` runs Sphinx
 with ``-W --keep-going``: every warning fails the build.
 """
@@ -28,6 +29,11 @@ DOCS = Path(__file__).resolve().parent
 sys.path.insert(0, str(DOCS / "_ext"))
 
 import schuler  # noqa: E402
+from sphinx_gallery.sorting import ExplicitOrder  # noqa: E402
+
+GALLERY = DOCS.parent / "examples" / "gallery"
+SYSTEM_ORDER = ("errors", "vertical", "calibrate", "align", "north", "engine", "imu")
+"""Gallery sections in the guide's order; a new system's folder is built after them ("*")."""
 
 project = "schuler"
 author = "the schuler developers"
@@ -39,7 +45,6 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
-    "sphinx-mathjax-offline",
     "numpydoc",
     "myst_parser",
     "sphinx_gallery.gen_gallery",
@@ -69,9 +74,15 @@ numpydoc_validation_checks: set[str] = set()
 
 myst_heading_anchors = 3
 
+# MathJax offline: its menu could switch on the speech explorer, which fetches rule files from a CDN
+mathjax3_config = {"options": {"enableMenu": False}}
+
 sphinx_gallery_conf = {
-    "examples_dirs": str(DOCS.parent / "examples" / "gallery"),
+    "examples_dirs": str(GALLERY),
+    "subsection_order": ExplicitOrder([*(f"../examples/gallery/{name}" for name in SYSTEM_ORDER), "*"]),
     "gallery_dirs": "gallery",
+    "backreferences_dir": "gallery/backreferences",
+    "doc_module": ("schuler",),
     "filename_pattern": r"/plot_",
     "abort_on_example_error": True,
     "only_warn_on_example_error": False,
@@ -82,6 +93,7 @@ sphinx_gallery_conf = {
     "image_scrapers": ("matplotlib",),
     "default_thumb_file": None,
     "show_memory": False,
+    "write_computation_times": False,  # its pages load jQuery and DataTables from CDNs
     "show_signature": False,
     "capture_repr": (),
     "reset_modules": ("matplotlib",),
@@ -89,7 +101,8 @@ sphinx_gallery_conf = {
 
 html_theme = "pydata_sphinx_theme"
 html_title = f"schuler {release}"
-html_static_path: list[str] = []
+html_static_path = ["_static"]
+html_css_files = ["schuler.css"]
 html_show_sourcelink = False
 html_copy_source = False
 html_theme_options = {

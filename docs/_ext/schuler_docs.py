@@ -25,6 +25,7 @@ Directives:
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import io
 import os
 import re
@@ -35,11 +36,10 @@ from pathlib import Path
 from docutils import nodes
 from docutils.parsers.rst import Directive, directives
 from docutils.statemachine import StringList
-from sphinx.util import logging
+from sphinx.util.fileutil import copy_asset
 
 import schuler_api
 
-LOGGER = logging.getLogger(__name__)
 REPOSITORY = Path(__file__).resolve().parents[2]
 
 
@@ -247,6 +247,23 @@ def escape_bars(app, what, name, obj, options, lines: list[str]) -> None:
             literal_indent = indent
 
 
+def _mathjax_files() -> Path:
+    """MathJax as the sphinx-mathjax-offline package ships it (its own extension is not parallel-safe)."""
+    spec = importlib.util.find_spec("sphinx-mathjax-offline")
+    if spec is None or spec.origin is None:
+        raise RuntimeError("sphinx-mathjax-offline is not installed: pip install -e '.[docs]'")
+    return Path(spec.origin).parent / "static" / "mathjax"
+
+
+def _offline_mathjax(app, config) -> None:
+    config.mathjax_path = "mathjax/tex-chtml.js"
+
+
+def _copy_mathjax(app, exception) -> None:
+    if exception is None and app.builder.format == "html":
+        copy_asset(_mathjax_files(), Path(app.outdir) / "_static" / "mathjax")
+
+
 def _write_api_index(app, config) -> None:
     schuler_api.write_index(Path(app.srcdir))
 
@@ -259,6 +276,9 @@ def setup(app):
     app.add_directive("schuler-help", Help)
     # before Sphinx lists the source files, so that autosummary finds api/index.rst and writes the module pages
     app.connect("config-inited", _write_api_index)
+    # MathJax served from the build, not a CDN
+    app.connect("config-inited", _offline_mathjax)
+    app.connect("build-finished", _copy_mathjax)
     # before numpydoc turns the sections into reStructuredText
     app.connect("autodoc-process-docstring", escape_bars, priority=400)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
