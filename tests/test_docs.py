@@ -75,6 +75,10 @@ def unit_problems(function) -> list[str]:
 
 
 FUNCTIONS = list(schuler_api.public_functions())
+BACKLOG_FILE = Path(__file__).with_name("docstring_backlog.txt")
+BACKLOG = {line.strip() for line in BACKLOG_FILE.read_text(encoding="utf-8").splitlines()
+           if line.strip() and not line.startswith("#")}
+"""Functions documented before the check existed whose Parameters still lack units: only ever shrinks."""
 MODULES = sorted({name.rsplit(".", 2)[0] if name.split(".")[-2][0].isupper() else name.rsplit(".", 1)[0]
                   for name, _ in FUNCTIONS})
 
@@ -84,9 +88,16 @@ def test_public_functions_document_parameters_with_units(module):
     problems = {}
     for name, function in FUNCTIONS:
         owner = name.rsplit(".", 2)[0] if name.split(".")[-2][0].isupper() else name.rsplit(".", 1)[0]
-        if owner == module and (found := unit_problems(function)):
+        if owner == module and name not in BACKLOG and (found := unit_problems(function)):
             problems[name] = found
     assert not problems, "\n".join(f"{name}: {'; '.join(found)}" for name, found in problems.items())
+
+
+def test_the_backlog_only_shrinks():
+    """A backlog entry that is now documented (or gone) must leave the list."""
+    functions = dict(FUNCTIONS)
+    stale = sorted(name for name in BACKLOG if name not in functions or not unit_problems(functions[name]))
+    assert not stale, f"remove from {BACKLOG_FILE.name}: {stale}"
 
 
 def test_the_unit_check_catches_what_it_should():
