@@ -28,8 +28,9 @@ matplotlib.use("Agg")
 DOCS = Path(__file__).resolve().parent
 sys.path.insert(0, str(DOCS / "_ext"))
 
-import schuler  # noqa: E402
 from sphinx_gallery.sorting import ExplicitOrder  # noqa: E402
+
+import schuler  # noqa: E402
 
 GALLERY = DOCS.parent / "examples" / "gallery"
 SYSTEM_ORDER = ("errors", "vertical", "calibrate", "align", "north", "engine", "imu")
@@ -37,7 +38,7 @@ SYSTEM_ORDER = ("errors", "vertical", "calibrate", "align", "north", "engine", "
 
 project = "schuler"
 author = "the schuler developers"
-copyright = "the schuler developers"  # noqa: A001
+copyright = "the schuler developers"
 release = schuler.__version__
 version = release
 

@@ -33,12 +33,11 @@ import shlex
 import tempfile
 from pathlib import Path
 
+import schuler_api
 from docutils import nodes
 from docutils.parsers.rst import Directive, directives
 from docutils.statemachine import StringList
 from sphinx.util.fileutil import copy_asset
-
-import schuler_api
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 

@@ -41,5 +41,7 @@ for phi, error in zip(np.degrees(latitudes), np.degrees(batch["azimuth_error_ana
     print(f"latitude {phi:4.0f} deg: azimuth error {error:6.2f} arcmin")
 
 # %%
-# The same sweep with a Monte Carlo of residual drifts, stored and resumable:
-# ``schuler sweep examples/align_gyrocompassing.toml --param latitude=0:80:5 --monte-carlo 200 --out results/sweep-align``.
+# The same sweep with a Monte Carlo of residual drifts, stored and resumable::
+#
+#     schuler sweep examples/align_gyrocompassing.toml --param latitude=0:80:5 \
+#         --monte-carlo 200 --out results/sweep-align

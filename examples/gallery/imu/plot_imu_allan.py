@@ -19,8 +19,8 @@ import numpy as np
 
 from schuler.imu.allan import allan_deviation
 from schuler.imu.identify import identify_terms
-from schuler.imu.spec import preset
 from schuler.imu.simulate import simulate_record
+from schuler.imu.spec import preset
 
 model = preset("industrial")
 record = simulate_record(model, duration_s=3600.0, sample_interval_s=0.01, seed=1)
