@@ -58,7 +58,15 @@ SOURCE_STEP = 1.0  # every 1 s
 
 
 def check_decay_rate(decay_rate, name: str = "lambda") -> None:
-    """Raise InvalidParameter unless every decay rate lambda is finite and > 0."""
+    """Raise InvalidParameter unless every decay rate lambda is finite and > 0.
+
+    Parameters
+    ----------
+    decay_rate : float or ndarray
+        lambda, 1/s.
+    name : str
+        Name used in the error message.
+    """
     if isinstance(decay_rate, float) and 0.0 < decay_rate < math.inf:
         return  # a valid scalar, without numpy's per-call cost (checked once per fit)
     values = np.asarray(decay_rate, dtype=float)
@@ -67,7 +75,17 @@ def check_decay_rate(decay_rate, name: str = "lambda") -> None:
 
 
 def check_positive(value, name: str, unit: str) -> None:
-    """Raise InvalidParameter unless every value is finite and > 0."""
+    """Raise InvalidParameter unless every value is finite and > 0.
+
+    Parameters
+    ----------
+    value : float or ndarray
+        The values, in ``unit``.
+    name : str
+        Name used in the error message.
+    unit : str
+        Their unit, for the message.
+    """
     if isinstance(value, float) and 0.0 < value < math.inf:
         return  # a valid scalar, without numpy's per-call cost
     values = np.asarray(value, dtype=float)
@@ -105,6 +123,16 @@ def bessel_argument(time, decay_rate, coefficient):
     """z(t) = (2 / lambda) sqrt(B exp(-lambda t)) (source 004, eq. (5)) and z0 = z(0).
 
     Broadcasts ``time`` against ``decay_rate`` and ``coefficient``.
+
+    Parameters
+    ----------
+    time : float or ndarray
+        Time since release, s.
+    decay_rate : float or ndarray
+        lambda, 1/s.
+    coefficient : float or ndarray
+        B = H_m Omega_h / J, 1/s^2.
+
     """
     z0 = 2.0 / decay_rate * np.sqrt(coefficient)
     return z0 * np.exp(-0.5 * decay_rate * time), z0
@@ -294,6 +322,21 @@ def simulate(time, alpha0, alpha0_dot, decay_rate, coefficient, specific_torque=
 
     Same parameters as :func:`closed_form`; ``time`` must be increasing from >= 0.
     The state is (alpha, alpha_dot), started at t = 0.
+
+    Parameters
+    ----------
+    time : ndarray
+        Time since release, s (increasing from >= 0).
+    alpha0 : float
+        Initial angle of the rotor axis from north, rad.
+    alpha0_dot : float
+        Initial azimuth rate, rad/s.
+    decay_rate : float
+        lambda, 1/s.
+    coefficient : float
+        B = H_m Omega_h / J, 1/s^2.
+    specific_torque : float
+        m = M / J, rad/s^2.
 
     Notes
     -----

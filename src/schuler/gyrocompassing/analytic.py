@@ -31,7 +31,7 @@ def gains_from_design(time_constant, damping, latitude, earth_rate=EARTH_RATE):
     time_constant : float or ndarray
         T, s (> 0).
     damping : float or ndarray
-        zeta (> 0).
+        zeta, dimensionless (> 0).
     latitude : float or ndarray
         phi, rad.
     earth_rate : float
@@ -60,6 +60,15 @@ def gains_from_design(time_constant, damping, latitude, earth_rate=EARTH_RATE):
 
 def design_from_gains(c_gamma, c_a, latitude, earth_rate=EARTH_RATE):
     """Time constant T = 1 / sqrt(U_eta c_a) and damping zeta = c_gamma / (2 sqrt(U_eta c_a)).
+
+    Parameters
+    ----------
+    c_gamma, c_a : float or ndarray
+        Gains, 1/s.
+    latitude : float or ndarray
+        phi, rad.
+    earth_rate : float
+        U, rad/s.
 
     Returns
     -------
@@ -175,7 +184,18 @@ def full_steady_state(latitude, c_gamma, c_a, drift_east=0.0, drift_north=0.0, d
 
     Parameters
     ----------
-    As :func:`steady_state`, plus drift_north (dw_deta, rad/s) and eps_alpha (rad).
+    latitude : float or ndarray
+        phi, rad.
+    c_gamma, c_a : float or ndarray
+        Gains, 1/s.
+    drift_east, drift_north, drift_up : float or ndarray
+        Residual drifts dw_dxi, dw_deta, dw_dz, rad/s.
+    latitude_error : float or ndarray
+        dphi, rad.
+    eps_beta, eps_alpha : float or ndarray
+        Accelerometer errors about the east and north axes over g, rad.
+    earth_rate : float
+        U, rad/s.
 
     Returns
     -------
@@ -206,6 +226,19 @@ def azimuth_error_sigma(latitude, c_gamma, c_a, sigma_drift_east=0.0, sigma_drif
 
     sigma_delta^2 = (sigma_xi / U_eta)^2 + (c_gamma sigma_z / (c_a U_eta))^2 + (c_gamma sigma_phi / c_a)^2.
     Accelerometer errors do not enter the simplified model's azimuth error.
+
+    Parameters
+    ----------
+    latitude : float or ndarray
+        phi, rad.
+    c_gamma, c_a : float or ndarray
+        Gains, 1/s.
+    sigma_drift_east, sigma_drift_up : float or ndarray
+        1-sigma of the residual drifts dw_dxi and dw_dz, rad/s.
+    sigma_latitude_error : float or ndarray
+        1-sigma of dphi, rad.
+    earth_rate : float
+        U, rad/s.
 
     Examples
     --------
@@ -245,6 +278,15 @@ def settling_time(c_gamma, c_a, latitude, earth_rate=EARTH_RATE) -> np.ndarray:
     corrected: it prints 5 / (-h + sqrt(h^2 - omega0^2)), which is negative; the
     slow root p = -h + sqrt(h^2 - omega0^2) decays with time constant
     1 / (h - sqrt(h^2 - omega0^2)). Both forms meet at h = omega0.
+
+    Parameters
+    ----------
+    c_gamma, c_a : float or ndarray
+        Gains, 1/s.
+    latitude : float or ndarray
+        phi, rad.
+    earth_rate : float
+        U, rad/s.
 
     Examples
     --------
