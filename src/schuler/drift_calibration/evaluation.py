@@ -183,7 +183,13 @@ def stabilizer_of(case) -> Stabilizer:
 
 
 def member_bytes(case) -> int:
-    """Memory one procedure needs while simulated, bytes: every cycle's grid of inputs, states and noise."""
+    """Memory one procedure needs while simulated, bytes: every cycle's grid of inputs, states and noise.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     channels = 1 if case["mode"] == "single-axis" else 2
     cycles = channels * int(case["positions"]) * int(case["cycles"])
     grid = cycle_grid(SHAPES[case["pulse_shape"]](), NOISE_STEPS).size
@@ -214,6 +220,11 @@ def check_observable(latitude: np.ndarray, max_latitude: np.ndarray) -> None:
 
 def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
 
     Examples
     --------
@@ -284,6 +295,13 @@ def run_case(case: Case, fidelity: str | None = None) -> CalibrationResult:
     """One procedure in full: the outputs of :func:`evaluate`, the true values and one cycle's histories.
 
     ``fidelity`` is accepted for the contract; the system has one way of evaluating.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    fidelity : str, optional
+        One of the system's fidelities (default: the first).
 
     Examples
     --------

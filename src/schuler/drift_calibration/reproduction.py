@@ -182,6 +182,12 @@ def report(figures_dir: Path) -> ReportSection:
 
     The run's Monte Carlo has 1000 members, the trade-offs 200 per point and
     the reproduction 500 per budget; ``--monte-carlo`` scales them up.
+
+    Parameters
+    ----------
+    figures_dir : Path
+        The report's figure folder.
+
     """
     from schuler.drift_calibration.plots import plot_trade_offs
     from schuler.io import save_figure_formats

@@ -222,7 +222,13 @@ def time_grid(duration: float, output_step: float) -> np.ndarray:
 
 
 def member_bytes(case: Case) -> int:
-    """Memory one case holds while simulated, bytes (see :data:`POINT_BYTES`)."""
+    """Memory one case holds while simulated, bytes (see :data:`POINT_BYTES`).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     return int(POINT_BYTES * output_points(case["duration"], case["output_step"]) + CASE_BYTES)
 
 
@@ -233,6 +239,11 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     at once; the simulation (or, with ``fidelity="closed"``, the quasi-steady
     error (29) along the path) runs case by case on each case's own duration and
     output step. The model has no random terms: ``cases.random`` is not used.
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
 
     Examples
     --------
@@ -332,6 +343,13 @@ def _start_closed_forms(cases: Cases, each: list[Case]) -> dict[str, np.ndarray]
 
 def run_case(case: Case, fidelity: str | None = None) -> VerticalResult:
     """One case in full: the outputs of :func:`evaluate` for the one-case batch, and its histories.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    fidelity : str, optional
+        One of the system's fidelities (default: the first).
 
     Examples
     --------
