@@ -40,21 +40,21 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import json  # noqa: E402
-import math  # noqa: E402
-import subprocess  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
-import tracemalloc  # noqa: E402
+import json
+import math
+import subprocess
+import sys
+import time
+import tracemalloc
 
-import numpy as np  # noqa: E402
-import scipy.signal  # noqa: E402
-from scipy.integrate import solve_ivp  # noqa: E402
+import numpy as np
+import scipy.signal
+from scipy.integrate import solve_ivp
 
-from schuler.core.earth import EARTH_RATE, MEAN_RADIUS, STANDARD_GRAVITY  # noqa: E402
-from schuler.core.lti import StateSpace, simulate, simulate_reduce, simulate_statistics  # noqa: E402
-from schuler.gyrocompassing.case import AlignmentCase  # noqa: E402
-from schuler.navigation_errors.three_d import psi_angle_model  # noqa: E402
+from schuler.core.earth import EARTH_RATE, MEAN_RADIUS, STANDARD_GRAVITY
+from schuler.core.lti import StateSpace, simulate, simulate_reduce, simulate_statistics
+from schuler.gyrocompassing.case import AlignmentCase
+from schuler.navigation_errors.three_d import psi_angle_model
 
 MEMBERS = 10_000
 STEPS = 7_200

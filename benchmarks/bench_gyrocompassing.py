@@ -23,18 +23,18 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import argparse  # noqa: E402
-import math  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
+import argparse
+import math
+import sys
+import time
 
-import numpy as np  # noqa: E402
-from scipy.integrate import solve_ivp  # noqa: E402
+import numpy as np
+from scipy.integrate import solve_ivp
 
-from schuler.gyrocompassing import analytic  # noqa: E402
-from schuler.gyrocompassing.api import SYSTEM  # noqa: E402
-from schuler.gyrocompassing.case import AlignmentCase  # noqa: E402
-from schuler.gyrocompassing.simulation import SETTLING_BAND, evaluate_cases  # noqa: E402
+from schuler.gyrocompassing import analytic
+from schuler.gyrocompassing.api import SYSTEM
+from schuler.gyrocompassing.case import AlignmentCase
+from schuler.gyrocompassing.simulation import SETTLING_BAND, evaluate_cases
 
 TARGET_RATIO = 100.0
 TARGET_SECONDS = 2.0

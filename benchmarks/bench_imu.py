@@ -85,7 +85,8 @@ def bench_allan_against_allantools() -> tuple[float, float]:
 def every_term_model():
     model = preset("tactical")
     gyro = replace(model.gyro, gm_sigma=np.full(3, 1e-6), gm_correlation_time_s=np.full(3, 300.0),
-                   rate_random_walk=np.full(3, 1e-8), quantization=np.full(3, 1e-6), g_sensitivity=np.full((3, 3), 1e-6))
+                   rate_random_walk=np.full(3, 1e-8), quantization=np.full(3, 1e-6),
+                   g_sensitivity=np.full((3, 3), 1e-6))
     accel = replace(model.accel, gm_sigma=np.full(3, 1e-4), gm_correlation_time_s=np.full(3, 300.0),
                     rate_random_walk=np.full(3, 1e-6), quantization=np.full(3, 1e-4))
     return replace(model, gyro=gyro, accel=accel, name="tactical, every term on")

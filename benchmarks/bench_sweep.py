@@ -34,8 +34,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from schuler.study.scenario import parse_scenario
 from schuler.gyrocompassing.case import DegradedAccuracyWarning
+from schuler.study.scenario import parse_scenario
 from schuler.study.sweep import run_sweep
 
 # the grid reaches 80 deg latitude on purpose: the accuracy warning is expected there
@@ -108,7 +108,8 @@ def main() -> int:
                 "Dask LocalCluster, 2 workers", scenario, tmp / "dask", draws, scheduler=cluster.scheduler_address
             )
         ratio = dask_seconds / inprocess
-        print(f"{'Dask / in-process time':>28}: {ratio:.2f} (with start-up {(dask_seconds + startup) / inprocess:.2f})", end="")
+        with_startup = (dask_seconds + startup) / inprocess
+        print(f"{'Dask / in-process time':>28}: {ratio:.2f} (with start-up {with_startup:.2f})", end="")
         if ratio < 0.8:
             print("  (Dask is faster)")
         else:

@@ -127,3 +127,9 @@ def test_parse_parameters_defaults_and_unknown_names():
     assert values == {"latitude": pytest.approx(math.radians(50)), "tau": 8.0, "mode": "single-axis", "monte_carlo": 0}
     with pytest.raises(InvalidParameter, match="unknown parameter"):
         parse_parameters([LATITUDE], {"latitud": 5})
+
+
+@pytest.mark.parametrize("text", ["()", "f()", "1 +", "deg deg (", "[1, 2]"])
+def test_malformed_text_is_one_clear_error(text):
+    with pytest.raises(InvalidParameter, match="latitude: "):
+        parse_quantity(text, "deg", name="latitude")

@@ -182,6 +182,16 @@ def test_run_down_too_long_is_refused(fidelity):
         SYSTEM.run(decay_rate=1.0, duration=2000.0, fidelity=fidelity)
 
 
+@pytest.mark.parametrize("fidelity", ["closed", "simulated"])
+def test_decay_too_slow_for_the_closed_form_is_refused(fidelity):
+    # z0 = 2 sqrt(B) / lambda above 5e6: the Bessel functions of (9) lose their phase (the fit's model,
+    # whichever way the record is made); 1e-105 1/s once gave NaN predicted errors
+    for decay_rate in (1e-8, 1.8776891407456315e-105):
+        with pytest.raises(InvalidParameter, match=f"decay_rate: {decay_rate:g} 1/s: z0 .* beyond the reach"):
+            SYSTEM.run(decay_rate=decay_rate, fidelity=fidelity)
+    SYSTEM.run(decay_rate=1e-7, fidelity=fidelity)  # z0 = 2.3e6: within reach
+
+
 def test_parameters_renamed_exclusive_and_suggested():
     assert SYSTEM.parameters.exclusive == (("latitude", "omega_h"),)
     assert SYSTEM.case()["alpha0"] == motion.SOURCE_ALPHA0  # the default, written "3.69*pi/540 rad" as printed

@@ -254,7 +254,8 @@ def test_aided_loop_settles_to_its_closed_form_steady_state(order):
     h = simulate(baro_aided_model(gains, MEAN_RADIUS, STANDARD_GRAVITY), t, inputs=[b, baro])["altitude_error"]
     expected = aided_steady_state_error(gains, b, baro, MEAN_RADIUS, STANDARD_GRAVITY)
     assert h[-1] == pytest.approx(float(expected), rel=1e-9)
-    assert expected == pytest.approx(baro if order == 3 else (b + gains.k2 * baro) / (gains.k2 - 2 * STANDARD_GRAVITY / MEAN_RADIUS))
+    closed_form = baro if order == 3 else (b + gains.k2 * baro) / (gains.k2 - 2 * STANDARD_GRAVITY / MEAN_RADIUS)
+    assert expected == pytest.approx(closed_form)
 
 
 def test_damping_stabilises_the_divergent_vertical_channel():

@@ -43,7 +43,8 @@ def test_renamed_step_is_refused_naming_output_step(run_cli):
     with pytest.raises(InvalidParameter, match="step: renamed to 'output_step'"):
         SYSTEM.run(step=10.0)
     out = run_cli("errors", "run", "--step", "10")
-    assert out.code == 2 and out.stderr.strip() == "schuler: error: --step: renamed to '--output-step' (see CHANGELOG.md)"
+    assert out.code == 2
+    assert out.stderr.strip() == "schuler: error: --step: renamed to '--output-step' (see CHANGELOG.md)"
 
 
 def test_magnitude_takes_si_numbers_and_text_in_the_source_unit():

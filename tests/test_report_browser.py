@@ -10,10 +10,10 @@ import shutil
 from pathlib import Path
 
 import pytest
-import test_study_fake_system as fake
-from test_study_report import full_report, landed_systems
 
+import test_study_fake_system as fake
 from schuler.study.report import build_report
+from test_study_report import full_report, landed_systems
 
 MIN_FONT_PX = 9.0
 """Smallest legible figure text as displayed in a 1280-px wide window, px."""

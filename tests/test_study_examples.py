@@ -46,7 +46,8 @@ def test_example_runs_like_the_system_command(path, run_cli, tmp_path):
     assert out.code == 0, out.stderr
     data = out.json()
     scenario = load_scenario(path)
-    expected = json.loads(json.dumps(scenario.definition().run(fidelity=scenario.fidelity, **scenario.given()).to_dict()))
+    result = scenario.definition().run(fidelity=scenario.fidelity, **scenario.given())
+    expected = json.loads(json.dumps(result.to_dict()))
     scalars = {k: v for k, v in expected.items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
     assert scalars, "the result has no scalar to compare"
     assert {k: data[k] for k in scalars} == pytest.approx(scalars, rel=1e-9)

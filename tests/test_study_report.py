@@ -7,8 +7,8 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
-import test_study_fake_system as fake
 
+import test_study_fake_system as fake
 from schuler.registry import SYSTEM_MODULES
 from schuler.study.report import build_report
 

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 import pytest
-import test_study_fake_system as fake
 
+import test_study_fake_system as fake
 from schuler.exceptions import ScenarioError
 from schuler.study.scenario import load_scenario, parse_scenario
 
@@ -81,20 +81,25 @@ def test_run_prints_what_the_api_returns(tmp_path, run_cli):
     ("text", "expected"),
     [
         # unknown key, with a suggestion and the allowed keys
-        ('system = "fake"\n[parameters]\nlattitude = 50\n', "[parameters] lattitude: unknown key; did you mean 'latitude'?"),
+        ('system = "fake"\n[parameters]\nlattitude = 50\n',
+         "[parameters] lattitude: unknown key; did you mean 'latitude'?"),
         ('system = "fake"\ncolour = "red"\n', "colour: unknown key"),
-        ('system = "fake"\n[simulation]\ntime = "1 h"\n', "[simulation] time: unknown key; allowed: duration, output_step"),
+        ('system = "fake"\n[simulation]\ntime = "1 h"\n',
+         "[simulation] time: unknown key; allowed: duration, output_step"),
         ('system = "fake"\n[outputs]\nfolder = "x"\n', "[outputs] folder: unknown key"),
         ('system = "fake"\n[parameters]\nduration = "1 h"\n[simulation]\nduration = "2 h"\n',
          "[simulation] duration: also set as [parameters] duration; set it once"),
         # bad unit: dimension checked
-        ('system = "fake"\n[parameters]\ndrift_east = "0.01 m"\n', "[parameters] drift_east: '0.01 m' is not an angular rate"),
+        ('system = "fake"\n[parameters]\ndrift_east = "0.01 m"\n',
+         "[parameters] drift_east: '0.01 m' is not an angular rate"),
         ('system = "fake"\n[parameters]\nlatitude = "50 furlongs"\n', "[parameters] latitude: "),
         ('system = "fake"\n[simulation]\nduration = "2 deg"\n', "[simulation] duration: '2 deg' is not a time"),
         # out of range
-        ('system = "fake"\n[parameters]\nlatitude = "95 deg"\n', "[parameters] latitude: '95 deg' is outside [-89, 89] deg"),
+        ('system = "fake"\n[parameters]\nlatitude = "95 deg"\n',
+         "[parameters] latitude: '95 deg' is outside [-89, 89] deg"),
         ('system = "fake"\n[parameters]\ngain = 0\n', "[parameters] gain: 0 is outside (0, inf)"),
-        ('system = "fake"\n[parameters]\nmethod = "guess"\n', "[parameters] method: 'guess' is not one of closed, table"),
+        ('system = "fake"\n[parameters]\nmethod = "guess"\n',
+         "[parameters] method: 'guess' is not one of closed, table"),
         ('system = "fake"\n[parameters]\nmembers = 0\n', "[parameters] members: 0 is outside [1, inf)"),
         # wrong types
         ('system = "fake"\n[parameters]\nlatitude = [1, 2]\n', "[parameters] latitude: [1, 2] is not a single number"),
@@ -103,10 +108,14 @@ def test_run_prints_what_the_api_returns(tmp_path, run_cli):
         ('[parameters]\nlatitude = 1\n', "system: missing"),
         ('system = "gyro"\n', "system: 'gyro' is not one of"),
         # Monte Carlo tables
-        ('system = "fake"\n[monte_carlo.normal]\ndrift_east = "1 m"\n', "[monte_carlo.normal] drift_east: '1 m' is not an angular rate"),
-        ('system = "fake"\n[monte_carlo.uniform]\nlatitude = ["10 deg", "99 deg"]\n', "[monte_carlo.uniform] latitude: '99 deg' is outside"),
-        ('system = "fake"\n[monte_carlo.uniform]\nlatitude = [20, 10]\n', "[monte_carlo.uniform] latitude: [20, 10]: the lower end"),
-        ('system = "fake"\n[monte_carlo.normal]\nmethod = "x"\n', "[monte_carlo.normal] method: only numeric parameters"),
+        ('system = "fake"\n[monte_carlo.normal]\ndrift_east = "1 m"\n',
+         "[monte_carlo.normal] drift_east: '1 m' is not an angular rate"),
+        ('system = "fake"\n[monte_carlo.uniform]\nlatitude = ["10 deg", "99 deg"]\n',
+         "[monte_carlo.uniform] latitude: '99 deg' is outside"),
+        ('system = "fake"\n[monte_carlo.uniform]\nlatitude = [20, 10]\n',
+         "[monte_carlo.uniform] latitude: [20, 10]: the lower end"),
+        ('system = "fake"\n[monte_carlo.normal]\nmethod = "x"\n',
+         "[monte_carlo.normal] method: only numeric parameters"),
         ('system = "fake"\n[monte_carlo]\ncases = 0\n', "[monte_carlo] cases: 0"),
         # malformed TOML
         ('system = "fake"\n[parameters\nlatitude = 1\n', "not valid TOML: "),
@@ -169,7 +178,8 @@ def test_every_real_system_gets_a_schema_from_its_parameters(name, tmp_path, run
     path = write(tmp_path, f'system = "{name}"\n[parameters]\nno_such_option = 1\n')
     out = run_cli("run", path)
     assert out.code == 2
-    assert f"[parameters] no_such_option: unknown key; allowed: {', '.join(p.name for p in system.parameters)}" in out.stderr
+    allowed = ", ".join(p.name for p in system.parameters)
+    assert f"[parameters] no_such_option: unknown key; allowed: {allowed}" in out.stderr
     latitude = next((p for p in system.parameters if p.name == "latitude"), None)
     if latitude is not None:
         out = run_cli("run", write(tmp_path, f'system = "{name}"\n[parameters]\nlatitude = "95 deg"\n'))

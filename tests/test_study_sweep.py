@@ -8,13 +8,13 @@ import os
 import numpy as np
 import pandas as pd
 import pytest
-import test_study_fake_system as fake
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+import test_study_fake_system as fake
 from schuler.exceptions import ScenarioError
-from schuler.study.scenario import parse_scenario
 from schuler.study.plan import grid_values, parse_axis, plan_sweep
+from schuler.study.scenario import parse_scenario
 from schuler.study.store import chunk_path
 from schuler.study.summary import histograms
 from schuler.study.sweep import run_sweep
@@ -124,7 +124,8 @@ def test_sweep_results_are_the_closed_form_per_case(scenario, tmp_path):
     # grid: case = (latitude index * 2 + members index) * 5 + draw
     assert np.allclose(frame["latitude_deg"], np.repeat(np.arange(0, 61, 10), 10))
     assert frame["members"].tolist() == np.tile(np.repeat([1, 2], 5), 7).tolist()
-    expected = np.radians(frame["drift_east_deg_per_h"]) / 3600 / (fake.EARTH_RATE * np.cos(np.radians(frame["latitude_deg"])))
+    horizontal_earth_rate = fake.EARTH_RATE * np.cos(np.radians(frame["latitude_deg"]))
+    expected = np.radians(frame["drift_east_deg_per_h"]) / 3600 / horizontal_earth_rate
     assert np.allclose(frame["azimuth_error_rad"], expected, rtol=1e-12)
     assert np.allclose(frame["settling_time_s"], 3600.0 / frame["gain"] * frame["members"], rtol=1e-12)
     assert frame["gain"].between(0.5, 1.5).all() and frame["gain"].std() > 0.2
@@ -156,7 +157,8 @@ def test_draws_do_not_depend_on_chunking(scenario, tmp_path):
 
 def test_system_random_terms_are_drawn_only_in_a_monte_carlo(scenario, tmp_path):
     # sigma_drift is a random term of the system itself: a plain grid is nominal, a Monte Carlo draws it
-    noisy = parse_scenario(SCENARIO.replace('drift_east = "0.01 deg/h"', 'drift_east = "0.01 deg/h"\nsigma_drift = "0.005 deg/h"'))
+    noisy = parse_scenario(SCENARIO.replace('drift_east = "0.01 deg/h"',
+                                            'drift_east = "0.01 deg/h"\nsigma_drift = "0.005 deg/h"'))
     plain = run_sweep(noisy, tmp_path / "grid", ("latitude=0,30",), progress=False, plots=False)
     assert plain.statistics["azimuth_error_rad"]["std"] > 0  # two latitudes
     grid = results(tmp_path / "grid")
@@ -166,13 +168,15 @@ def test_system_random_terms_are_drawn_only_in_a_monte_carlo(scenario, tmp_path)
     run_sweep(noisy, tmp_path / "mc50", ("latitude=0,30",), monte_carlo=25, chunk_size=50, progress=False, plots=False)
     pd.testing.assert_frame_equal(results(tmp_path / "mc7"), results(tmp_path / "mc50"), check_exact=True)
     drawn = results(tmp_path / "mc7")
-    nominal = np.radians(drawn["drift_east_deg_per_h"]) / 3600 / (fake.EARTH_RATE * np.cos(np.radians(drawn["latitude_deg"])))
+    horizontal_earth_rate = fake.EARTH_RATE * np.cos(np.radians(drawn["latitude_deg"]))
+    nominal = np.radians(drawn["drift_east_deg_per_h"]) / 3600 / horizontal_earth_rate
     assert not np.allclose(drawn["azimuth_error_rad"], nominal)
 
 
 def test_monte_carlo_draws_outside_the_range_are_refused(tmp_path):
     wide = parse_scenario('system = "fake"\n[monte_carlo.normal]\nlatitude = "30 deg"\n')
-    with pytest.raises(ScenarioError, match=r"\[monte_carlo.normal\] latitude: a draw of .* deg is outside \[-89, 89\] deg"):
+    outside = r"\[monte_carlo.normal\] latitude: a draw of .* deg is outside \[-89, 89\] deg"
+    with pytest.raises(ScenarioError, match=outside):
         run_sweep(wide, tmp_path, (), monte_carlo=1000, progress=False)
 
 
@@ -232,7 +236,8 @@ def test_a_killed_dask_worker_loses_no_finished_chunk(scenario, tmp_path, monkey
     with distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=50
     ) as cluster:
-        summary = run_sweep(scenario, tmp_path / "dask", scheduler=cluster.scheduler_address, on_chunk=finished.append, **args)
+        summary = run_sweep(scenario, tmp_path / "dask", scheduler=cluster.scheduler_address,
+                            on_chunk=finished.append, **args)
     assert marker.exists() and int(marker.read_text()) != os.getpid()  # a worker process died
     assert summary.chunks_computed == summary.chunks == 7
     assert sorted(finished) == list(range(7))  # every chunk stored exactly once

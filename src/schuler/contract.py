@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -44,7 +44,7 @@ from schuler.core.random import RandomStreams
 from schuler.core.stats import StreamingStatistics
 from schuler.exceptions import InvalidParameter
 from schuler.params import Case, Parameter, ParameterSet
-from schuler.results import MonteCarloSummary, Result
+from schuler.results import MonteCarloSummary, Result, RunResult
 
 MONTE_CARLO_CHUNK = 2_000
 """Members evaluated at once in :meth:`System.run` Monte Carlo (unless the system says otherwise)."""
@@ -158,7 +158,8 @@ class Cases:
         """
         array = self._values[name]
         if array.dtype == object:
-            unset = np.equal(array, None)
+            # numpy's stubs leave out None, which object arrays compare elementwise
+            unset = np.equal(array, None)  # type: ignore[call-overload]
             return np.where(unset, np.nan, array).astype(float) if unset.any() else array.astype(float)
         return array.astype(float)
 
@@ -185,7 +186,8 @@ class Cases:
         """
         array = self._values[name]
         if array.dtype == object:
-            return ~np.equal(array, None)
+            # numpy's stubs leave out None, which object arrays compare elementwise
+            return ~np.equal(array, None)  # type: ignore[call-overload]
         if array.dtype.kind == "f":
             return ~np.isnan(array)
         return np.ones(self.n, dtype=bool)
@@ -521,9 +523,9 @@ def monte_carlo(evaluate: Callable[[Cases], dict[str, np.ndarray]], outputs: tup
         numbers = np.arange(start, min(start + chunk, members), dtype=np.int64)
         batch = Cases.from_case(case, numbers.size, members=numbers, random=streams, fidelity=fidelity)
         if draw is not None:
-            values = {name: batch[name] for name in batch.names}
-            values.update(draw(numbers))
-            batch = Cases(values, members=numbers, random=streams, fidelity=fidelity)
+            drawn = {name: batch[name] for name in batch.names}
+            drawn.update(draw(numbers))
+            batch = Cases(drawn, members=numbers, random=streams, fidelity=fidelity)
         results = evaluate(batch)
         for name, stats in statistics.items():
             values = np.asarray(results[name], dtype=float)
@@ -543,12 +545,10 @@ def _count(value, name: str) -> int:
     return int(value)
 
 
-def _with_monte_carlo(result: Result, summary: MonteCarloSummary) -> Result:
-    import dataclasses
-
-    if not any(f.name == "monte_carlo" for f in dataclasses.fields(result)):
+def _with_monte_carlo(result: Result, summary: MonteCarloSummary) -> RunResult:
+    if not isinstance(result, RunResult):
         raise TypeError(f"{type(result).__name__} has no monte_carlo field; derive it from RunResult")
-    return dataclasses.replace(result, monte_carlo=summary)
+    return replace(result, monte_carlo=summary)
 
 
 RUN_OPTIONS = (

@@ -68,8 +68,8 @@ class Parameter:
         Allowed range in the display unit.
     exclusive_minimum, exclusive_maximum : bool
         Whether the bounds themselves are excluded.
-    choices : tuple of str, optional
-        Allowed values of a ``choice``.
+    choices : tuple of str
+        Allowed values of a ``choice`` (which must have some); empty for other kinds.
     kind : {"quantity", "choice", "integer", "flag", "text"}
     """
 
@@ -81,8 +81,12 @@ class Parameter:
     maximum: float | None = None
     exclusive_minimum: bool = False
     exclusive_maximum: bool = False
-    choices: tuple[str, ...] | None = None
+    choices: tuple[str, ...] = ()
     kind: Kind = "quantity"
+
+    def __post_init__(self):
+        if self.kind == "choice" and not self.choices:
+            raise ValueError(f"parameter {self.name}: a choice needs its allowed values (choices=...)")
 
     @property
     def option(self) -> str:
@@ -177,7 +181,7 @@ class Parameter:
             try:
                 number = int(str(value).strip()) if not isinstance(value, int) or isinstance(value, bool) else value
             except ValueError:
-                raise InvalidParameter(label, f"{value!r} is not a whole number")
+                raise InvalidParameter(label, f"{value!r} is not a whole number") from None
             self._check_range(number, number, value, label)
             return number
         si = parse_quantity(value, self.unit, name=label)
@@ -185,17 +189,16 @@ class Parameter:
         return si
 
     def _check_range(self, shown: float, si, raw, label: str) -> None:
-        low_bad = self.minimum is not None and (
-            shown < self.minimum or (self.exclusive_minimum and shown <= self.minimum)
-        )
-        high_bad = self.maximum is not None and (
-            shown > self.maximum or (self.exclusive_maximum and shown >= self.maximum)
-        )
-        # tolerate rounding of unit conversion at an inclusive bound
-        if low_bad and not self.exclusive_minimum and math.isclose(shown, self.minimum, rel_tol=1e-12, abs_tol=1e-12):
-            low_bad = False
-        if high_bad and not self.exclusive_maximum and math.isclose(shown, self.maximum, rel_tol=1e-12, abs_tol=1e-12):
-            high_bad = False
+        # an inclusive bound tolerates the rounding of the unit conversion
+        low_bad = high_bad = False
+        if self.minimum is not None:
+            low_bad = shown < self.minimum or (self.exclusive_minimum and shown <= self.minimum)
+            if low_bad and not self.exclusive_minimum:
+                low_bad = not math.isclose(shown, self.minimum, rel_tol=1e-12, abs_tol=1e-12)
+        if self.maximum is not None:
+            high_bad = shown > self.maximum or (self.exclusive_maximum and shown >= self.maximum)
+            if high_bad and not self.exclusive_maximum:
+                high_bad = not math.isclose(shown, self.maximum, rel_tol=1e-12, abs_tol=1e-12)
         if low_bad or high_bad:
             raise InvalidParameter(label, f"{raw!r} is outside {self.range_text()}")
 

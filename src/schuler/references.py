@@ -7,7 +7,8 @@ document it belongs to ("Drozdovich (1959), eq. (29)").
 Examples
 --------
 >>> print(DROZDOVICH_1959.citation)
-Drozdovich, V. N., "On an inertial method of measuring velocities", Izvestiya VUZ, Priborostroyeniye, no. 3, pp. 29-39, 1959
+Drozdovich, V. N., "On an inertial method of measuring velocities", Izvestiya VUZ, Priborostroyeniye,
+no. 3, pp. 29-39, 1959
 >>> DROZDOVICH_1959.short
 'Drozdovich (1959)'
 """

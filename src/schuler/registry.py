@@ -38,10 +38,12 @@ def get_system(name: str) -> System:
     >>> get_system("allign")
     Traceback (most recent call last):
     ...
-    schuler.exceptions.InvalidParameter: system: 'allign' is not a system; did you mean 'align'? choose from errors, vertical, calibrate, align, north
+    schuler.exceptions.InvalidParameter: system: 'allign' is not a system; did you mean 'align'?
+    choose from errors, vertical, calibrate, align, north
     """
     if name not in SYSTEM_MODULES:
         hint = difflib.get_close_matches(str(name), SYSTEM_MODULES, n=1)
         suggestion = f"did you mean {hint[0]!r}? " if hint else ""
-        raise InvalidParameter("system", f"{name!r} is not a system; {suggestion}choose from {', '.join(SYSTEM_MODULES)}")
+        raise InvalidParameter("system",
+                               f"{name!r} is not a system; {suggestion}choose from {', '.join(SYSTEM_MODULES)}")
     return importlib.import_module(SYSTEM_MODULES[name]).SYSTEM

@@ -106,7 +106,7 @@ class Footnotes:
     ['[1] 3,650 ft is the amplitude']
     """
 
-    def __init__(self):
+    def __init__(self) -> None:
         self._numbers: dict[str, int] = {}
 
     def reference(self, *notes: str) -> str:

@@ -39,10 +39,11 @@ import re
 from functools import lru_cache
 
 import pint
+from pint.facets.plain import PlainUnit
 
 from schuler.exceptions import InvalidParameter
 
-ureg = pint.UnitRegistry()
+ureg: pint.UnitRegistry = pint.UnitRegistry()
 ureg.define("standard_gravity_unit = 9.80665 meter / second ** 2 = g0 = gee")
 ureg.define("statute_mile = 1609.344 meter = smi")
 
@@ -72,10 +73,16 @@ _KIND_NAMES = {
 }
 
 
-def _angle_power(unit: pint.Unit) -> int:
+def _exponents(unit: PlainUnit) -> dict[str, float]:
+    """Each unit name in ``unit`` with its exponent (deg/h -> {"degree": 1.0, "hour": -1.0})."""
+    # pint types an exponent as any scalar, complex included; the units it builds have real ones
+    return {name: float(exponent) for name, exponent in unit._units.items()}  # type: ignore[arg-type]
+
+
+def _angle_power(unit: PlainUnit) -> int:
     """The power of angle units in a unit (deg/h -> 1, Hz -> 0, rad^2 -> 2)."""
-    power = 0
-    for name, exponent in unit._units.items():
+    power = 0.0
+    for name, exponent in _exponents(unit).items():
         _, base, _ = ureg.parse_unit_name(name)[0] if ureg.parse_unit_name(name) else ("", name, "")
         if base in _ANGLE_UNITS or base in _ANGLE_RATE_UNITS:
             power += exponent
@@ -157,8 +164,10 @@ def parse_quantity(value, unit: str, *, name: str) -> float:
             spelled = _standard_gravity_spelling(text) if _gravity_units_expected(target) else _square_roots(text)
             try:
                 quantity = ureg.Quantity(spelled)
-            except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError, KeyError):
-                raise InvalidParameter(name, f"cannot read {shown} as a quantity in {unit or 'plain numbers'}")
+            except Exception:  # pint raises many kinds on malformed text: "()" asserts, "deg (" fails to tokenize
+                raise InvalidParameter(
+                    name, f"cannot read {shown} as a quantity in {unit or 'plain numbers'}"
+                ) from None
             if not isinstance(quantity, ureg.Quantity):
                 quantity = ureg.Quantity(float(quantity), "")
             if not str(quantity.units) and str(target):
@@ -172,7 +181,7 @@ def parse_quantity(value, unit: str, *, name: str) -> float:
     try:
         magnitude = float(si.magnitude)
     except TypeError:
-        raise InvalidParameter(name, f"{shown} is not a single number")
+        raise InvalidParameter(name, f"{shown} is not a single number") from None
     if not math.isfinite(magnitude):
         raise InvalidParameter(name, f"{shown} is not a finite number")
     return magnitude
@@ -245,9 +254,7 @@ def si_unit(unit: str) -> str:
     ('rad/s', 'm/s^2', 'rad', '1', 'rad/s^0.5')
     """
     base = ureg.Quantity(1.0, _display_unit(unit)).to_base_units().units
-    powers = {}
-    for name, exponent in base._units.items():
-        powers[_SI_SYMBOLS.get(name, name)] = exponent
+    powers = {_SI_SYMBOLS.get(name, name): exponent for name, exponent in _exponents(base).items()}
     if _angle_power(_display_unit(unit)) and "rad" not in powers:
         powers = {"rad": _angle_power(_display_unit(unit)), **powers}
 

@@ -32,6 +32,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "run": ("schuler.cli.study:run_scenario", "Run a scenario file (TOML)."),
     "sweep": ("schuler.cli.study:sweep", "Sweep parameters or Monte Carlo over a scenario."),
     "report": ("schuler.cli.study:report", "Build the HTML report of all systems."),
+    "lab": ("schuler.cli.lab:lab", "Open the interactive lab bench in the browser."),
 }
 """Each command: where it comes from (``"system"``: generated from the registry's System) and its short help."""
 

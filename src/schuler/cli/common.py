@@ -16,7 +16,6 @@ import click
 
 from schuler import __version__
 from schuler.exceptions import InvalidParameter, SchulerError
-from schuler.params import Parameter
 from schuler.results import json_safe
 
 
@@ -60,6 +59,7 @@ def options_named(parameters):
 
     Examples
     --------
+    >>> from schuler.params import Parameter
     >>> speed = Parameter("speed", "m/s", 10.0, "Ground speed.")
     >>> try:
     ...     with options_named([speed]):

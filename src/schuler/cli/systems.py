@@ -51,8 +51,8 @@ def _given(case) -> dict:
 def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fidelity: str | None,
                 out_dir: Path | None, as_json: bool, draw=None) -> None:
     """What ``schuler NAME run`` and ``schuler run SCENARIO`` do with a parsed case."""
-    with options_named(system.parameters + RUN_OPTIONS), progress_reporter(f"{system.name} Monte Carlo", enabled=not as_json) \
-            as progress:
+    with options_named(system.parameters + RUN_OPTIONS), \
+            progress_reporter(f"{system.name} Monte Carlo", enabled=not as_json) as progress:
         result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
                             **_given(case))
     files = system.write_files(result, out_dir) if out_dir is not None else []
@@ -89,8 +89,8 @@ def _run_command(system: System) -> click.Command:
 
 
 def _output_params() -> list[click.Parameter]:
-    holder = out_option(json_option(lambda **kw: None))
-    return list(reversed(holder.__click_params__))
+    # the shared options, as click collects them into a command (in the order declared)
+    return click.command()(out_option(json_option(lambda **kw: None))).params
 
 
 def _reproduce_command(system: System) -> click.Command:

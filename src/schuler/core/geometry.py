@@ -213,7 +213,7 @@ def horizontal_earth_rate(latitude, earth_rate: float = EARTH_RATE):
     return float(north) if north.ndim == 0 else north
 
 
-def _grid_counts(durations, steps, names: tuple[str, str], max_points: int) -> np.ndarray:
+def _grid_counts(durations, steps, names: tuple[str, str], max_points: float) -> np.ndarray:
     """Number of points of each case's :func:`time_grid`, checked before anything is allocated."""
     duration_name, step_name = names
     durations, steps = np.broadcast_arrays(np.asarray(durations, dtype=float), np.asarray(steps, dtype=float))

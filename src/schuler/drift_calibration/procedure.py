@@ -71,7 +71,8 @@ def apparent_drift(latitude, azimuth, earth_rate: float = EARTH_RATE):
     [1.0, -0.0, -0.0]
     """
     horizontal = earth_rate * np.cos(latitude)
-    return horizontal * np.sin(azimuth), -horizontal * np.cos(azimuth), -earth_rate * np.sin(latitude) * np.ones_like(azimuth)
+    vertical = earth_rate * np.sin(latitude)
+    return horizontal * np.sin(azimuth), -horizontal * np.cos(azimuth), -vertical * np.ones_like(azimuth)
 
 
 def rate_from_reading(reading, k1: float, tau: float):
@@ -262,7 +263,8 @@ def fit_positions(rates_x, rates_y=None, mode: str = "three-axis"):
     # einsum, not a BLAS product: each member's numbers then do not depend on how many are fitted at once
     solution = np.einsum("mk,jk->mj", data, np.linalg.pinv(design))
     if mode == "single-axis":
-        return {"drift_x": solution[:, 0], "drift_y": np.full(len(data), np.nan), "c": solution[:, 1], "s": solution[:, 2]}
+        return {"drift_x": solution[:, 0], "drift_y": np.full(len(data), np.nan), "c": solution[:, 1],
+                "s": solution[:, 2]}
     return {"drift_x": solution[:, 0], "drift_y": solution[:, 1], "c": solution[:, 2], "s": solution[:, 3]}
 
 

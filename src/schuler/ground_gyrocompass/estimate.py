@@ -69,9 +69,9 @@ class NorthEstimate(Result):
     inertia: float
     omega_h: float
     correlation: dict
-    time: np.ndarray = field(repr=False, default=None)
-    observed: np.ndarray = field(repr=False, default=None)
-    residuals: np.ndarray = field(repr=False, default=None)
+    time: np.ndarray = field(repr=False)
+    observed: np.ndarray = field(repr=False)
+    residuals: np.ndarray = field(repr=False)
 
     units: ClassVar[dict] = {
         "alpha0_dot": "rad/s",
@@ -155,7 +155,7 @@ def make_estimate(fit: Fit, time, observed, unknowns, reading, method, inertia, 
     """
     values = fit.values
     errors = {}
-    correlation = {"parameters": list(fit.names), "matrix": None}
+    correlation: dict[str, list[str] | np.ndarray | None] = {"parameters": list(fit.names), "matrix": None}
     if fit.covariance is not None:
         errors = dict(zip(fit.names, np.sqrt(np.diag(fit.covariance))))
         scale = np.sqrt(np.diag(fit.covariance))

@@ -244,7 +244,7 @@ def refine_around(time, observed, box, decay_rate, coefficient, stages=3, readin
     previous step either side of the previous optimum.
     """
     results = [run_stage(time, observed, box, decay_rate, coefficient, reading, torque)]
-    for k in range(1, stages):
+    for _ in range(1, stages):
         best = results[-1].best
         box = {name: (best[name] - limits[2], best[name] + limits[2], limits[2] / 10) for name, limits in box.items()}
         results.append(run_stage(time, observed, box, decay_rate, coefficient, reading, torque))

@@ -138,6 +138,40 @@ def bessel_argument(time, decay_rate, coefficient):
     return z0 * np.exp(-0.5 * decay_rate * time), z0
 
 
+MAX_BESSEL_ARGUMENT = 5e6
+"""Largest z0 = 2 sqrt(B) / lambda at which the closed form (9) holds 1e-9 of the motion.
+
+A Bessel function of a large argument x carries the phase x, which a double holds
+to about eps x rad; against the numerical integration of (4), the closed form's
+error grows as about 1.6e-16 z0 of the motion's amplitude (7.9e-10 at 5e6, 2.2e-9
+at 1e7, measured on records of 200 to 2,000 s).
+"""
+
+
+def check_closed_form_reach(decay_rate, coefficient) -> None:
+    """Raise InvalidParameter where lambda is so small that z0 exceeds :data:`MAX_BESSEL_ARGUMENT`.
+
+    >>> check_closed_form_reach(1e-9, 0.0135849)
+    Traceback (most recent call last):
+    ...
+    schuler.exceptions.InvalidParameter: decay_rate: 1e-09 1/s: z0 = 2 sqrt(B) / lambda = 2.33e+08 is beyond
+    the reach of the closed form (9) (at most 5e+06: its Bessel functions lose their phase); here lambda
+    must be at least 4.66e-08 1/s
+    """
+    lam, b = np.broadcast_arrays(np.atleast_1d(np.asarray(decay_rate, dtype=float)),
+                                 np.atleast_1d(np.asarray(coefficient, dtype=float)))
+    _, z0 = bessel_argument(0.0, lam, b)
+    beyond = np.flatnonzero(z0 > MAX_BESSEL_ARGUMENT)
+    if beyond.size:
+        k = beyond[0]
+        raise InvalidParameter(
+            "decay_rate",
+            f"{lam.flat[k]:g} 1/s: z0 = 2 sqrt(B) / lambda = {z0.flat[k]:.3g} is beyond the reach of the "
+            f"closed form (9) (at most {MAX_BESSEL_ARGUMENT:g}: its Bessel functions lose their phase); here "
+            f"lambda must be at least {2.0 * math.sqrt(b.flat[k]) / MAX_BESSEL_ARGUMENT:.3g} 1/s",
+        )
+
+
 @dataclass(frozen=True)
 class Basis:
     """Fundamental solutions of eq. (4) and their derivatives w.r.t. lambda and B.

@@ -111,7 +111,8 @@ def read_record(path):
 
 
 def _read_rows(path: Path):
-    times, angles = [], []
+    times: list[float] = []
+    angles: list[float] = []
     with path.open(newline="", encoding="utf-8-sig") as handle:
         reader = csv.reader(handle)
         header = next(reader, None)
@@ -133,7 +134,7 @@ def _read_rows(path: Path):
                 try:
                     value = float(text)
                 except ValueError:
-                    raise InvalidParameter(f"{path} line {line}", f"{column} {text!r} is not a number")
+                    raise InvalidParameter(f"{path} line {line}", f"{column} {text!r} is not a number") from None
                 if not math.isfinite(value):
                     raise InvalidParameter(f"{path} line {line}", f"{column} is {text} (not a finite number)")
                 values.append(value)

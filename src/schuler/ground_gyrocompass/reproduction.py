@@ -19,7 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.core.geometry import time_grid
 from schuler.ground_gyrocompass import motion
+from schuler.ground_gyrocompass.estimate import NorthEstimate, identify
 from schuler.ground_gyrocompass.grid import (
     AXES,
     STEP_ALPHA0,
@@ -30,8 +32,6 @@ from schuler.ground_gyrocompass.grid import (
     run_stage,
     source_boxes,
 )
-from schuler.ground_gyrocompass.estimate import NorthEstimate, identify
-from schuler.core.geometry import time_grid
 from schuler.ground_gyrocompass.results import NorthIdentification, ReproductionFigures
 from schuler.params import Parameter, ParameterSet
 from schuler.references import FEDOROV_2020
@@ -405,7 +405,8 @@ def reproduce(unknowns: int = 4, method: str = "lsq") -> Reproduction:
          f"{100 * analysis['quadratic_fit_max_deviation']:.1f} %, i.e. it is the norm of some residual linear in the "
          f"initial conditions, but of shape {analysis['table_shape'][0]:.2f}, {analysis['table_shape'][1]:.0f} s^2 "
          "(cross / alpha0^2, alpha0_dot^2 / alpha0^2) where this experiment gives "
-         f"{relative[0]:.2f}, {relative[1]:.0f} s^2 (relative) or {absolute[0]:.2f}, {absolute[1]:.0f} s^2 (absolute)."),
+         f"{relative[0]:.2f}, {relative[1]:.0f} s^2 (relative) or {absolute[0]:.2f}, {absolute[1]:.0f} s^2 "
+         "(absolute)."),
         ("Garbled in the source: the second-stage F of Tables 2 and 3 (0,302*10^-4 is taken; 0.262*10^-4 and "
          "0.362*10^-4 also appear) and the third-stage H_m range of Table 3 ('(0,431;0,432 3)': 0.4310..0.4330 "
          "is taken, step 10^-4 as printed)."),

@@ -21,8 +21,8 @@ from typing import Any, ClassVar
 import numpy as np
 
 from schuler.ground_gyrocompass import plots
-from schuler.ground_gyrocompass.grid import STEP_ALPHA0, run_stage
 from schuler.ground_gyrocompass.estimate import NorthEstimate
+from schuler.ground_gyrocompass.grid import STEP_ALPHA0, run_stage
 from schuler.ground_gyrocompass.monte_carlo import predicted_errors
 from schuler.io import write_dataframe_csv
 from schuler.reproduction import Reproduction

@@ -24,6 +24,7 @@ Analysis 10(2), 1973, pp. 413-432.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.linalg.lapack import dgeqrf, dorgqr, dtrtrs
@@ -269,7 +270,8 @@ def fit_least_squares(time, observed, unknowns, decay_rate, coefficient, reading
     return _nonlinear_fit(time, observed, unknowns, decay_rate, coefficient, reading, start)
 
 
-def fit_records(time, records, unknowns, decay_rate, coefficient, reading="relative") -> list:
+def fit_records(time, records, unknowns, decay_rate, coefficient,
+                reading="relative") -> Sequence[Fit | IdentificationError]:
     """:func:`fit_least_squares` from its default start for many records sampled at the same times.
 
     The same estimator, record by record, as ``schuler north identify`` runs it,
@@ -315,7 +317,7 @@ def fit_records(time, records, unknowns, decay_rate, coefficient, reading="relat
             return _linear_fits(time, records, unknowns, decay_rate, coefficient, reading)
         except IdentificationError as error:  # the shared design: every record fails alike
             return [error] * records.shape[0]
-    outcomes = []
+    outcomes: list[Fit | IdentificationError] = []
     for observed in records:
         try:
             outcomes.append(_nonlinear_fit(time, observed, unknowns, decay_rate, coefficient, reading, None))
@@ -355,7 +357,7 @@ def _nonlinear_fit(time, observed, unknowns, decay_rate, coefficient, reading, s
         starts = [estimate, (decay_rate, coefficient)]
         if estimate is not None and _close(estimate, (decay_rate, coefficient), 0.05):
             starts = [estimate]  # both starts in one basin: a second descent adds nothing
-    best = None
+    descents = []  # (cost, x, MINPACK status) from each start
     for guess in starts:
         if guess is None:
             continue
@@ -371,14 +373,12 @@ def _nonlinear_fit(time, observed, unknowns, decay_rate, coefficient, reading, s
             problem.residual, x0, Dfun=problem.jacobian, full_output=True, xtol=1e-15, ftol=1e-15,
             gtol=1e-15, maxfev=200,
         )
-        cost = float(info["fvec"] @ info["fvec"])
-        if best is None or cost < best[0]:
-            best = (cost, solution, status)
-    _, x, status = best
+        descents.append((float(info["fvec"] @ info["fvec"]), solution, status))
+    _, x, status = min(descents, key=lambda descent: descent[0])  # the first of equal costs, as before
     converged, message = status in TERMINATION, TERMINATION.get(status, MAXIMUM_EVALUATIONS)
-    residual, _, coefficients, names, values, columns = problem.evaluate(np.asarray(x, dtype=float))
+    residual, _, coefficients, names, values, (phi, d_lam, d_b) = problem.evaluate(np.asarray(x, dtype=float))
     values = {"specific_torque": 0.0, "offset": 0.0, **{name: float(value) for name, value in values.items()}}
     values.update({name: float(value) for name, value in zip(names, coefficients)})
     order = parameter_order(unknowns, reading)
-    cov = covariance(jacobian_from_design(*columns, coefficients, unknowns), residual, unknowns)
+    cov = covariance(jacobian_from_design(phi, d_lam, d_b, coefficients, unknowns), residual, unknowns)
     return Fit(values, order, cov, float(residual @ residual), residual, problem.evaluations, converged, message)

@@ -56,6 +56,7 @@ A tilt of 1e-6 rad: the gimbals stick while the x integrator runs up to the edge
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -158,12 +159,12 @@ class AccelerationInput:
 
     @classmethod
     def constant(cls, W_x: float = 0.0, W_y: float = 0.0) -> AccelerationInput:
-        return cls([0.0], [W_x], [W_y])
+        return cls(np.zeros(1), np.array([W_x], dtype=float), np.array([W_y], dtype=float))
 
     @classmethod
     def ramp(cls, W_x_final: float, W_y_final: float, duration: float) -> AccelerationInput:
         """From zero to the final values over ``duration`` (s), then held."""
-        return cls([0.0, duration], [0.0, W_x_final], [0.0, W_y_final])
+        return cls(np.array([0.0, duration]), np.array([0.0, W_x_final]), np.array([0.0, W_y_final]))
 
     def piece(self, index: int):
         """Start (s), values (m/s^2) and slopes (m/s^3) of piece ``index``."""
@@ -256,24 +257,28 @@ def simulate_friction(q, time, initial_tilt=(0.0, 0.0), initial_velocity_error=(
     nfev = 0
     knots = acceleration.times[acceleration.times < t[-1]]
     edges = np.append(knots, t[-1])
+
+    # the cell's friction signs and the acceleration piece are bound with partial, not read
+    # from the loop's variables, so each integration sees the values it was started with
+    # (solve_ivp's args= would also pass them to the event functions)
+    def rhs(time_, x, *, stuck, sign_alpha, sign_beta, piece_start, w_0, slope):
+        tau = time_ - piece_start
+        alpha_rate = 0.0 if stuck else -x[3] / R + q_2 * sign_beta
+        beta_rate = 0.0 if stuck else x[2] / R - q_1 * sign_alpha
+        return np.array([alpha_rate, beta_rate, -g * x[1] + w_0[0] + slope[0] * tau,
+                         g * x[0] + w_0[1] + slope[1] * tau])
+
     for index in range(knots.size):
-        piece_start, (w_x0, w_y0), (slope_x, slope_y) = acceleration.piece(index)
+        piece_start, w_0, slope = acceleration.piece(index)
         start, stop = edges[index], edges[index + 1]
         while start < stop:
             if len(switch_times) > _MAX_EVENTS:
                 raise SimulationError("friction simulation: too many stick/slip switches")
-            stuck = cell == (0, 0)
             sign_alpha, sign_beta = _SIGNS.get(cell, (0, 0))
-
-            def rhs(time_, x, stuck=stuck, sa=sign_alpha, sb=sign_beta):
-                tau = time_ - piece_start
-                alpha_rate = 0.0 if stuck else -x[3] / R + q_2 * sb
-                beta_rate = 0.0 if stuck else x[2] / R - q_1 * sa
-                return np.array([alpha_rate, beta_rate, -g * x[1] + w_x0 + slope_x * tau,
-                                 g * x[0] + w_y0 + slope_y * tau])
-
             events = _exit_events(cell, q_1, q_2, R)
-            solution = solve_ivp(rhs, (start, stop), state, method="DOP853", dense_output=True,
+            cell_rhs = partial(rhs, stuck=cell == (0, 0), sign_alpha=sign_alpha, sign_beta=sign_beta,
+                               piece_start=piece_start, w_0=w_0, slope=slope)
+            solution = solve_ivp(cell_rhs, (start, stop), state, method="DOP853", dense_output=True,
                                  events=[e for e, _ in events], rtol=RTOL, atol=atol)
             if solution.status == -1:
                 raise SimulationError(f"friction simulation failed: {solution.message}")

@@ -453,7 +453,7 @@ def analyse(vertical: GyroVertical, time, method: str = "auto") -> Analysis:
     moving = np.sqrt(np.mean(ox**2 + oy**2)) > 1e-9
     if moving and resolved:
         # sign of each mode on the complex axis: the fast one turns with omega_2
-        signs = (1.0, -1.0) if omega_2 >= 0 else (-1.0, 1.0)
+        signs = (1, -1) if omega_2 >= 0 else (-1, 1)
         guesses = [s * w for s, w in zip(signs, eigen)]
         if spectrum is not None and t[-1] >= 6 * periods[-1]:
             guesses = [2 * np.pi * spectrum.peak(s) for s in signs]

@@ -25,9 +25,9 @@ from schuler.core.earth import DROZDOVICH, EarthModel
 from schuler.gyro_vertical.actions import friction
 from schuler.gyro_vertical.evaluation import PARAMETERS, run_case
 from schuler.gyro_vertical.friction import friction_from_velocity_error
-from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, transport_coriolis_acceleration
 from schuler.gyro_vertical.quasi_steady import steady_errors
 from schuler.gyro_vertical.results import write_files
+from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, transport_coriolis_acceleration
 from schuler.references import DROZDOVICH_1959
 from schuler.reproduction import Reproduction, Tolerance, compare
 from schuler.units import from_unit, to_unit

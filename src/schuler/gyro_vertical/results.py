@@ -121,7 +121,7 @@ class VerticalResult(RunResult):
         table.caption = (f"{_shown(self.end_time_s, 'h', 4)} h, final latitude "
                          f"{_shown(self.final_latitude_rad, 'deg', 6)} deg, Schuler period "
                          f"{_shown(self.schuler_period_s, 'min', 4)} min, beat period {beat}; {solver}")
-        parts: list[Any] = [table]
+        parts = [table]
         if self.monte_carlo is not None:
             parts.append(self.monte_carlo.render())
         return Group(*parts)

@@ -79,6 +79,10 @@ class SpeedProfile:
 
     times: np.ndarray
     speeds: np.ndarray
+    # derived in __post_init__: the slope of each piece (0 after the last knot), m/s^2, and the
+    # distance at each knot, m
+    _slopes: np.ndarray = field(init=False, repr=False, compare=False)
+    _distances: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         times = np.atleast_1d(np.asarray(self.times, dtype=float))
@@ -107,7 +111,7 @@ class SpeedProfile:
         speed : float
             Speed, m/s.
         """
-        return cls([0.0], [speed])
+        return cls(np.zeros(1), np.array([speed], dtype=float))
 
     def _piece(self, t):
         return np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, self.times.size - 1)
@@ -167,7 +171,11 @@ class SpeedProfile:
 
 @dataclass(frozen=True)
 class Kinematics:
-    """Trajectory quantities in the horizontal frame (arrays over time, SI).
+    """Trajectory quantities in the horizontal frame (SI): arrays over time, or floats at one time.
+
+    :meth:`GreatCircleTrajectory.kinematics` and :func:`start_kinematics` fill it with
+    arrays; :meth:`GreatCircleTrajectory.piece_kinematics` with plain floats, for an ODE
+    right-hand side.
 
     Attributes
     ----------
@@ -179,14 +187,14 @@ class Kinematics:
     a_x, a_y : relative acceleration v_x', v_y', m/s^2.
     """
 
-    latitude: np.ndarray
-    omega_1x: np.ndarray
-    omega_1y: np.ndarray
-    omega_2: np.ndarray
-    v_x: np.ndarray
-    v_y: np.ndarray
-    a_x: np.ndarray
-    a_y: np.ndarray
+    latitude: np.ndarray | float
+    omega_1x: np.ndarray | float
+    omega_1y: np.ndarray | float
+    omega_2: np.ndarray | float
+    v_x: np.ndarray | float
+    v_y: np.ndarray | float
+    a_x: np.ndarray | float
+    a_y: np.ndarray | float
 
 
 @dataclass(frozen=True)
@@ -344,7 +352,7 @@ class GreatCircleTrajectory:
         return on_equator and self.speed.is_constant
 
 
-def transport_coriolis_acceleration(kinematics: Kinematics, radius: float):
+def transport_coriolis_acceleration(kinematics: Kinematics, radius: float | np.ndarray):
     """Transport (centripetal) plus Coriolis horizontal acceleration W*, eq. (21), m/s^2.
 
     W*_x = R omega_1 omega_2 cos(psi + gamma) - 2 omega_2 v_y,
@@ -354,8 +362,8 @@ def transport_coriolis_acceleration(kinematics: Kinematics, radius: float):
     Parameters
     ----------
     kinematics : Kinematics
-    radius : float
-        R, m.
+    radius : float or ndarray
+        R, m (one per case, or one for all).
 
     Returns
     -------

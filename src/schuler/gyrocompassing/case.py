@@ -178,7 +178,8 @@ class AlignmentCase:
 
     def initial_state(self, name: str) -> np.ndarray:
         """Initial state of the model ``name``: (delta0, beta0, alpha0) in its coordinates, rad."""
-        return models.initial_state(name, self.initial_azimuth_error, self.initial_beta, self.initial_alpha, self.azimuth)
+        return models.initial_state(name, self.initial_azimuth_error, self.initial_beta, self.initial_alpha,
+                                    self.azimuth)
 
 
 def check_model(model: str) -> None:

@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 
 from schuler.contract import Cases, Output
-from schuler.core.earth import EARTH_RATE
+from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.gyrocompassing import analytic, models
 from schuler.gyrocompassing.case import (
     DEFAULT_DAMPING,
@@ -41,7 +41,8 @@ from schuler.gyrocompassing.simulation import run_case as simulate_case
 from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
 
-_ERROR_RANGE = {"minimum": -600.0, "maximum": 600.0}
+_ERROR_LIMIT = 600.0
+"""Largest latitude error and initial level error accepted, arcmin (either sign)."""
 
 PARAMETERS = ParameterSet((
     Parameter("latitude", "deg", 50.0, "Latitude of the site.", minimum=-90, maximum=90,
@@ -52,7 +53,8 @@ PARAMETERS = ParameterSet((
     Parameter("drift_x", "deg/h", 0.0, "Residual drift about the platform x axis (adds to east/north)."),
     Parameter("drift_y", "deg/h", 0.0, "Residual drift about the platform y axis (adds to east/north)."),
     Parameter("drift_z", "deg/h", 0.0, "Residual drift about the platform z axis (up)."),
-    Parameter("latitude_error", "arcmin", 0.0, "Error Delta phi of the latitude entered.", **_ERROR_RANGE),
+    Parameter("latitude_error", "arcmin", 0.0, "Error Delta phi of the latitude entered.",
+              minimum=-_ERROR_LIMIT, maximum=_ERROR_LIMIT),
     Parameter("accel_bias_x", "g", 0.0, "Bias Delta a_x of the x accelerometer (measured - true).",
               minimum=-0.1, maximum=0.1),
     Parameter("accel_bias_y", "g", 0.0, "Bias Delta a_y of the y accelerometer (measured - true).",
@@ -68,8 +70,10 @@ PARAMETERS = ParameterSet((
               minimum=1e-6, maximum=1e8),
     Parameter("initial_azimuth_error", "deg", math.degrees(DEFAULT_INITIAL_AZIMUTH_ERROR),
               "Initial azimuth misalignment delta0.", minimum=-90, maximum=90),
-    Parameter("initial_beta", "arcmin", 0.0, "Initial level error beta0 (0: levelled).", **_ERROR_RANGE),
-    Parameter("initial_alpha", "arcmin", 0.0, "Initial level error alpha0 (0: levelled).", **_ERROR_RANGE),
+    Parameter("initial_beta", "arcmin", 0.0, "Initial level error beta0 (0: levelled).",
+              minimum=-_ERROR_LIMIT, maximum=_ERROR_LIMIT),
+    Parameter("initial_alpha", "arcmin", 0.0, "Initial level error alpha0 (0: levelled).",
+              minimum=-_ERROR_LIMIT, maximum=_ERROR_LIMIT),
     Parameter("model", "", "full", "Model: full (mu, nu) (1.17), full-ab (beta, alpha) (1.18) or simplified (1.19).",
               choices=models.MODELS, kind="choice"),
     Parameter("duration", "s", None,
@@ -83,7 +87,8 @@ PARAMETERS = ParameterSet((
     Parameter("sigma_drift", "deg/h", 0.01, "Monte Carlo: 1-sigma of the x and y residual drifts.", minimum=0),
     Parameter("sigma_drift_z", "deg/h", 0.01, "Monte Carlo: 1-sigma of the z residual drift.", minimum=0),
     Parameter("sigma_accel", "g", 1e-4, "Monte Carlo: 1-sigma of each accelerometer bias.", minimum=0),
-), owner="align", renamed={"time_step": "output_step", "accel_error_x": "accel_bias_x", "accel_error_y": "accel_bias_y"})
+), owner="align",
+   renamed={"time_step": "output_step", "accel_error_x": "accel_bias_x", "accel_error_y": "accel_bias_y"})
 """Every option of ``schuler align run`` (and key of an ``align`` scenario)."""
 
 OUTPUTS = (
@@ -100,13 +105,13 @@ OUTPUTS = (
     Output("settling_time_simulated_s", "s", "", "last exit from the 1 % band (simulated; inf: not settled)"),
     Output("c_gamma", "1/s", "", "level correction gain used"),
     Output("c_a", "1/s", "", "azimuth correction gain used"),
-    Output("time_constant_s", "s", "", "time constant T of the gains used"),
-    Output("damping", "1", "", "damping ratio zeta of the gains used"),
+    Output("design_time_constant_s", "s", "", "time constant T of the gains used"),
+    Output("design_damping", "1", "", "damping ratio zeta of the gains used"),
     Output("max_abs_delta_rad", "rad", "", "largest |delta| over the run (simulated)"),
     Output("max_abs_beta_rad", "rad", "", "largest |beta| over the run (simulated)"),
     Output("max_abs_delta_rate_rad_s", "rad/s", "", "largest |delta'| over the run (simulated)"),
     Output("constraints_ok", "1", "", "1 when |delta| < 0.4 rad, |beta| < 0.01 rad, |delta'| < 0.2 rad/s throughout"),
-    Output("duration_s", "s", "", "simulated time"),
+    Output("simulated_duration_s", "s", "", "simulated time"),
 )
 
 FIDELITIES = ("simulated", "closed")
@@ -130,8 +135,10 @@ def alignment_case(cases: Cases) -> AlignmentCase:
                             ("accel_error_x", "sigma_accel"), ("accel_error_y", "sigma_accel")):
             arrays[name] = arrays[name] + cases.float(sigma) * draw(name, cases.members)
     max_latitude = cases.float("max_latitude")
+    # the system has no Earth parameters: the model's constants, named so that only
+    # the per-case arrays go through **arrays
     return AlignmentCase(**arrays, max_latitude=float(max_latitude.max()) if max_latitude.size else
-                               DEFAULT_MAX_LATITUDE)
+                         DEFAULT_MAX_LATITUDE, earth_rate=EARTH_RATE, gravity=STANDARD_GRAVITY)
 
 
 def evaluate(cases: Cases) -> dict[str, np.ndarray]:
@@ -191,8 +198,8 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
         "settling_time_s": result["settling_time_s"],
         "c_gamma": c_gamma,
         "c_a": c_a,
-        "time_constant_s": result["time_constant_s"],
-        "damping": result["damping"],
+        "design_time_constant_s": result["time_constant_s"],
+        "design_damping": result["damping"],
     }
     if simulate:
         out.update({
@@ -201,7 +208,7 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
             "max_abs_beta_rad": result["max_abs_beta_rad"],
             "max_abs_delta_rate_rad_s": result["max_abs_delta_rate_rad_per_s"],
             "constraints_ok": np.asarray(result["constraints_ok"], dtype=float),
-            "duration_s": np.full(len(cases), duration),
+            "simulated_duration_s": np.full(len(cases), duration),
         })
     return out
 
@@ -235,20 +242,22 @@ def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
         with warnings.catch_warnings():
             # evaluate has warned about the latitude already; the histories are the same case
             warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")
-            histories = simulate_case(single, model, duration=outputs["duration_s"], time_step=case["output_step"])
+            histories = simulate_case(single, model, duration=outputs["simulated_duration_s"],
+                                      time_step=case["output_step"])
             simplified = histories
             if model != "simplified":
                 # (1.19) beside the model for the comparison figures; the model's own run has warned already
                 warnings.simplefilter("ignore", DegradedAccuracyWarning)
-                simplified = simulate_case(single, "simplified", duration=outputs["duration_s"],
+                simplified = simulate_case(single, "simplified", duration=outputs["simulated_duration_s"],
                                             time_step=case["output_step"])
     violations = [] if histories is None else list(histories.violations)
     return AlignmentResult(
         model=model, fidelity=fidelity,
         regime=_regime(outputs["c_gamma"], outputs["c_a"], case["latitude"]),
         constraint_violations=violations, run=histories, simplified_run=simplified,
-        **{name: (None if math.isnan(value) else bool(value)) if name == "constraints_ok" else value
-           for name, value in outputs.items()},
+        constraints_ok=None if math.isnan(outputs["constraints_ok"]) else bool(outputs["constraints_ok"]),
+        monte_carlo=None,  # System.run adds it
+        **{name: value for name, value in outputs.items() if name != "constraints_ok"},
     )
 
 

@@ -60,7 +60,8 @@ def _broadcast(*values):
 
 def _assemble(rows, shape):
     """Stack nested lists of (broadcast) arrays into matrices of shape (*shape, r, c)."""
-    return np.stack([np.stack([np.broadcast_to(np.asarray(e, dtype=float), shape) for e in row], -1) for row in rows], -2)
+    return np.stack([np.stack([np.broadcast_to(np.asarray(e, dtype=float), shape) for e in row], -1)
+                     for row in rows], -2)
 
 
 def earth_rate_components(latitude, azimuth, earth_rate=EARTH_RATE):
@@ -138,7 +139,8 @@ def full_mu_nu_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_RATE, 
     return _mu_nu_model(latitude, azimuth, c_gamma, c_a, earth_rate, gravity, printed=False)
 
 
-def printed_mu_nu_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_RATE, gravity=STANDARD_GRAVITY) -> StateSpace:
+def printed_mu_nu_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_RATE,
+                        gravity=STANDARD_GRAVITY) -> StateSpace:
     """The (mu, nu, delta) model exactly as (1.17) is printed, for demonstration only.
 
     The printed third line, delta' = -c_a [(mu + eps_x) cos A + (nu + eps_y) sin A] ...,
@@ -183,7 +185,8 @@ def _mu_nu_model(latitude, azimuth, c_gamma, c_a, earth_rate, gravity, printed):
     )
     # outputs: delta, beta, alpha (1.11), mu, nu, and delta' = third rows of A and B
     C_matrix = _assemble(
-        [[zero, zero, 1.0], [sin_A, cos_A, zero], [cos_A, -sin_A, zero], [1.0, zero, zero], [zero, 1.0, zero], delta_row],
+        [[zero, zero, 1.0], [sin_A, cos_A, zero], [cos_A, -sin_A, zero], [1.0, zero, zero], [zero, 1.0, zero],
+         delta_row],
         shape,
     )
     D_matrix = np.zeros((*shape, 6, 6))
@@ -207,7 +210,8 @@ def _level_input_rows(A, cg, ca, U_sin, U_cos, gravity, zero):
     return beta_row, alpha_row, delta_row
 
 
-def full_alpha_beta_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_RATE, gravity=STANDARD_GRAVITY) -> StateSpace:
+def full_alpha_beta_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_RATE,
+                          gravity=STANDARD_GRAVITY) -> StateSpace:
     """Full model in the geographic level angles (beta, alpha) and azimuth delta: (1.18).
 
     States (beta, alpha, delta), rad; inputs :data:`INPUTS`; outputs delta,
@@ -315,6 +319,7 @@ def initial_state(model: str, delta0, beta0=0.0, alpha0=0.0, azimuth=0.0) -> np.
     array([0.  , 0.  , 0.01])
     """
     d, b, a, A = _broadcast(delta0, beta0, alpha0, azimuth)
+    columns: tuple[np.ndarray, ...]
     if model == "full":
         columns = (b * np.sin(A) + a * np.cos(A), b * np.cos(A) - a * np.sin(A), d)
     elif model == "full-ab":

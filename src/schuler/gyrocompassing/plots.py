@@ -25,7 +25,9 @@ def _figure(rows: int = 1, height: float = 3.2):
 
 
 def time_history(runs: dict, title: str = "Gyrocompassing: azimuth and level errors", settling_times: float = 4.0):
-    """delta and beta against time for one or more runs (label -> :class:`~schuler.gyrocompassing.simulation.CaseRun`), Fig. 1.4 style.
+    """delta and beta against time for one or more runs, Fig. 1.4 style.
+
+    ``runs`` maps a label to a :class:`~schuler.gyrocompassing.simulation.CaseRun`.
 
     The time axis spans ``settling_times`` analytic settling times (or the whole
     run if shorter), so that the transient is visible.
@@ -87,7 +89,8 @@ def sweep_curves(x, x_label: str, columns: dict, groups=None):
     for group in dict.fromkeys(groups.tolist()):
         chosen = groups == group
         suffix = f" {group}" if group else ""
-        line, = ax_error.plot(x[chosen], columns["azimuth_error_analytic_arcmin"][chosen], label=f"analytic (1.21){suffix}")
+        line, = ax_error.plot(x[chosen], columns["azimuth_error_analytic_arcmin"][chosen],
+                              label=f"analytic (1.21){suffix}")
         if "azimuth_error_arcmin" in columns:
             ax_error.plot(x[chosen], columns["azimuth_error_arcmin"][chosen], "o", color=line.get_color(),
                           mfc="none", label=f"simulated{suffix}")

@@ -37,18 +37,18 @@ class AlignmentResult(RunResult):
     regime: str
     c_gamma: float
     c_a: float
-    time_constant_s: float
-    damping: float
+    design_time_constant_s: float
+    design_damping: float
     max_abs_delta_rad: float
     max_abs_beta_rad: float
     max_abs_delta_rate_rad_s: float
     constraints_ok: bool | None
     constraint_violations: list
-    duration_s: float
+    simulated_duration_s: float
     run: CaseRun | None = field(default=None, repr=False)
     simplified_run: CaseRun | None = field(default=None, repr=False)
 
-    units: ClassVar[dict[str, str]] = {"c_gamma": "1/s", "c_a": "1/s", "damping": "1"}
+    units: ClassVar[dict[str, str]] = {"c_gamma": "1/s", "c_a": "1/s", "design_damping": "1"}
 
     def render(self):
         from rich.console import Group
@@ -77,7 +77,7 @@ class AlignmentResult(RunResult):
             ("settling time, analytic", f"{seconds(self.settling_time_s)} ({self.regime})"),
             ("settling time, simulated 1 % band", seconds(self.settling_time_simulated_s)),
             ("c_Gamma, c_a", f"{self.c_gamma:.4g} 1/s, {self.c_a:.4g} 1/s"),
-            ("T, zeta", f"{self.time_constant_s:.4g} s, {self.damping:.3g}"),
+            ("T, zeta", f"{self.design_time_constant_s:.4g} s, {self.design_damping:.3g}"),
             ("constraints (0.4 rad, 0.01 rad, 0.2 rad/s)", constraint),
         ]
         if self.monte_carlo is not None:
@@ -129,8 +129,9 @@ def write_files(result: Result, out_dir: Path) -> list[Path]:
         figures["align_time_history"] = plots.time_history(runs)
         figures["align_phase_trajectory"] = plots.phase_trajectory(runs)
         columns = {"t_s": run.time, "delta_rad": run.delta, "beta_rad": run.beta, "delta_rate_rad_s": run.delta_rate}
-        if run.alpha is not None:
-            columns.update({"alpha_rad": run.alpha, "mu_rad": run.mu, "nu_rad": run.nu})
+        # the level angles of the full models (None on the simplified one)
+        level = {"alpha_rad": run.alpha, "mu_rad": run.mu, "nu_rad": run.nu}
+        columns.update({name: values for name, values in level.items() if values is not None})
         files.append(write_dataframe_csv(pd.DataFrame(columns), out_dir / "align_time_history.csv"))
     if result.monte_carlo is not None:
         samples = to_unit(result.monte_carlo.samples["azimuth_error_rad"], "arcmin")

@@ -56,7 +56,8 @@ class SimulatedCases:
 
     @property
     def constraints_ok(self) -> np.ndarray:
-        return (self.max_abs_delta < MAX_DELTA) & (self.max_abs_beta < MAX_BETA) & (self.max_abs_delta_rate < MAX_DELTA_RATE)
+        return ((self.max_abs_delta < MAX_DELTA) & (self.max_abs_beta < MAX_BETA)
+                & (self.max_abs_delta_rate < MAX_DELTA_RATE))
 
 
 def _steady_delta(system: StateSpace, inputs: np.ndarray) -> np.ndarray:
@@ -104,8 +105,8 @@ def simulate_cases(system: StateSpace, time: np.ndarray, initial_state: np.ndarr
     x0 = np.broadcast_to(initial_state, (members, system.n_states))
     u = np.broadcast_to(inputs, (members, system.n_inputs))
     steady = np.broadcast_to(_steady_delta(system, u), (members,))
-    fields = {name: np.empty(members) for name in
-              ("azimuth_error", "level_error_beta", "settling_time", "max_abs_delta", "max_abs_beta", "max_abs_delta_rate")}
+    fields = {name: np.empty(members) for name in ("azimuth_error", "level_error_beta", "settling_time",
+                                                   "max_abs_delta", "max_abs_beta", "max_abs_delta_rate")}
 
     def reduce(chunk: Response, part: slice) -> None:
         delta, beta = chunk["delta"], chunk["beta"]

@@ -222,5 +222,6 @@ def period(*, thrust_factor: float, speed: float, path_radius: float | None, ear
         thrust_factor=thrust_factor,
         thrust_period_s=float(effective_schuler_period(R, thrust_gravity(thrust_factor, g))),
         speed_m_s=speed, path_radius_m=r, orbital_speed_m_s=circular,
-        flight_effective_gravity_m_s2=g_flight, flight_period_s=float(np.asarray(effective_schuler_period(R, g_flight))),
+        flight_effective_gravity_m_s2=g_flight,
+        flight_period_s=float(np.asarray(effective_schuler_period(R, g_flight))),
     )

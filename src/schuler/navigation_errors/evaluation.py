@@ -223,6 +223,7 @@ def run_case(case: Case, fidelity: str | None = None) -> ErrorRunResult:
         schuler_period_s=outputs["schuler_period_s"], final_flat_m=outputs["final_flat_m"],
         final_spherical_m=outputs["final_spherical_m"], max_flat_m=outputs["max_flat_m"],
         max_spherical_m=outputs["max_spherical_m"], simulation_minus_closed_m=outputs["simulation_minus_closed_m"],
-        t_s=t, flat_m=flat_error(source, magnitude, t, g, V), spherical_m=spherical_error(source, magnitude, t, R, g, V),
+        t_s=t, flat_m=flat_error(source, magnitude, t, g, V),
+        spherical_m=spherical_error(source, magnitude, t, R, g, V),
         simulated_m=simulated,
     )

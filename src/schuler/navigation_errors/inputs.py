@@ -212,7 +212,8 @@ def earth_constants(earth: str = "default", radius: float | None = None, gravity
 
 def earth_constant_arrays(earth: np.ndarray, radius: np.ndarray, gravity: np.ndarray):
     """:func:`earth_constants` for arrays of cases (NaN radius or gravity: not set), m and m/s^2."""
-    earth = np.where(earth == None, "default", earth)
+    # numpy's stubs leave out None, which object arrays compare elementwise
+    earth = np.where(np.equal(earth, None), "default", earth)  # type: ignore[call-overload]
     R, g = radius.astype(float).copy(), gravity.astype(float).copy()
     for name in set(earth.tolist()):
         chosen = earth == name
@@ -229,12 +230,14 @@ def check_vertical_growth(duration: float, radius: float, gravity: float) -> Non
     >>> check_vertical_growth(1e6, 6.371e6, 9.80665)
     Traceback (most recent call last):
     ...
-    schuler.exceptions.InvalidParameter: duration: 1e+06 s lets the vertical error grow as exp(1755); at most 113,988 s here
+    schuler.exceptions.InvalidParameter: duration: 1e+06 s lets the vertical error grow as exp(1755);
+    at most 113,988 s here
     """
     rate = math.sqrt(2.0 * gravity / radius)
     if rate * duration > MAX_GROWTH_EXPONENT:
-        raise InvalidParameter("duration", f"{duration:g} s lets the vertical error grow as exp({rate * duration:.0f}); "
-                                           f"at most {MAX_GROWTH_EXPONENT / rate:,.0f} s here")
+        raise InvalidParameter("duration",
+                               f"{duration:g} s lets the vertical error grow as exp({rate * duration:.0f}); "
+                               f"at most {MAX_GROWTH_EXPONENT / rate:,.0f} s here")
 
 
 def grid_points(duration, step, names: tuple[str, str] = ("duration", "output_step")) -> np.ndarray:

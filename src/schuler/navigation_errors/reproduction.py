@@ -120,7 +120,8 @@ def problem3_rows() -> list[ReproductionRow]:
     range_angle = SPEED * t / R
     hover_mi = -float(hover_altitude_error(BOLLAY.schuler_period, -HOVER_K * g, R, g)) / STATUTE_MILE
     sinh_mi = float(printed_hover_expression(BOLLAY.schuler_period, HOVER_K, R, g)) / STATUTE_MILE
-    hover_84_min_mi = -float(hover_altitude_error(84 * 60.0, -HOVER_K * BOLLAY.gravity, R, BOLLAY.gravity)) / STATUTE_MILE
+    hover_84_min_mi = (-float(hover_altitude_error(84 * 60.0, -HOVER_K * BOLLAY.gravity, R, BOLLAY.gravity))
+                       / STATUTE_MILE)
     mile = STATUTE_MILE
     return [
         compare("level misalignment 0.01 deg, flat Earth at 10,120 s", _feet(flat["tilt"]), "ft",

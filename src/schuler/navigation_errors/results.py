@@ -278,7 +278,8 @@ class Problem3Figures(Result):
         for column in ("source", "flat Earth (ft)", "spherical Earth (ft)"):
             table.add_column(column, justify="left" if column == "source" else "right")
         for source, flat in self.max_flat_m.items():
-            table.add_row(SOURCE_TITLES[source], length_text(flat, "ft"), length_text(self.max_spherical_m[source], "ft"))
+            table.add_row(SOURCE_TITLES[source], length_text(flat, "ft"),
+                          length_text(self.max_spherical_m[source], "ft"))
         note = (f"closed forms and simulation agree within {self.largest_simulation_minus_closed_m:.2g} m; "
                 "add --out DIR to write the figures (PNG, SVG) and their data (CSV)")
         return Group(table, Text(note))

@@ -205,6 +205,8 @@ def baro_aided_model(gains: BaroLoopGains, radius: float, gravity: float) -> Sta
     """
     omega_squared = _positive(gravity, "gravity") / _positive(radius, "radius")
     k1, k2, k3 = gains.k1, gains.k2, gains.k3
+    states: tuple[str, ...]
+    units: tuple[str, ...]
     if gains.order == 2:
         A = [[-k1, 1.0], [2.0 * omega_squared - k2, 0.0]]
         B = [[0.0, k1], [1.0, k2]]

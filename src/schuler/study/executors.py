@@ -12,6 +12,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
 from schuler.exceptions import ScenarioError
 
+
 class InProcess:
     """Evaluate chunks one after another in this process (vectorised within each)."""
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -209,7 +209,7 @@ def _is_number(text: str) -> bool:
     return True
 
 
-def parse_axis(text: str, parameters: Sequence[Parameter]) -> Axis:
+def parse_axis(text: str, parameters: Iterable[Parameter]) -> Axis:
     """Read ``NAME=START:STOP:STEP`` or ``NAME=V1,V2,...`` (values as on the command line).
 
     A unit written only after the step applies to all three numbers:
@@ -248,6 +248,9 @@ def _range_values(spec: Parameter, text: str, label: str) -> np.ndarray:
     match = _NUMBER_AND_UNIT.match(parts[2])
     if _is_number(parts[0]) and _is_number(parts[1]) and match and not _is_number(parts[2]):
         parts = [f"{parts[0]} {match[2]}", f"{parts[1]} {match[2]}", parts[2]]
+    start: float
+    stop: float
+    step: float
     if spec.kind == "integer":
         try:
             start, stop, step = (int(part) for part in parts)
@@ -259,6 +262,7 @@ def _range_values(spec: Parameter, text: str, label: str) -> np.ndarray:
         values = grid_values(start, stop, step)
     except ValueError as error:
         raise InvalidParameter(label, f"{text!r}: {error}") from None
+    ends: tuple[float, float]
     if spec.kind == "integer":
         values = np.rint(values).astype(np.int64)
         ends = (int(values[0]), int(values[-1]))

@@ -7,27 +7,46 @@ from pathlib import Path
 import numpy as np
 
 from schuler.io import save_figure_formats
+from schuler.results import display_label
 from schuler.units import to_unit
 
 MAX_RESULTS_PLOTTED = 8
 """Results plotted at most (all of them are in results.csv and summary.json)."""
 
 
-def plot_sweep_summary(plan, statistics: dict, per_axis: dict, histograms: dict, out_dir) -> list[Path]:
-    """One PNG per result: its mean and range against each swept parameter, and its histogram.
+def plot_sweep_summary(plan, statistics: dict, per_axis: dict, histograms: dict, out_dir,
+                       display_units: dict | None = None) -> list[Path]:
+    """One figure per result that varies: its mean and range against each swept parameter, and its histogram.
 
-    Returns the files written (``summary_<result>.png``).
+    Values are shown in the result's display unit (``display_units``: name ->
+    unit, e.g. arcmin for an angle in rad). Returns the files written
+    (``summary_<result>.png``).
     """
     import matplotlib.pyplot as plt
 
+    display_units = display_units or {}
     files: list[Path] = []
-    for name in list(statistics)[:MAX_RESULTS_PLOTTED]:
+    varying = [name for name, stats in statistics.items() if stats["count"] and stats["max"] > stats["min"]]
+    for name in varying[:MAX_RESULTS_PLOTTED]:
+        unit = display_units.get(name, "")
+        label = display_label(name, unit)
+        scale = 1.0 / float(to_unit(1.0, unit)) if unit else 1.0
+
+        def shown(values, scale=scale):
+            return np.asarray(values, dtype=float) / scale
+
         panels = len(plan.axes) + 1
-        fig, axes = plt.subplots(1, panels, figsize=(4.5 * panels, 3.6), squeeze=False)
+        fig, axes = plt.subplots(1, panels, figsize=(min(4.5 * panels, 13.5), 3.8), squeeze=False)
         for ax, axis in zip(axes[0], plan.axes):
-            _axis_panel(ax, plan, axis, per_axis[(axis.name, name)], name)
-        _histogram_panel(axes[0][-1], statistics[name], histograms.get(name), name)
-        fig.suptitle(f"{plan.system} sweep: {name} ({plan.total} cases)")
+            summary = {key: shown(value) for key, value in per_axis[(axis.name, name)].items() if key != "count"}
+            _axis_panel(ax, plan, axis, summary, label)
+        stats = {key: (None if value is None else float(shown(value)) if key not in ("count", "nan_count")
+                       else value) for key, value in statistics[name].items()}
+        histogram = histograms.get(name)
+        if histogram is not None:
+            histogram = (histogram[0], shown(histogram[1]))
+        _histogram_panel(axes[0][-1], stats, histogram, label)
+        fig.suptitle(f"{plan.system} sweep: {label} ({plan.total} cases)")
         fig.tight_layout()
         files.extend(save_figure_formats(fig, Path(out_dir) / f"summary_{name}", ("png",), dpi=100))
     return files
@@ -39,7 +58,7 @@ def _axis_panel(ax, plan, axis, summary: dict, name: str) -> None:
     label = axis.name
     if spec.kind == "quantity":
         x = to_unit(np.asarray(x, dtype=float), spec.unit)
-        label = f"{axis.name} [{spec.unit}]" if spec.unit else axis.name
+        label = f"{axis.name} ({spec.unit})" if spec.unit else axis.name
     positions = np.arange(len(x)) if x.dtype.kind in "USO" else x
     ax.plot(positions, summary["mean"], marker="o", markersize=3, label="mean")
     if plan.total > len(x):

@@ -20,9 +20,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from schuler import __version__
+from schuler.contract import ReportSection, System
 from schuler.exceptions import SchulerError
 from schuler.io import MIN_FONT_KEY, write_text
-from schuler.contract import ReportSection, System
 from schuler.registry import SYSTEM_MODULES
 from schuler.study.systems import load_system
 
@@ -182,7 +182,7 @@ def _figure(figure, figures_dir: Path | None) -> str:
 
 def _section(entry: SystemEntry, figures_dir: Path | None = None) -> str:
     name = html.escape(entry.name)
-    if entry.section is None:
+    if entry.section is None or entry.system is None:  # not installed: neither exists
         return (
             f'<section id="{_anchor(entry.name)}" class="missing"><h2>{name}</h2>'
             f"<p>Not yet available in this installation (module "
@@ -269,7 +269,7 @@ def _parameters_table(system: System) -> str:
     rows = []
     for spec in system.parameters:
         unit = spec.unit if spec.kind == "quantity" else spec.kind
-        allowed = spec.range_text() if spec.kind in ("quantity", "integer") else ", ".join(spec.choices or ())
+        allowed = spec.range_text() if spec.kind in ("quantity", "integer") else ", ".join(spec.choices)
         default = "not set" if spec.default is None else str(spec.default)
         rows.append(
             f"<tr><td><code>{html.escape(spec.option)}</code></td><td>{html.escape(unit)}</td>"

@@ -47,20 +47,29 @@ import difflib
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, Union
+from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr, ValidationError
-from pydantic import create_model
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictBool,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+    create_model,
+)
 from scipy.special import ndtri
 
-from schuler.exceptions import InvalidParameter, ScenarioError
 from schuler.contract import System
 from schuler.core.random import RandomStreams
+from schuler.exceptions import InvalidParameter, ScenarioError
 from schuler.params import Case, Parameter
 from schuler.registry import SYSTEM_MODULES, get_system
-from schuler.units import to_unit
 from schuler.study.systems import load_system
+from schuler.units import to_unit
 
 SIMULATION_KEYS = ("duration", "output_step")
 """Parameters that may also be set in the ``[simulation]`` table (where the system has them)."""
@@ -76,7 +85,7 @@ def simulation_keys(parameters) -> dict[str, str]:
     names = {spec.name for spec in parameters}
     return {key: key for key in SIMULATION_KEYS if key in names}
 
-Value = Union[StrictBool, StrictInt, StrictFloat, StrictStr]
+Value = StrictBool | StrictInt | StrictFloat | StrictStr
 """What a TOML scalar can be; the Parameter decides what it means."""
 
 _STRICT = ConfigDict(extra="forbid")
@@ -87,7 +96,25 @@ class OutputsTable(BaseModel):
 
     model_config = _STRICT
     directory: StrictStr | None = None
-    json_: StrictBool = Field(False, alias="json")
+    json_: StrictBool = Field(default=False, alias="json")
+
+
+class ScenarioTables(BaseModel):
+    """The top level of a scenario file, for any system.
+
+    :func:`scenario_model` derives one system's schema from it, narrowing ``system``
+    to its name and the parameter tables to its parameters; the tables are declared
+    here, in the file's order, so that code reading a validated scenario is typed.
+    """
+
+    model_config = _STRICT
+    system: StrictStr
+    title: StrictStr = ""
+    description: StrictStr = ""
+    parameters: BaseModel | None = None
+    simulation: BaseModel | None = None
+    outputs: OutputsTable | None = None
+    monte_carlo: BaseModel | None = None
 
 
 @dataclass(frozen=True)
@@ -238,14 +265,15 @@ def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
     return _build(parsed, system, source)
 
 
-def scenario_model(system: System) -> type[BaseModel]:
+def scenario_model(system: System) -> type[ScenarioTables]:
     """The pydantic schema of a scenario file of ``system`` (unknown keys forbidden).
 
     Every parameter is validated by its :meth:`Parameter.parse` (unit dimension
     and range), so a scenario accepts exactly what the command line accepts.
     """
     parameters = {spec.name: spec for spec in system.parameters}
-    fields = {name: (Value | None, None) for name in parameters}
+    # (type, default) pairs built at run time: pydantic reads them, a type checker cannot
+    fields: dict[str, Any] = {name: (Value | None, None) for name in parameters}
     parameters_table = create_model(
         f"{system.name}_parameters", __config__=_STRICT, __validators__=_validators(parameters, fields), **fields
     )
@@ -253,12 +281,12 @@ def scenario_model(system: System) -> type[BaseModel]:
     sim_fields: dict[str, Any] = {key: (Value | None, None) for key in stands_for}
     validators = _validators({key: parameters[name] for key, name in stands_for.items()}, dict(sim_fields))
     if system.fidelities:
-        sim_fields["fidelity"] = (Literal[system.fidelities] | None, None)  # type: ignore[valid-type]
+        sim_fields["fidelity"] = (Literal[system.fidelities] | None, None)
     simulation_table = create_model(
         f"{system.name}_simulation", __config__=_STRICT, __validators__=validators, **sim_fields)
-    random_fields = {name: (Value | None, None) for name in parameters}
+    random_fields: dict[str, Any] = {name: (Value | None, None) for name in parameters}
     normal_table = create_model(f"{system.name}_normal", __config__=_STRICT, **random_fields)
-    uniform_fields = {name: (tuple[Value, Value] | None, None) for name in parameters}
+    uniform_fields: dict[str, Any] = {name: (tuple[Value, Value] | None, None) for name in parameters}
     uniform_table = create_model(f"{system.name}_uniform", __config__=_STRICT, **uniform_fields)
     monte_carlo_table = create_model(
         f"{system.name}_monte_carlo",
@@ -268,17 +296,13 @@ def scenario_model(system: System) -> type[BaseModel]:
         normal=(normal_table | None, None),
         uniform=(uniform_table | None, None),
     )
-    return create_model(
-        f"{system.name}_scenario",
-        __config__=_STRICT,
-        system=(Literal[system.name], ...),
-        title=(StrictStr, ""),
-        description=(StrictStr, ""),
-        parameters=(parameters_table | None, None),
-        simulation=(simulation_table | None, None),
-        outputs=(OutputsTable | None, None),
-        monte_carlo=(monte_carlo_table | None, None),
-    )
+    narrowed: dict[str, Any] = {
+        "system": (Literal[system.name], ...),
+        "parameters": (parameters_table | None, None),
+        "simulation": (simulation_table | None, None),
+        "monte_carlo": (monte_carlo_table | None, None),
+    }
+    return create_model(f"{system.name}_scenario", __base__=ScenarioTables, **narrowed)
 
 
 def _validators(parameters: dict[str, Parameter], fields: dict) -> dict:
@@ -348,7 +372,7 @@ def _names(items) -> str:
     return ", ".join(items) if items else "(none)"
 
 
-def _build(parsed: BaseModel, system: System, source: str) -> Scenario:
+def _build(parsed: ScenarioTables, system: System, source: str) -> Scenario:
     written: dict[str, Any] = {}
     if parsed.parameters is not None:
         written.update({k: v for k, v in parsed.parameters.model_dump().items() if v is not None})
@@ -397,7 +421,9 @@ def _monte_carlo(table, specs: dict[str, Parameter], source: str) -> MonteCarlo 
             where = f"[monte_carlo.{kind}] {name}"
             spec = specs[name]
             if spec.kind not in ("quantity", "integer"):
-                raise ScenarioError(f"{source}: {where}: only numeric parameters can be random ({name} is a {spec.kind})")
+                raise ScenarioError(
+                    f"{source}: {where}: only numeric parameters can be random ({name} is a {spec.kind})"
+                )
             if name in distributions:
                 raise ScenarioError(f"{source}: {where}: already random in [monte_carlo.normal]")
             try:

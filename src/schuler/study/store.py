@@ -23,6 +23,7 @@ from schuler.params import Parameter
 from schuler.study.plan import SweepPlan
 from schuler.units import to_unit
 
+
 def column_name(spec: Parameter) -> str:
     """Results column of a parameter: its name and display unit (``drift_east_deg_per_h``).
 

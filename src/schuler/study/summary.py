@@ -10,17 +10,19 @@ second streamed pass.
 from __future__ import annotations
 
 import contextlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
 
 from schuler.core.stats import StreamingStatistics
+from schuler.exceptions import ScenarioError
 from schuler.io import atomic_path
 from schuler.results import Result
 from schuler.study.plan import SweepPlan
 from schuler.study.store import _text_columns, chunk_path, column_name
+
 
 @dataclass
 class SweepSummary(Result):
@@ -41,28 +43,63 @@ class SweepSummary(Result):
     cases_per_second: float
     out_dir: str
     statistics: dict[str, dict[str, float]]
+    per_value: dict[str, dict]
     files: list[str]
+    seconds_total: float = 0.0
+    display_units: dict[str, str] = field(default_factory=dict, repr=False)
 
-    units: ClassVar[dict[str, str]] = {"seconds": "s", "cases_per_second": "1/s"}
+    units: ClassVar[dict[str, str]] = {"seconds": "s", "seconds_total": "s", "cases_per_second": "1/s",
+                                       "cases": "1", "chunks": "1", "chunks_computed": "1", "chunks_resumed": "1",
+                                       "count": "1", "nan_count": "1"}
 
     def render(self):
+        from rich.console import Group
         from rich.table import Table
 
+        from schuler.results import display_label
+        from schuler.units import to_unit
+
+        def shown(name, value):
+            unit = self.display_units.get(name, "")
+            if value is None or (isinstance(value, float) and not np.isfinite(value)):
+                return "-"
+            return f"{float(to_unit(value, unit)) if unit else value:.4g}"
+
+        varying = [name for name, stats in self.statistics.items() if stats["min"] != stats["max"]]
+        constant = [name for name in self.statistics if name not in varying]
         missing = {name: stats["nan_count"] for name, stats in self.statistics.items() if stats["nan_count"]}
-        table = Table(
-            title=f"{self.system} sweep: {self.cases} cases",
-            caption=f"{self.chunks} chunks ({self.chunks_computed} computed, {self.chunks_resumed} resumed) "
-            f"on {self.executor} in {self.seconds:.3g} s; results in {self.out_dir}"
-            + (f"; not finite: {missing}" if missing else ""),
-        )
-        table.add_column("result", no_wrap=True)
+        caption = (f"{self.chunks} chunks ({self.chunks_computed} computed, {self.chunks_resumed} resumed) on "
+                   f"{self.executor}: {self.seconds_total:.3g} s in all ({self.seconds:.3g} s evaluating); "
+                   f"results in {self.out_dir}" + (f"; not finite: {missing}" if missing else "")
+                   + (f"; the same in every case: {', '.join(constant)}" if constant else ""))
+        parts = []
+        for axis, by_output in self.per_value.items():
+            table = Table(title=f"{self.system} sweep: mean of each result per {axis}")
+            table.add_column(axis, justify="right")
+            names = [name for name in varying if name in by_output][:6]
+            for name in names:
+                table.add_column(display_label(name, self.display_units.get(name, "")), justify="right")
+            values = by_output["_values"]
+            for i, value in enumerate(values):
+                cells = []
+                for name in names:
+                    mean, std = by_output[name]["mean"][i], by_output[name]["std"][i]
+                    text = shown(name, mean)
+                    if std is not None and np.isfinite(std) and std > 0:
+                        text += f" ± {shown(name, std)}"
+                    cells.append(text)
+                table.add_row(str(value), *cells)
+            parts.append(table)
+        overall = Table(title=f"{self.system} sweep: {self.cases} cases, all together", caption=caption)
+        overall.add_column("result", no_wrap=True)
         for heading in ("mean", "std", "min", "max"):
-            table.add_column(heading, justify="right", no_wrap=True)
-        for name, stats in self.statistics.items():
-            table.add_row(
-                name, *(f"{stats[k]:.4g}" if stats[k] is not None else "-" for k in ("mean", "std", "min", "max"))
-            )
-        return table
+            overall.add_column(heading, justify="right", no_wrap=True)
+        for name in varying:
+            stats = self.statistics[name]
+            overall.add_row(display_label(name, self.display_units.get(name, "")),
+                            *(shown(name, stats[k]) for k in ("mean", "std", "min", "max")))
+        parts.append(overall)
+        return Group(*parts)
 
 
 _RESERVOIR = 100_000
@@ -81,6 +118,7 @@ class _Accumulator:
             (axis, name): {
                 "count": np.zeros(size[axis]),
                 "sum": np.zeros(size[axis]),
+                "sumsq": np.zeros(size[axis]),
                 "min": np.full(size[axis], np.inf),
                 "max": np.full(size[axis], -np.inf),
             }
@@ -103,14 +141,15 @@ class _Accumulator:
                 where = position[finite]
                 slot["count"] += np.bincount(where, minlength=slot["count"].size)
                 slot["sum"] += np.bincount(where, weights=kept, minlength=slot["sum"].size)
+                slot["sumsq"] += np.bincount(where, weights=kept**2, minlength=slot["sumsq"].size)
                 np.minimum.at(slot["min"], where, kept)
                 np.maximum.at(slot["max"], where, kept)
 
-    def statistics(self) -> dict[str, dict[str, float]]:
+    def statistics(self) -> dict[str, dict[str, float | None]]:
         summary = {}
         for name, stats in self.overall.items():
             empty = stats.count == 0
-            entry = {"count": int(stats.count), "nan_count": self.nan_count[name]}
+            entry: dict[str, float | None] = {"count": int(stats.count), "nan_count": self.nan_count[name]}
             for key, value in (("mean", stats.mean), ("std", stats.std), ("min", stats.min), ("max", stats.max)):
                 entry[key] = None if empty else float(value[0])
             for q in (5, 50, 95):
@@ -119,14 +158,19 @@ class _Accumulator:
         return summary
 
     def per_axis(self) -> dict[tuple[str, str], dict[str, np.ndarray]]:
-        """Mean, min and max of each result at each value of each axis (NaN where no case)."""
+        """Count, mean, std, min and max of each result at each value of each axis (NaN where no case)."""
         out = {}
         for key, slot in self.by_axis.items():
+            count = slot["count"]
             with np.errstate(invalid="ignore", divide="ignore"):
-                mean = np.where(slot["count"] > 0, slot["sum"] / np.maximum(slot["count"], 1), np.nan)
-            seen = slot["count"] > 0
+                mean = np.where(count > 0, slot["sum"] / np.maximum(count, 1), np.nan)
+                # the sample variance from sums: enough for a summary (the exact values are in results.parquet)
+                variance = (slot["sumsq"] - count * mean**2) / np.maximum(count - 1, 1)
+            seen = count > 0
             out[key] = {
+                "count": count.astype(np.int64),
                 "mean": mean,
+                "std": np.where(count > 1, np.sqrt(np.maximum(variance, 0.0)), np.nan),
                 "min": np.where(seen, slot["min"], np.nan),
                 "max": np.where(seen, slot["max"], np.nan),
             }
@@ -177,8 +221,12 @@ def gather(plan: SweepPlan, out_dir: Path, *, write_csv: bool = True) -> tuple[d
             if csv_tmp is not None:
                 if csv_writer is None:
                     options = pa_csv.WriteOptions(quoting_style="needed")
-                    csv_writer = stack.enter_context(pa_csv.CSVWriter(str(csv_tmp), writer.schema, write_options=options))
+                    csv_writer = stack.enter_context(
+                        pa_csv.CSVWriter(str(csv_tmp), writer.schema, write_options=options)
+                    )
                 csv_writer.write_table(table)
+        if accumulator is None:  # raised inside, so that no empty results file is left behind
+            raise ScenarioError(f"{out_dir}: the sweep has no cases to gather")
     return accumulator.statistics(), accumulator.per_axis(), targets
 
 

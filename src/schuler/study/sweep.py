@@ -46,8 +46,11 @@ import warnings
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
-from schuler.results import json_safe
+import numpy as np
+
 from schuler.io import remove_stale_parts, write_json
+from schuler.memory import format_bytes
+from schuler.results import json_safe
 from schuler.study.executors import InProcess, make_executor
 from schuler.study.plan import DEFAULT_CHUNK_SIZE, SweepPlan, plan_sweep
 from schuler.study.scenario import Scenario
@@ -110,7 +113,7 @@ def run_sweep(
     done = {i for i in range(plan.chunks) if chunk_path(out_dir, i).exists()}
     todo = [i for i in range(plan.chunks) if i not in done]
     tasks = (ChunkTask(plan, index, system.evaluate) for index in todo)
-    began = time.perf_counter()
+    started = began = time.perf_counter()
     caught: dict = {}
     executor = make_executor(scheduler, workers) if todo else InProcess()
     try:
@@ -125,10 +128,16 @@ def run_sweep(
         executor.close()
         _report_warnings(caught)
     seconds = time.perf_counter() - began
+    if write_csv:
+        _warn_about_csv_size(plan, system)
     statistics, per_axis, files = gather(plan, out_dir, write_csv=write_csv)
-    files.append(write_json(out_dir / "summary.json", json_safe({"manifest": plan.manifest(), "statistics": statistics})))
+    per_value = _per_value(plan, per_axis)
+    files.append(write_json(out_dir / "summary.json", json_safe(
+        {"manifest": plan.manifest(), "statistics": statistics, "per_value": per_value})))
+    display = {output.name: output.display for output in system.outputs if output.display}
     if plots:
-        files.extend(plot_sweep_summary(plan, statistics, per_axis, histograms(plan, out_dir, statistics), out_dir))
+        files.extend(plot_sweep_summary(plan, statistics, per_axis, histograms(plan, out_dir, statistics), out_dir,
+                                        display))
     computed_cases = sum(plan.chunk_range(i)[1] - plan.chunk_range(i)[0] for i in todo)
     return SweepSummary(
         system=plan.system,
@@ -141,8 +150,43 @@ def run_sweep(
         cases_per_second=computed_cases / seconds if seconds > 0 and computed_cases else 0.0,
         out_dir=str(out_dir),
         statistics=statistics,
+        per_value=per_value,
         files=[str(f) for f in files],
+        seconds_total=time.perf_counter() - started,
+        display_units=display,
     )
+
+
+CSV_WARNING_BYTES = 2**30
+"""A results.csv expected to be larger than this gets a warning (``--no-csv`` skips it)."""
+
+
+def _warn_about_csv_size(plan: SweepPlan, system) -> None:
+    # about 12 bytes per number in CSV: the case, every parameter and every output
+    estimate = plan.total * (1 + len(plan.parameters) + len(system.outputs)) * 12
+    if estimate > CSV_WARNING_BYTES:
+        warnings.warn(f"results.csv will be about {format_bytes(estimate)}; add --no-csv to write results.parquet "
+                      "only", UserWarning, stacklevel=3)
+
+
+def _per_value(plan: SweepPlan, per_axis: dict) -> dict[str, dict]:
+    """Per swept parameter: its values (display unit) and each result's count, mean, std, min, max per value."""
+    from schuler.units import to_unit
+
+    table: dict[str, dict] = {}
+    for axis in plan.axes:
+        spec = next(p for p in plan.parameters if p.name == axis.name)
+        values = axis.values
+        if spec.kind == "quantity" and spec.unit:
+            values = to_unit(np.asarray(values, dtype=float), spec.unit)
+        label = f"{axis.name} ({spec.unit})" if spec.kind == "quantity" and spec.unit else axis.name
+        entry: dict = {"_values": [float(f"{v:.10g}") if isinstance(v, (float, np.floating)) else
+                                   v.item() if isinstance(v, np.generic) else v for v in values]}
+        for (name, output), stats in per_axis.items():
+            if name == axis.name:
+                entry[output] = {key: np.asarray(value).tolist() for key, value in stats.items()}
+        table[label] = entry
+    return table
 
 
 _WARNINGS_SHOWN = 3

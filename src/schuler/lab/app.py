@@ -1,0 +1,229 @@
+"""The lab application: pages from the registry, routing, limits, and the job manager.
+
+:func:`create_app` builds one Dash application. Its pages: ``/`` (what there
+is), ``/NAME`` for every registered system (:mod:`schuler.lab.system_page`),
+``/NAME/reproduction``, and the KPI lab tasks at ``/align/task1`` ...
+(:mod:`schuler.lab.tasks`). Systems whose module fails to import are listed as
+"not available" with the reason, and the rest of the lab works.
+
+Every asset (Dash's renderer, React, plotly.js, the lab's CSS and scripts) is
+served by the application itself from the installed packages; the page's
+Content-Security-Policy lets the browser load nothing from anywhere else.
+Requests larger than :data:`MAX_REQUEST_BYTES` are refused (HTTP 413).
+Computations run as background jobs (Dash's ``DiskcacheManager``: one process
+per job, results in a job cache in a temporary folder removed at shutdown).
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+import time
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from dash import Dash, DiskcacheManager, Input, Output, dcc, html
+
+from schuler import __version__
+from schuler.contract import System
+from schuler.lab import manual, system_page
+from schuler.registry import SYSTEM_MODULES, get_system
+
+MAX_REQUEST_BYTES = 256 * 1024
+"""Largest request body the lab accepts, bytes (a page's callbacks send a few kB)."""
+
+ASSETS = Path(__file__).parent / "assets"
+
+TASK_PAGES = {f"task{n}" for n in manual.TASK_TITLES}
+"""The KPI task pages under ``/align/``."""
+
+CONTENT_SECURITY_POLICY = ("default-src 'self'; connect-src 'self'; img-src 'self' data: blob:; "
+                           "style-src 'self' 'unsafe-inline'; font-src 'self' data:; object-src 'none'; "
+                           "base-uri 'self'; form-action 'self'; frame-ancestors 'self'")
+"""Nothing outside the lab's own origin; ``script-src`` adds the hashes of Dash's inline scripts."""
+
+
+@dataclass(frozen=True)
+class Availability:
+    """A registered system and whether it can be used here (the import error's line otherwise)."""
+
+    name: str
+    system: System | None
+    reason: str = ""
+
+
+def systems_available() -> list[Availability]:
+    """Every registered system, imported once (jobs then start warm); failures become "not available"."""
+    found = []
+    for name in SYSTEM_MODULES:
+        try:
+            found.append(Availability(name, get_system(name)))
+        except Exception as error:  # any import failure of one system must not take the lab down
+            found.append(Availability(name, None, f"{type(error).__name__}: {error}".splitlines()[0]))
+    return found
+
+
+class Lab:
+    """The Dash application and what it owns: the job cache folder and the job manager.
+
+    Attributes
+    ----------
+    app : dash.Dash
+    server : flask.Flask
+        The WSGI application to serve.
+    cache_dir : Path
+        Where background jobs leave their results (removed by :meth:`close`).
+    """
+
+    def __init__(self, app: Dash, cache_dir: Path, manager: DiskcacheManager):
+        self.app = app
+        self.server = app.server
+        self.cache_dir = cache_dir
+        self._manager = manager
+
+    def close(self) -> None:
+        """End running jobs (the processes this server started) and remove the job cache."""
+        import psutil
+
+        for child in psutil.Process().children(recursive=True):
+            try:
+                child.terminate()
+            except psutil.NoSuchProcess:
+                pass
+        psutil.wait_procs(psutil.Process().children(recursive=True), timeout=3)
+        self._manager.handle.close()
+        for _ in range(3):  # a job ending just now may still be closing its files in the folder
+            shutil.rmtree(self.cache_dir, ignore_errors=True)
+            if not self.cache_dir.exists():
+                break
+            time.sleep(0.2)
+
+
+def create_app() -> Lab:
+    """Build the lab (pages for every registered system, the KPI tasks, limits and headers)."""
+    import diskcache
+
+    cache_dir = Path(tempfile.mkdtemp(prefix="schuler-lab-jobs-"))
+    manager = DiskcacheManager(diskcache.Cache(str(cache_dir)))
+    app = Dash(
+        __name__,
+        title="schuler lab",
+        update_title="",  # the tab keeps its title while a page updates
+        assets_folder=str(ASSETS),
+        serve_locally=True,
+        suppress_callback_exceptions=True,
+        background_callback_manager=manager,
+        enable_mcp=False,
+        compress=False,
+    )
+    available = systems_available()
+    app.layout = lambda: _shell(available)
+    system_page.register(app)
+    _routing(app, {a.name: a for a in available}, _task_pages(app))
+    _limits(app)
+    return Lab(app, cache_dir, manager)
+
+
+def _shell(available: list[Availability]) -> html.Div:
+    """The frame of every page; a new session token per page load keeps sessions' jobs apart."""
+    links: list[Any] = []
+    for item in available:
+        if item.system is None:
+            links.append(html.Span(item.name, className="unavailable", title=f"not available: {item.reason}"))
+        else:
+            links.append(dcc.Link(item.name, href=f"/{item.name}", title=item.system.title))
+    task_links = [dcc.Link(f"task {n}", href=f"/align/task{n}") for n in manual.TASK_TITLES]
+    return html.Div([
+        dcc.Location(id="url"),
+        dcc.Store(id="session", data=uuid.uuid4().hex),
+        html.Header([
+            dcc.Link("schuler lab", href="/", className="brand"),
+            html.Nav([html.Span("systems:", className="hint"), *links], className="systems"),
+            html.Nav([html.Span("KPI lab tasks:", className="hint"), *task_links], className="tasks"),
+        ]),
+        html.Div(id="page"),
+        html.Footer(f"schuler {__version__}: computations run on this machine; nothing leaves it."),
+    ])
+
+
+def _task_pages(app: Dash):
+    """The KPI task pages' layout function, or None when they cannot be offered.
+
+    They are built on the gyrocompassing system; imported here, so that a
+    gyrocompassing module that fails to import makes them (and its own page)
+    "not available" instead of stopping the lab.
+    """
+    try:
+        from schuler.lab import tasks
+    except Exception:  # the align page says why
+        return None
+    tasks.register(app)
+    return tasks.layout
+
+
+def _routing(app: Dash, by_name: dict[str, Availability], task_layout) -> None:
+    @app.callback(Output("page", "children"), Input("url", "pathname"))
+    def route(pathname):
+        parts = [p for p in (pathname or "/").split("/") if p]
+        if not parts:
+            return _index(list(by_name.values()))
+        item = by_name.get(parts[0])
+        if item is None:
+            return _not_found(pathname)
+        if item.system is None:
+            return html.Div([html.H1(item.name), html.P(f"not available: {item.reason}", className="page-error")])
+        if len(parts) == 1:
+            return system_page.layout(item.system)
+        if len(parts) == 2 and parts[1] == "reproduction":
+            return system_page.reproduction_layout(item.system)
+        if item.name == "align" and len(parts) == 2 and parts[1] in TASK_PAGES and task_layout is not None:
+            return task_layout(item.system, parts[1])
+        return _not_found(pathname)
+
+
+def _index(available: list[Availability]) -> html.Div:
+    rows = []
+    for item in available:
+        if item.system is None:
+            rows.append(html.Li([html.Strong(item.name), f": not available ({item.reason})"], className="unavailable"))
+        else:
+            rows.append(html.Li([dcc.Link(item.name, href=f"/{item.name}"), f": {item.system.title} (",
+                                 dcc.Link("reproduction", href=f"/{item.name}/reproduction"), ")"]))
+    return html.Div([
+        html.H1("schuler lab bench"),
+        html.P("Every system's parameters are controls; the numbers and figures follow as they change."),
+        html.H2("Systems"), html.Ul(rows),
+        html.H2("KPI lab tasks (gyrocompassing)"),
+        html.Ul([html.Li(dcc.Link(f"Task {n}: {title}", href=f"/align/task{n}"))
+                 for n, title in manual.TASK_TITLES.items()]),
+        html.P("Task 4 (the MIS-2 system) is left out: the manual does not give that system's parameters.",
+               className="hint"),
+    ])
+
+
+def _not_found(pathname: str) -> html.Div:
+    return html.Div([html.H1("Not found"), html.P(f"There is no page {pathname!r} in the lab."),
+                     dcc.Link("the list of pages", href="/")])
+
+
+def _limits(app: Dash) -> None:
+    """Refuse large requests before reading them; headers that keep the page to its own origin."""
+    from flask import abort, request
+
+    server = app.server
+    server.config["MAX_CONTENT_LENGTH"] = MAX_REQUEST_BYTES
+    policy = f"{CONTENT_SECURITY_POLICY}; script-src 'self' {' '.join(app.csp_hashes())}"
+
+    @server.before_request
+    def refuse_large():
+        if request.content_length is not None and request.content_length > MAX_REQUEST_BYTES:
+            abort(413)
+
+    @server.after_request
+    def headers(response):
+        response.headers["Content-Security-Policy"] = policy
+        response.headers["X-Content-Type-Options"] = "nosniff"
+        response.headers["Referrer-Policy"] = "no-referrer"
+        return response

@@ -1,0 +1,173 @@
+"""Controls generated from a :class:`~schuler.params.ParameterSet`, and what they send back.
+
+Every control is a ``<div data-param="NAME">`` holding a label with the display
+unit, a text ``<input>`` (a typed value, applied on Enter or when the field is
+left), the default and range, and a place for the one-line error. Values travel
+as the text the user typed and are converted only by
+:meth:`~schuler.params.ParameterSet.parse` (the command line's own parser), so
+the messages are the command line's too and nothing typed is ever evaluated.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+
+from dash import dcc, html
+
+from schuler.exceptions import InvalidParameter, SchulerError
+from schuler.lab.views import data_attributes
+from schuler.params import Case, Parameter, ParameterSet
+
+MAX_VALUE_CHARS = 200
+"""Longest text a control accepts (the input refuses more; the server checks again)."""
+
+PARAM = "param"
+"""Component-id type of a control's input: ``{"type": PARAM, "name": NAME}``."""
+ERROR = "param-error"
+"""Component-id type of a control's message line."""
+
+
+def initial_text(parameter: Parameter) -> str:
+    """The default as the input shows it: ``50``, ``0.0001``, ``full``; empty when not set.
+
+    >>> initial_text(Parameter("latitude", "deg", 50.0, "Latitude."))
+    '50'
+    >>> initial_text(Parameter("c_a", "1/s", None, "Gain."))
+    ''
+    """
+    default = parameter.default
+    if default is None:
+        return ""
+    if isinstance(default, bool):
+        return "true" if default else "false"
+    if isinstance(default, float):
+        return f"{default:.12g}"
+    return str(default)
+
+
+def describe(parameter: Parameter) -> str:
+    """The line under a control: default and allowed range or choices."""
+    parts = [f"default {parameter.default_text()}"]
+    if parameter.kind == "choice":
+        parts.append("one of " + ", ".join(parameter.choices or ()))
+    elif parameter.kind == "flag":
+        parts.append("true or false")
+    elif parameter.minimum is not None or parameter.maximum is not None:
+        parts.append(f"range {parameter.range_text()}")
+    return "; ".join(parts)
+
+
+def unit_label(parameter: Parameter) -> str:
+    return parameter.unit if parameter.kind == "quantity" and parameter.unit else ""
+
+
+def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM) -> html.Div:
+    """One control: ``div[data-param=NAME]`` with label, ``<input>``, default and range, error line."""
+    name = parameter.name
+    unit = unit_label(parameter)
+    options = None
+    if parameter.kind in ("choice", "flag"):
+        choices = (parameter.choices or ()) if parameter.kind == "choice" else ("true", "false")
+        options = html.Datalist(id=f"{id_type}-{name}-choices", children=[html.Option(value=c) for c in choices])
+    placeholder = "not set" if parameter.default is None else ""
+    field = dcc.Input(
+        id={"type": id_type, "name": name},
+        type="text",
+        value=initial_text(parameter) if value is None else value,
+        debounce=True,
+        maxLength=MAX_VALUE_CHARS,
+        placeholder=placeholder,
+        list=f"{id_type}-{name}-choices" if options is not None else None,
+        autoComplete="off",
+        spellCheck=False,
+        className="value",
+    )
+    label = html.Label([html.Span(name, className="name"), html.Span(unit, className="unit") if unit else None],
+                       title=parameter.help)
+    children = [label, field, options, html.Div(describe(parameter), className="hint", title=parameter.help),
+                html.Div(id={"type": ERROR if id_type == PARAM else f"{id_type}-error", "name": name},
+                         className="error", role="alert")]
+    return html.Div([c for c in children if c is not None], className="control", **data_attributes(param=name))
+
+
+def controls(parameters: Iterable[Parameter], id_type: str = PARAM, values: Mapping[str, str] | None = None
+             ) -> list[html.Div]:
+    """A control per parameter; ``values`` are texts to start with instead of the defaults."""
+    return [control(p, (values or {}).get(p.name), id_type=id_type) for p in parameters]
+
+
+def typed_values(parameters: ParameterSet, ids: list[dict], values: list) -> dict[str, str]:
+    """The values the user changed from the defaults shown, as typed (names of ``parameters`` only).
+
+    An emptied field goes back to its default ("not set" where there is none).
+    """
+    typed: dict[str, str] = {}
+    for ident, value in zip(ids, values):
+        name = ident.get("name") if isinstance(ident, Mapping) else None
+        if not isinstance(name, str) or name not in parameters:
+            continue
+        text = "" if value is None else str(value)
+        if text.strip() and text.strip() != initial_text(parameters[name]):
+            typed[name] = text
+    return typed
+
+
+def parse_typed(parameters: ParameterSet, typed: Mapping[str, str]) -> tuple[Case | None, dict[str, str]]:
+    """Parse typed values as the command line does: a case, or the one-line message per control.
+
+    Each value is parsed on its own first, so that every wrong field gets its
+    message; then the set as a whole (options that exclude each other).
+    Messages name the option as the command line does (``--latitude: '95' is
+    outside (-90, 90) deg``).
+
+    Examples
+    --------
+    >>> ps = ParameterSet([Parameter("latitude", "deg", 50.0, "Latitude.", minimum=-90, maximum=90)])
+    >>> parse_typed(ps, {"latitude": "95"})[1]
+    {'latitude': "--latitude: '95' is outside [-90, 90] deg"}
+    >>> round(parse_typed(ps, {"latitude": "45"})[0]["latitude"], 6)
+    0.785398
+    """
+    errors: dict[str, str] = {}
+    for name, text in typed.items():
+        parameter = parameters[name]
+        if len(text) > MAX_VALUE_CHARS:
+            errors[name] = f"{parameter.option}: longer than {MAX_VALUE_CHARS} characters"
+            continue
+        try:
+            parameter.parse(text, parameter.option)
+        except SchulerError as error:
+            errors[name] = str(error)
+        except Exception:  # the units library fails on some texts ("()") with errors of its own
+            unit = (parameter.unit if parameter.kind == "quantity" else "") or "plain numbers"
+            errors[name] = f"{parameter.option}: cannot read {text.strip()!r} as a quantity in {unit}"
+    if errors:
+        return None, errors
+    try:
+        return parameters.parse(dict(typed), labels="option"), {}
+    except InvalidParameter as error:
+        return None, {_owner(parameters, error.name) or parameters.names[0]: str(error)}
+
+
+def _owner(parameters: ParameterSet, label: str) -> str | None:
+    """The parameter a message names, by name or by option (None when it names none)."""
+    for parameter in parameters:
+        if label in (parameter.option, parameter.name):
+            return parameter.name
+    return None
+
+
+def error_owner(parameters: ParameterSet, error: SchulerError) -> tuple[str | None, str]:
+    """Where a run's error belongs and its message in the command line's words.
+
+    An error naming a parameter (``latitude: ...``) goes beside that control and
+    names its option (``--latitude: ...``); any other goes to the page (None).
+    """
+    name = getattr(error, "name", None)
+    reason = getattr(error, "reason", None)
+    if name is None:
+        name, _, reason = str(error).partition(": ")
+    owner = _owner(parameters, name)
+    if owner is not None and reason:
+        return owner, f"{parameters[owner].option}: {reason}"
+    return None, str(error)

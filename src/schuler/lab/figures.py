@@ -1,0 +1,249 @@
+"""The lab's figures: interactive ones for gyrocompassing, the system's own files for any system.
+
+A system's page shows interactive (plotly) figures where the lab knows its
+result's histories (:data:`INTERACTIVE`: the gyrocompassing system, whose page
+must follow a change within a second), and otherwise the PNG figures of the
+system's own ``write_files`` (slower: matplotlib renders them, so they come in
+a second step with its own progress indicator).
+
+Angles are shown as the source's figures show them: delta in arcmin, level
+errors in arcsec, time in minutes.
+"""
+
+from __future__ import annotations
+
+import base64
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from dash import dcc, html
+
+from schuler.contract import System
+from schuler.lab.views import data_attributes
+from schuler.units import to_unit
+
+MAX_POINTS = 400
+"""Points per trace sent to the browser (histories are thinned evenly, first and last point kept)."""
+
+SETTLING_TIMES_SHOWN = 4.0
+"""The time axis of a history spans this many analytic settling times (or the whole run if shorter)."""
+
+GRAPH_CONFIG: Any = {"displaylogo": False, "responsive": True,
+                "modeBarButtonsToRemove": ["select2d", "lasso2d", "autoScale2d"],
+                "toImageButtonOptions": {"format": "png", "scale": 2}}
+"""dcc.Graph config: the camera button saves a PNG (rendered in the browser, no server involved)."""
+
+DASHES = ("solid", "dash", "dot")
+"""Line styles of the runs drawn together (the model, then (1.19)), so that coinciding curves stay visible."""
+
+# Figures are plain plotly dicts: building them through plotly's validating classes took longer
+# (0.2-0.6 s a figure) than the simulation they show.
+
+
+def thin(*arrays: np.ndarray, limit: int = MAX_POINTS) -> list[np.ndarray]:
+    """Every k-th point of equally long arrays so that at most ``limit`` remain (the last kept).
+
+    >>> [a.tolist() for a in thin(np.arange(10), limit=4)]
+    [[0, 3, 6, 9]]
+    """
+    n = len(arrays[0])
+    if n <= limit:
+        return list(arrays)
+    step = int(np.ceil((n - 1) / (limit - 1)))
+    index = np.arange(0, n, step)
+    if index[-1] != n - 1:
+        index = np.append(index, n - 1)
+    return [np.asarray(a)[index] for a in arrays]
+
+
+def _line(x, y, name: str, row: int = 1, mode: str = "lines", **style) -> dict:
+    suffix = "" if row == 1 else str(row)
+    return {"type": "scatter", "x": np.asarray(x, dtype=float).tolist(), "y": np.asarray(y, dtype=float).tolist(),
+            "name": name, "mode": mode, "xaxis": f"x{suffix}", "yaxis": f"y{suffix}", **style}
+
+
+def _figure(traces: list[dict], title: str, y_titles: list[str], x_title: str, height: int, shapes=(),
+            annotations=()) -> dict:
+    """A figure of ``len(y_titles)`` rows stacked over one shared x axis."""
+    rows = len(y_titles)
+    gap = 0.07
+    size = (1 - gap * (rows - 1)) / rows
+    layout = {"title": {"text": title}, "height": height, "template": "plotly_white",
+              "margin": {"l": 75, "r": 20, "t": 110, "b": 50}, "font": {"size": 13},
+              "legend": {"orientation": "h", "x": 0, "y": 1.0, "yanchor": "bottom"}, "hovermode": "closest",
+              "shapes": list(shapes), "annotations": list(annotations)}
+    for row in range(1, rows + 1):
+        suffix = "" if row == 1 else str(row)
+        top = 1 - (row - 1) * (size + gap)
+        layout[f"yaxis{suffix}"] = {"title": {"text": y_titles[row - 1]}, "domain": [top - size, top],
+                                    "anchor": f"x{suffix}", "zeroline": True}
+        layout[f"xaxis{suffix}"] = {"anchor": f"y{suffix}", "showticklabels": row == rows,
+                                    **({"matches": "x"} if row > 1 else {}),
+                                    **({"title": {"text": x_title}} if row == rows else {})}
+    return {"data": traces, "layout": layout}
+
+
+def _level(value: float, row: int, label: str, color: str = "black") -> tuple[dict, dict]:
+    """A horizontal line across row ``row`` at ``value`` and its label."""
+    suffix = "" if row == 1 else str(row)
+    shape = {"type": "line", "xref": f"x{suffix} domain", "x0": 0, "x1": 1, "yref": f"y{suffix}", "y0": value,
+             "y1": value, "line": {"dash": "dot", "color": color, "width": 1.5}}
+    note = {"xref": f"x{suffix} domain", "x": 1, "xanchor": "right", "yref": f"y{suffix}", "y": value,
+            "yanchor": "bottom", "text": label, "showarrow": False}
+    return shape, note
+
+
+def shown_window(run) -> np.ndarray:
+    """The part of a run a history figure shows: a few settling times, at least the first 10 points."""
+    end = max(SETTLING_TIMES_SHOWN * run.analytic["settling_time_s"], run.time[min(10, run.time.size - 1)])
+    return run.time <= end
+
+
+def time_history(runs: dict, title: str = "Azimuth and level errors (Fig. 1.4)") -> dict:
+    """delta [arcmin] and beta [arcsec] against time [min] for runs (label -> CaseRun), delta_y dotted."""
+    traces = []
+    for number, (label, run) in enumerate(runs.items()):
+        window = shown_window(run)
+        minutes, delta, beta = thin(run.time[window] / 60.0, to_unit(run.delta[window], "arcmin"),
+                                    to_unit(run.beta[window], "arcsec"))
+        line = {"dash": DASHES[number % len(DASHES)]}
+        traces += [_line(minutes, delta, f"delta, {label}", line=line),
+                   _line(minutes, beta, f"beta, {label}", row=2, line=line)]
+    steady = float(to_unit(next(iter(runs.values())).analytic["azimuth_error_analytic_rad"], "arcmin"))
+    shape, note = _level(steady, 1, "delta_y (1.21)")
+    return _figure(traces, title, ["delta [arcmin]", "beta [arcsec]"], "time [min]", 520, [shape], [note])
+
+
+def phase_trajectory(runs: dict, title: str = "Phase trajectory in the (delta, beta) plane (task 5)") -> dict:
+    """The platform's path in the (delta [arcmin], beta [arcsec]) plane, start marked, steady state starred."""
+    traces = []
+    for number, (label, run) in enumerate(runs.items()):
+        window = shown_window(run)  # past a few settling times the path sits on the steady point
+        delta, beta = thin(to_unit(run.delta[window], "arcmin"), to_unit(run.beta[window], "arcsec"))
+        traces += [_line(delta, beta, label, line={"dash": DASHES[number % len(DASHES)]}),
+                   _line(delta[:1], beta[:1], f"start, {label}", mode="markers", marker={"size": 9})]
+    first = next(iter(runs.values())).analytic
+    traces.append(_line([to_unit(first["azimuth_error_analytic_rad"], "arcmin")],
+                        [to_unit(first["level_error_beta_analytic_rad"], "arcsec")],
+                        "steady state (1.21), (1.25)", mode="markers",
+                        marker={"size": 14, "symbol": "star", "color": "black"}))
+    return _figure(traces, title, ["level error beta [arcsec]"], "azimuth error delta [arcmin]", 480)
+
+
+def level_angles(run, title: str = "Level errors in mu, nu and in beta, alpha (task 3)") -> dict:
+    """mu, nu (platform axes, (1.17)) and beta, alpha (geographic, (1.18)) [arcsec] against time [min]."""
+    window = shown_window(run)
+    minutes = run.time[window] / 60.0
+    traces = []
+    for row, names in ((1, ("mu", "nu")), (2, ("beta", "alpha"))):
+        for name in names:
+            values = getattr(run, name)
+            if values is not None:
+                x, y = thin(minutes, to_unit(values[window], "arcsec"))
+                traces.append(_line(x, y, name, row=row))
+    return _figure(traces, title, ["mu, nu [arcsec]", "beta, alpha [arcsec]"], "time [min]", 520)
+
+
+def sweep_curves(x, x_label: str, columns: dict, constraints, title: str = "Accuracy and time against a parameter"):
+    """Azimuth error, settling time and the constraint ratios against a swept parameter.
+
+    ``columns`` holds display-unit arrays: ``azimuth_error_arcmin`` (simulated),
+    ``azimuth_error_analytic_arcmin`` ((1.21)), ``settling_time_s``,
+    ``settling_time_simulated_s`` and the maxima named by ``constraints`` (SI);
+    optionally ``simplified_azimuth_error_arcmin``. ``constraints``: (output key,
+    symbol, limit, unit) of each constraint; a ratio of 1 or more is a violation
+    (drawn red).
+    """
+    open_circle = {"symbol": "circle-open", "size": 8}
+    traces = [_line(x, columns["azimuth_error_analytic_arcmin"], "analytic (1.21)"),
+              _line(x, columns["azimuth_error_arcmin"], "simulated", mode="markers", marker=open_circle)]
+    if "simplified_azimuth_error_arcmin" in columns:
+        traces.append(_line(x, columns["simplified_azimuth_error_arcmin"], "simulated, (1.19)", mode="markers",
+                            marker={"symbol": "x", "size": 7}))
+    traces += [_line(x, columns["settling_time_s"], "settling time, analytic", row=2),
+               _line(x, np.where(np.isfinite(columns["settling_time_simulated_s"]),
+                                 columns["settling_time_simulated_s"], np.nan),
+                     "settling time, 1 % band", row=2, mode="markers", marker=open_circle)]
+    for key, symbol, limit, unit in constraints:
+        ratio = np.asarray(columns[key], dtype=float) / limit
+        traces.append(_line(x, ratio, f"max {symbol} / {limit:g} {unit}", row=3, mode="lines+markers",
+                            marker={"color": np.where(ratio >= 1, "crimson", "seagreen").tolist(), "size": 7}))
+    shape, note = _level(1.0, 3, "limit", color="crimson")
+    fig = _figure(traces, title, ["azimuth error [arcmin]", "settling time [s]", "max / limit"], x_label, 760,
+                  [shape], [note])
+    fig["layout"]["yaxis2"]["rangemode"] = "tozero"
+    fig["layout"]["yaxis3"]["type"] = "log"
+    return fig
+
+
+GRAPH = "lab-graph"
+"""Component-id type of a system page's interactive graphs: ``{"type": GRAPH, "figure": STEM}``."""
+
+
+def empty(note: str) -> dict:
+    """A figure with nothing drawn but a note (before the first run, or when a run has no histories)."""
+    return {"data": [], "layout": {"height": 200, "template": "plotly_white", "xaxis": {"visible": False},
+                                   "yaxis": {"visible": False},
+                                   "annotations": [{"text": note, "showarrow": False, "font": {"size": 14}}]}}
+
+
+def block(stem: str, fig: dict, csv: bool = False, graph_id: dict | None = None) -> html.Div:
+    """A figure with its export buttons: PNG and SVG (drawn by the browser), and CSV of its data if ``csv``.
+
+    The CSV button (``{"type": "csv-export", "figure": stem}``) needs a
+    callback of the page that knows the figure's data. ``graph_id`` gives the
+    graph an id, so that a callback can replace its figure in place.
+    """
+    buttons: list[Any] = [html.Button(fmt.upper(), id={"type": "image-export", "figure": stem, "format": fmt},
+                           className="export", title=f"save the figure as {fmt.upper()}") for fmt in ("png", "svg")]
+    if csv:
+        buttons += [html.Button("CSV", id={"type": "csv-export", "figure": stem}, className="export",
+                                title="download the figure's data as CSV"),
+                    dcc.Download(id={"type": "csv-download", "figure": stem})]
+    identity: dict[str, Any] = {} if graph_id is None else {"id": graph_id}
+    graph = dcc.Graph(figure=fig, config=GRAPH_CONFIG, **identity)
+    return html.Div([graph, html.Div([html.Span("export:", className="hint"), *buttons], className="exports")],
+                    className="figure", **data_attributes(figure=stem))
+
+
+@dataclass(frozen=True)
+class Interactive:
+    """The interactive figures the lab draws for one system: their names and how to build them from a result."""
+
+    stems: tuple[str, ...]
+    build: Callable[[object], list[dict]]
+
+
+def _alignment_figures(result) -> list[dict]:
+    if result.run is None:
+        return [empty("no histories: the closed form computes none")] * 2
+    runs = {f"{result.model} model": result.run}
+    if result.model != "simplified" and result.simplified_run is not None:
+        runs["simplified (1.19)"] = result.simplified_run
+    return [time_history(runs), phase_trajectory(runs)]
+
+
+INTERACTIVE = {"align": Interactive(("align_time_history", "align_phase_trajectory"), _alignment_figures)}
+"""System name -> the interactive figures of its ``run`` result."""
+
+
+def interactive_stems(system: System) -> tuple[str, ...]:
+    """Names of the interactive figures of a system's page (empty: it shows its own files' figures)."""
+    return INTERACTIVE[system.name].stems if system.name in INTERACTIVE else ()
+
+
+def interactive_figures(system: System, result) -> list[dict] | None:
+    """The interactive figures of a result (in the order of :func:`interactive_stems`), or None."""
+    return INTERACTIVE[system.name].build(result) if system.name in INTERACTIVE else None
+
+
+def file_figures(system: System, result) -> list[tuple[str, str]]:
+    """The system's own PNG figures of a result as (file name, data URI) pairs."""
+    with tempfile.TemporaryDirectory(prefix="schuler-lab-") as folder:
+        paths = system.write_files(result, Path(folder))
+        return [(path.name, "data:image/png;base64," + base64.b64encode(path.read_bytes()).decode("ascii"))
+                for path in paths if path.suffix == ".png"]

@@ -1,0 +1,124 @@
+"""What a page shows of a result: headline numbers, Monte Carlo statistics, the reproduction table.
+
+Everything is built generically from the system's declared outputs: each
+headline number is a ``<span data-result="KEY">`` (KEY as in the system's JSON)
+whose text is only the number and its display unit ("3.556 arcmin").
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from dash import html
+
+from schuler.contract import Output, System
+from schuler.reproduction import Reproduction
+from schuler.results import display_label
+from schuler.units import to_unit
+
+
+def number_text(value: float) -> str:
+    """A number for people: 4 significant digits (no trailing zeros), whole numbers below 10^6 in full.
+
+    >>> number_text(3.55583), number_text(0.0533333), number_text(10800.0), number_text(1.2345e-7)
+    ('3.556', '0.05333', '10800', '1.234e-07')
+    >>> number_text(-0.0), number_text(float("inf")), number_text(30.0), number_text(0.8)
+    ('0', 'inf', '30', '0.8')
+    """
+    if math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    if value == 0:
+        return "0"
+    magnitude = math.floor(math.log10(abs(value)))
+    if -3 <= magnitude < 6:
+        text = f"{value:.{max(0, 3 - magnitude)}f}"
+        if "." in text:
+            text = text.rstrip("0").rstrip(".")
+        return text[1:] if text.startswith("-") and float(text) == 0 else text
+    return f"{value:.4g}"
+
+
+def quantity_text(value_si, output: Output) -> str:
+    """An output's value in its display unit: ``3.556 arcmin``; ``-`` when not computed.
+
+    >>> quantity_text(1.0343e-3, Output("azimuth_error_rad", "rad", "arcmin"))
+    '3.556 arcmin'
+    >>> quantity_text(None, Output("settling_time_s", "s")), quantity_text(True, Output("constraints_ok", "1"))
+    ('-', '1')
+    """
+    if value_si is None:
+        return "-"
+    value = float(value_si)
+    if math.isnan(value):
+        return "-"
+    unit = output.shown_unit
+    shown = float(to_unit(value, output.display)) if output.display else value
+    return f"{number_text(shown)} {unit}".strip()
+
+
+def data_attributes(**values) -> dict[str, Any]:
+    """``data-*`` attributes for a Dash component: ``data_attributes(param="x")`` -> ``{"data-param": "x"}``."""
+    return {f"data-{key.replace('_', '-')}": value for key, value in values.items()}
+
+
+RESULT = "result"
+"""Component-id type of a headline number: ``{"type": RESULT, "key": KEY}`` (with ``data-result="KEY"``)."""
+
+
+def headline(system: System, values: Mapping[str, object], with_ids: bool = False) -> html.Table:
+    """The system's outputs as a table of ``data-result`` numbers (values: SI, keyed as in ``to_dict``).
+
+    ``with_ids`` gives each number an id, so that a callback can replace its text in place.
+    """
+    rows = []
+    for output in system.outputs:
+        ident: dict[str, Any] = {"id": {"type": RESULT, "key": output.name}} if with_ids else {}
+        rows.append(html.Tr([
+            html.Th(output.description or output.name, scope="row"),
+            html.Td(html.Span(quantity_text(values.get(output.name), output), **ident,
+                              **data_attributes(result=output.name)), className="number"),
+            html.Td(output.name, className="key"),
+        ]))
+    return html.Table(html.Tbody(rows), className="headline")
+
+
+def headline_texts(system: System, values: Mapping[str, object]) -> list[str]:
+    """The texts of :func:`headline`'s numbers, in the order of the system's outputs."""
+    return [quantity_text(values.get(output.name), output) for output in system.outputs]
+
+
+def monte_carlo_table(system: System, statistics: Mapping[str, Mapping[str, float | None]], members: int) -> html.Div:
+    """Mean, standard deviation and 5 %/95 % points of every output over the members (display units)."""
+    header = html.Tr([html.Th("output")] + [html.Th(h) for h in ("mean", "std", "p05", "p95")])
+    rows = []
+    for output in system.outputs:
+        stats = statistics.get(output.name)
+        if not stats or stats.get("min") == stats.get("max"):
+            continue
+        cells = []
+        for key in ("mean", "std", "p05", "p95"):
+            value = stats.get(key)
+            cells.append(html.Td("-" if value is None else number_text(
+                float(to_unit(value, output.display)) if output.display else float(value)), className="number"))
+        rows.append(html.Tr([html.Th(display_label(output.name, output.shown_unit), scope="row"), *cells]))
+    return html.Div([html.H3(f"Monte Carlo: {members} members"),
+                     html.Table([html.Thead(header), html.Tbody(rows)], className="statistics")])
+
+
+def reproduction_table(reproduction: Reproduction) -> html.Div:
+    """The source's printed values beside the computed ones, with verdicts, constants and notes."""
+    headings = ("quantity", "printed", "where", "computed", "unit", "verdict", "note")
+    rows = [html.Tr([
+        html.Td(row.quantity), html.Td(row.printed or "-", className="number"), html.Td(row.where),
+        html.Td(f"{row.computed:.6g}", className="number"), html.Td(row.unit),
+        html.Td(row.verdict, className="verdict failed" if row.failed else "verdict"), html.Td(row.note),
+    ]) for row in reproduction.rows]
+    return html.Div([
+        html.P(["Source: ", reproduction.source]),
+        html.P(["Constants: ", reproduction.constants]),
+        html.Table([html.Thead(html.Tr([html.Th(h) for h in headings])), html.Tbody(rows)],
+                   className="reproduction"),
+        html.Ul([html.Li(note) for note in reproduction.notes]) if reproduction.notes else None,
+    ], className="reproduction-view")
