@@ -20,7 +20,7 @@ def test_default_schuler_period_is_84_4_minutes():
 
 
 def test_bollay_preset_uses_the_stated_period():
-    # source 002: R = 3960 mi, g = 32.2 ft/s^2, T = 5060 s (2 pi sqrt(R/g) = 5063.1 s)
+    # Bollay (1966): R = 3960 mi, g = 32.2 ft/s^2, T = 5060 s (2 pi sqrt(R/g) = 5063.1 s)
     assert earth.BOLLAY.radius == pytest.approx(3960 * 1609.344)
     assert earth.BOLLAY.gravity == pytest.approx(32.2 * 0.3048)
     assert earth.BOLLAY.schuler_period == 5060.0

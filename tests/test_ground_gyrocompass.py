@@ -1,4 +1,4 @@
-"""Ground gyrocompass during rotor run-down (source 004, Fedorov, Kikot, Shtefan)."""
+"""Ground gyrocompass during rotor run-down (Fedorov et al. (2020), Fedorov, Kikot, Shtefan)."""
 
 from __future__ import annotations
 
@@ -299,7 +299,7 @@ def test_quantisation_enters_predicted_error():
 
 
 def test_two_unknown_grid_reproduces_source_stage_minima(record):
-    # source 004, text after Table 1: best cells 4pi/540, 4e-4; 3.7pi/540, 4.1e-4; 3.69pi/540, 4.08e-4
+    # Fedorov et al. (2020), text after Table 1: best cells 4pi/540, 4e-4; 3.7pi/540, 4.1e-4; 3.69pi/540, 4.08e-4
     time, observed = record
     rows = stage_comparison(time, observed, 2)
     assert [row["computed_best"] for row in rows] == [[4.0, 4.0], [3.7, 4.1], [3.69, 4.08]]

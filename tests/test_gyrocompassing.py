@@ -1,4 +1,4 @@
-"""Gyrocompassing of a platform INS (source 003, KPI lab manual): models, closed forms, lab tasks."""
+"""Gyrocompassing of a platform INS (the KPI manual, KPI lab manual): models, closed forms, lab tasks."""
 
 from __future__ import annotations
 
@@ -159,7 +159,7 @@ def test_mu_nu_and_alpha_beta_models_are_the_same_system():
 
 
 def test_printed_third_line_of_1_17_diverges_at_azimuth_zero():
-    # source 003, (1.17) as printed: loop delta -> nu -> mu -> delta has gain +c_a U_y U_z
+    # the KPI manual, (1.17) as printed: loop delta -> nu -> mu -> delta has gain +c_a U_y U_z
     c_gamma, c_a = analytic.gains_from_design(30.0, 0.8, LAT50)
     printed = models.printed_mu_nu_model(LAT50, 0.0, c_gamma, c_a)
     corrected = models.full_mu_nu_model(LAT50, 0.0, c_gamma, c_a)
@@ -231,7 +231,7 @@ def test_settling_time_is_five_slowest_time_constants(c_gamma, c_a, latitude):
 
 
 def test_design_from_time_constant_and_damping():
-    # source 003: c_a = 1/(T^2 U_eta), c_gamma = 2 zeta / T; T = 30 s, zeta = 0.8 -> c_gamma = 0.0533 1/s
+    # the KPI manual: c_a = 1/(T^2 U_eta), c_gamma = 2 zeta / T; T = 30 s, zeta = 0.8 -> c_gamma = 0.0533 1/s
     c_gamma, c_a = analytic.gains_from_design(30.0, 0.8, LAT50)
     assert float(c_gamma) == pytest.approx(0.0533, abs=5e-5)
     assert float(c_a) == pytest.approx(1 / (900 * EARTH_RATE * math.cos(LAT50)), rel=1e-15)

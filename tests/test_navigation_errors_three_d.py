@@ -56,7 +56,7 @@ def test_stationary_eigenvalues_match_the_exact_theory(latitude_deg):
 
 
 def test_non_rotating_limit_of_a_north_drift_is_the_single_channel_formula():
-    # drift about east makes a north error: (R eps / omega)(omega t - sin omega t), source 002 eq. (4)
+    # drift about east makes a north error: (R eps / omega)(omega t - sin omega t), Bollay (1966) eq. (4)
     epsilon = math.radians(0.01) / 3600
     R, g = BOLLAY.radius, BOLLAY.effective_gravity
     model = psi_angle_model(math.radians(30.0), R, g, 0.0)

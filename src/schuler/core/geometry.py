@@ -107,7 +107,7 @@ def earth_rate_north_up(latitude, earth_rate: float = EARTH_RATE):
        Navigation Systems*, 2nd ed., Artech House, 2013, ch. 2 (Earth rotation
        resolved in the local navigation frame).
     .. [2] KPI laboratory manual on physical gyrocompassing of a semi-analytic
-       platform INS (source 003), Sec. 2.
+       platform INS (the KPI manual), Sec. 2.
 
     Examples
     --------

@@ -1,7 +1,7 @@
 """North as users see it: the dispatcher :func:`identify` over both methods, and its result.
 
 :func:`identify` turns the instrument's known or nominal values into the
-problem's (B = H_m Omega_h / J, source 004, eq. (3)), runs one method, the
+problem's (B = H_m Omega_h / J, Fedorov et al. (2020), eq. (3)), runs one method, the
 variable-projection least squares of :mod:`.varpro` (``method="lsq"``) or the
 source's three-stage grid of :mod:`.grid` (``method="grid"``), and returns a
 :class:`NorthEstimate` with standard errors.
@@ -210,7 +210,7 @@ def make_estimate(fit: Fit, time, observed, unknowns, reading, method, inertia, 
 def identify(
     time, observed, unknowns: int = 4, *, decay_rate, hm, inertia, omega_h, reading="relative", method="lsq"
 ) -> NorthEstimate:
-    """Identify north from an observed run-down record (source 004, eqs. (9)-(10)).
+    """Identify north from an observed run-down record (Fedorov et al. (2020), eqs. (9)-(10)).
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """The source's identification: a grid search refined three times (the baseline).
 
-Source 004 compares the simulator with the model on every cell of a grid over the
+Fedorov et al. (2020) compares the simulator with the model on every cell of a grid over the
 unknowns (alpha0, alpha0_dot[, lambda[, H_m]]), picks the cell of least misfit
 F = sum (model - simulator)^2, and refines twice around it with steps ten times
 smaller (Tables 1-3). Two implementations:
@@ -59,7 +59,7 @@ def _source_box(a0, a0d, lam=None, hm=None):
 
 
 SOURCE_STAGES = {
-    # source 004, text after Table 1 (2 unknowns); alpha0 in pi/540, alpha0_dot in 1e-4 rad/s
+    # Fedorov et al. (2020), text after Table 1 (2 unknowns); alpha0 in pi/540, alpha0_dot in 1e-4 rad/s
     2: [
         _source_box((-9, 9, 1), (-6, 6, 1)),
         _source_box((3.0, 5.9, 0.1), (3.0, 5.9, 0.1)),

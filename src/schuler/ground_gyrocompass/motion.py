@@ -2,7 +2,7 @@
 
 The sensitive element turns about a vertical suspension axis; ``alpha`` is the
 angle of the rotor axis from north, positive in the sense in which the Earth's
-horizontal rate ``Omega_h`` precesses it back towards the meridian (source 004,
+horizontal rate ``Omega_h`` precesses it back towards the meridian (Fedorov et al. (2020),
 eq. (1)). With the rotor's angular momentum decaying as H = H_m exp(-lambda t)
 (eq. (2)) and B = H_m Omega_h / J (eq. (3)) the motion obeys (eq. (4))
 
@@ -46,7 +46,7 @@ from scipy.special import it2j0y0, j0, j1, y0, y1
 
 from schuler.exceptions import InvalidParameter, SimulationError
 
-# The source's machine experiment (source 004, text before Table 1).
+# The source's machine experiment (Fedorov et al. (2020), text before Table 1).
 SOURCE_INERTIA = 1.1607e-3  # J, kg m^2
 SOURCE_OMEGA_H = 3.65e-5  # Omega_h, rad/s
 SOURCE_HM = 0.432  # H_m, N m s
@@ -95,7 +95,7 @@ def check_positive(value, name: str, unit: str) -> None:
 
 
 def directive_coefficient(hm, omega_h, inertia):
-    """B = H_m Omega_h / J (source 004, eq. (3)), 1/s^2.
+    """B = H_m Omega_h / J (Fedorov et al. (2020), eq. (3)), 1/s^2.
 
     Parameters
     ----------
@@ -120,7 +120,7 @@ def directive_coefficient(hm, omega_h, inertia):
 
 
 def bessel_argument(time, decay_rate, coefficient):
-    """z(t) = (2 / lambda) sqrt(B exp(-lambda t)) (source 004, eq. (5)) and z0 = z(0).
+    """z(t) = (2 / lambda) sqrt(B exp(-lambda t)) (Fedorov et al. (2020), eq. (5)) and z0 = z(0).
 
     Broadcasts ``time`` against ``decay_rate`` and ``coefficient``.
 
@@ -194,7 +194,7 @@ class Basis:
 
 
 def basis(time, decay_rate, coefficient, torque: bool = True, derivatives: bool = True) -> Basis:
-    """The motion's basis u1, u2, u3 in closed form (source 004, eq. (9)) with derivatives.
+    """The motion's basis u1, u2, u3 in closed form (Fedorov et al. (2020), eq. (9)) with derivatives.
 
     Parameters
     ----------
@@ -323,7 +323,7 @@ def basis_columns(time, decay_rate, coefficient, torque: bool, derivatives: bool
 
 
 def closed_form(time, alpha0, alpha0_dot, decay_rate, coefficient, specific_torque=0.0):
-    """Azimuth alpha(t) in closed form (source 004, eq. (9), plus a constant torque), rad.
+    """Azimuth alpha(t) in closed form (Fedorov et al. (2020), eq. (9), plus a constant torque), rad.
 
     Parameters
     ----------

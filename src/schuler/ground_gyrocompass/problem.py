@@ -1,7 +1,7 @@
 """The identification problem every method solves: unknowns, records, model columns, covariance.
 
 The observations are y_k at times t_k, either the coordinate the instrument sees,
-alpha(t) - alpha0 (``reading="relative"``, source 004, eq. (10)), or absolute
+alpha(t) - alpha0 (``reading="relative"``, Fedorov et al. (2020), eq. (10)), or absolute
 readings alpha(t) + c with an unknown constant offset c (``reading="absolute"``).
 The model (see :mod:`.motion`) is linear in alpha0, alpha0_dot, the specific harmful
 torque m and c, and nonlinear only in lambda and B:

@@ -63,7 +63,7 @@ TABLE_1 = 1e-3 * np.array(
         [16.7, 16.6, 16.5, 16.5, 16.5, 16.5, 16.5, 16.5, 16.6, 16.7, 16.8, 16.9, 17.0],
     ]
 )
-"""Source 004, Table 1: F(alpha0, alpha0_dot), rad^2; rows k = -9..9, columns m = -6..6."""
+"""Fedorov et al. (2020), Table 1: F(alpha0, alpha0_dot), rad^2; rows k = -9..9, columns m = -6..6."""
 
 MISPRINTS = ((-5, -1), (1, -6))
 """Cells (k, m) of Table 1 that break their monotone rows: 25.1 between 28.4 and 28.1,

@@ -1,4 +1,4 @@
-"""Closed forms of gyrocompassing (source 003): steady state, transient, settling time, design.
+"""Closed forms of gyrocompassing (the KPI manual): steady state, transient, settling time, design.
 
 All functions take SI floats or arrays (broadcast together) and return arrays:
 angles in rad, rates in rad/s, gains c_gamma and c_a in 1/s, times in s.
@@ -17,11 +17,11 @@ from schuler.core.geometry import earth_rate_north_up, horizontal_earth_rate
 from schuler.exceptions import InvalidParameter
 
 SETTLING_DECREMENTS = 5.0
-"""Settling time = 5 time constants of the slowest mode (source 003: t = 5 / h)."""
+"""Settling time = 5 time constants of the slowest mode (the KPI manual: t = 5 / h)."""
 
 
 def gains_from_design(time_constant, damping, latitude, earth_rate=EARTH_RATE):
-    """Correction gains from the time constant T and damping zeta (source 003, end of Sec. 2).
+    """Correction gains from the time constant T and damping zeta (the KPI manual, end of Sec. 2).
 
     From T^2 p^2 + 2 T zeta p + 1 = 0 matched to p^2 + c_gamma p + U_eta c_a = 0:
     c_a = 1 / (T^2 U_eta), c_gamma = 2 T zeta U_eta c_a = 2 zeta / T.

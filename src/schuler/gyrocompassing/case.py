@@ -1,4 +1,4 @@
-"""One gyrocompassing case or N cases (source 003, Sec. 3): parameters, validation, gains, closed forms.
+"""One gyrocompassing case or N cases (the KPI manual, Sec. 3): parameters, validation, gains, closed forms.
 
 A :class:`AlignmentCase` holds one case or N cases (every field a float or an
 array of length N, SI); it checks that azimuth is observable at its latitude,
@@ -25,7 +25,7 @@ from schuler.gyrocompassing import analytic, models
 
 DEFAULT_LATITUDE = math.radians(50.0)
 DEFAULT_TIME_CONSTANT = 30.0
-"""T, s (source 003: "often T = 30 s, zeta = 0.8")."""
+"""T, s (the KPI manual: "often T = 30 s, zeta = 0.8")."""
 DEFAULT_DAMPING = 0.8
 DEFAULT_INITIAL_AZIMUTH_ERROR = math.radians(1.0)
 DEFAULT_MAX_LATITUDE = math.radians(85.0)

@@ -1,6 +1,6 @@
 """Linear models of physical gyrocompassing of a semi-analytic platform INS.
 
-Frames (source 003, Sec. 2): xi eta zeta is the geographic frame (xi east,
+Frames (the KPI manual, Sec. 2): xi eta zeta is the geographic frame (xi east,
 eta north, zeta up); x_g y_g z_g is the horizontal frame turned by the azimuth A
 about zeta; xyz is the platform. The platform is off x_g y_g z_g by delta
 (azimuth, about z) and the level angles nu (about x) and mu (about y); the
@@ -65,7 +65,7 @@ def _assemble(rows, shape):
 
 
 def earth_rate_components(latitude, azimuth, earth_rate=EARTH_RATE):
-    """Earth-rate components on a fixed base (source 003, Sec. 2).
+    """Earth-rate components on a fixed base (the KPI manual, Sec. 2).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Simulating gyrocompassing cases on the exact engine and checking the lab's constraints (source 003, Sec. 3).
+"""Simulating gyrocompassing cases on the exact engine and checking the lab's constraints (the KPI manual, Sec. 3).
 
 :func:`run_case` simulates one case on the chosen model and checks the lab's
 constraints over the whole run; :func:`evaluate_cases` evaluates many cases at

@@ -1,4 +1,4 @@
-"""Effective Schuler period under thrust or fast level flight (source 002, footnote).
+"""Effective Schuler period under thrust or fast level flight (Bollay (1966), footnote).
 
 The levelling loop's period is T = 2 pi sqrt(R / g_eff), where g_eff is the
 specific force along the vertical that the accelerometers feel and R the radius

@@ -176,8 +176,9 @@ class SourceParameters(ParameterSet):
 
 
 EARTH_PARAMETERS: tuple[Parameter, ...] = (
-    Parameter("earth", "", "default", "Earth constants preset (bollay: R = 3960 mi, T = 5060 s; "
-              "drozdovich: R = 6400 km).", choices=tuple(PRESETS), kind="choice"),
+    Parameter("earth", "", "default", "Earth constants preset (default: mean radius 6371 km, standard "
+              "gravity; bollay: R = 3960 mi, T = 5060 s; drozdovich: R = 6400 km).",
+              choices=tuple(PRESETS), kind="choice"),
     Parameter("radius", "km", None, "Earth radius R (not set: the preset's).", minimum=1.0, maximum=1e5),
     Parameter("gravity", "m/s^2", None, "Gravity g of the Schuler loop (not set: the preset's; with only the "
               "radius set, the preset's g).", minimum=1e-3, maximum=1e3),

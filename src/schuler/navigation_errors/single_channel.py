@@ -1,6 +1,6 @@
 """One horizontal channel of a Schuler-tuned INS: five error sources, flat and spherical Earth.
 
-Source 002 (Bollay, "The Story of 84 Minutes"): the platform is levelled by the
+Bollay (1966) (Bollay, "The Story of 84 Minutes"): the platform is levelled by the
 computed distance, phi = x / R, so a position error x sees the restoring
 acceleration -(g/R) x and obeys
 
@@ -54,7 +54,7 @@ from schuler.core.lti import StateSpace, simulate
 from schuler.exceptions import InvalidParameter
 
 SOURCES: tuple[str, ...] = ("tilt", "velocity", "accelerometer", "drift", "azimuth")
-"""The five error sources of source 002, Problems 1-3."""
+"""The five error sources of Bollay (1966), Problems 1-3."""
 
 _SCHULER_SOURCES = ("tilt", "velocity", "accelerometer", "drift")
 
@@ -150,7 +150,7 @@ def flat_error(source: str, magnitude, time, gravity, speed=0.0):
 
     Notes
     -----
-    Source 002, Problem 1 solutions: g Delta_theta t^2/2, Delta_V t, Delta_a t^2/2,
+    Bollay (1966), Problem 1 solutions: g Delta_theta t^2/2, Delta_V t, Delta_a t^2/2,
     epsilon g t^3/6, range x Delta_theta_z.
 
     Examples
@@ -197,7 +197,7 @@ def spherical_error(source: str, magnitude, time, radius, gravity, speed=0.0):
 
     Notes
     -----
-    Source 002, solutions (2) and (4) and Problem 2: R Delta_theta (1 - cos wt),
+    Bollay (1966), solutions (2) and (4) and Problem 2: R Delta_theta (1 - cos wt),
     (Delta_V/w) sin wt, (Delta_a/w^2)(1 - cos wt), (R epsilon/w)(wt - sin wt),
     R sin(r/R) Delta_theta_z with r = V t.
 
@@ -278,7 +278,7 @@ def maximum_error(source: str, magnitude, duration, radius, gravity, speed=0.0, 
 
 
 def channel_model(radius: float, gravity: float) -> StateSpace:
-    """State-space model of one Schuler-tuned channel (source 002, equations (1), (3)).
+    """State-space model of one Schuler-tuned channel (Bollay (1966), equations (1), (3)).
 
     States: ``position_error`` x (m), ``velocity_error`` x' (m/s),
     ``drift_angle`` theta_1 (rad: the platform's rotation by initial tilt and gyro

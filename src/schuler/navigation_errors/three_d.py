@@ -1,6 +1,6 @@
 """The linearised 3-D INS error model on a rotating spherical Earth, in psi-angle form.
 
-Beyond source 002, whose single channel is this model's non-rotating limit.
+Beyond Bollay (1966), whose single channel is this model's non-rotating limit.
 Frame: local-level North-East-Down (n frame) of the computed position; Earth
 rate Omega_n = Omega (cos L, 0, -sin L), transport rate
 rho = (V_E / R, -V_N / R, -V_E tan L / R) for a vehicle flying at constant

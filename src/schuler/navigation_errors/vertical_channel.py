@@ -1,6 +1,6 @@
 """The vertical channel: divergent pure-inertial altitude, and the baro-aided loop that tames it.
 
-Source 002, Problem 4: gravity falls off with height, g(h) ~ g0 (1 - 2 h / R),
+Bollay (1966), Problem 4: gravity falls off with height, g(h) ~ g0 (1 - 2 h / R),
 so an altitude error delta_h makes the computed gravity wrong by
 -2 (g0/R) delta_h, which pushes the error further:
 
@@ -60,7 +60,7 @@ def hover_altitude_error(time, accelerometer_error, radius, gravity):
     time : float or ndarray
         t, s (>= 0).
     accelerometer_error : float or ndarray
-        b, m/s^2 (positive when the accelerometer reads high; source 002 Problem 4
+        b, m/s^2 (positive when the accelerometer reads high; Bollay (1966) Problem 4
         has b = -k g0).
     radius : float
         R, m (> 0).
@@ -71,7 +71,7 @@ def hover_altitude_error(time, accelerometer_error, radius, gravity):
     -------
     ndarray
         (b / (2 omega_s^2)) (cosh(sqrt(2) omega_s t) - 1), m: the solution of
-        source 002 Problem 4's delta_h'' - 2 omega_s^2 delta_h = b from rest.
+        Bollay (1966) Problem 4's delta_h'' - 2 omega_s^2 delta_h = b from rest.
 
     Examples
     --------
@@ -100,7 +100,7 @@ def printed_hover_expression(time, k, radius, gravity):
 
 
 def unaided_model(radius: float, gravity: float) -> StateSpace:
-    """State-space model of the pure-inertial vertical channel (source 002, Problem 4).
+    """State-space model of the pure-inertial vertical channel (Bollay (1966), Problem 4).
 
     States ``altitude_error`` delta_h (m) and ``vertical_velocity_error`` (m/s),
     input ``accelerometer_error`` b (m/s^2). Eigenvalues +/- sqrt(2) omega_s: one is
