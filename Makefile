@@ -33,7 +33,7 @@ PSINS_IMU ?= $(abspath $(wildcard ../shared/data/psins/lasergyro.imu))
 # the guards: lint, types, and the layers of the import contract (pyproject.toml)
 lint: $(VENV)/.installed-test
 	@echo "== ruff: lint"
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks docs/_ext docs/conf.py examples
 	@echo "== mypy: types"
 	$(BIN)/mypy
 	@echo "== import-linter: layers cli > study > systems > boundary > core"

@@ -54,7 +54,8 @@ extensions = [
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "gallery/**/*.ipynb", "gallery/**/*.py", "gallery/**/*.zip", "**/*.md5"]
+# lab.md is read on its own (README) and included by guide/lab.md
+exclude_patterns = ["_build", "lab.md", "gallery/**/*.ipynb", "gallery/**/*.py", "gallery/**/*.zip", "**/*.md5"]
 templates_path = ["_templates"]
 default_role = "code"
 nitpicky = False

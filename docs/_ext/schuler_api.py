@@ -112,10 +112,19 @@ def index_text() -> str:
 
 
 def write_index(source_dir: Path) -> Path:
-    """Write ``api/index.rst`` under ``source_dir`` (only when its text changed, so rebuilds stay incremental)."""
+    """Write ``api/index.rst`` under ``source_dir`` (only when its text changed, so rebuilds stay incremental).
+
+    Module pages of an earlier build whose module is gone (renamed, removed in a
+    merge) are deleted: autosummary only adds pages, and a page that cannot
+    import its module would fail the build.
+    """
     path = Path(source_dir) / "api" / "index.rst"
     text = index_text()
     if not path.exists() or path.read_text(encoding="utf-8") != text:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(text, encoding="utf-8")
+    modules = set(public_modules())
+    for page in (path.parent / "generated").glob("*.rst"):
+        if page.stem not in modules:
+            page.unlink()
     return path

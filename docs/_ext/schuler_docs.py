@@ -98,8 +98,11 @@ class ReproductionTable(_Generated):
 
     def lines(self) -> list[str]:
         from schuler.registry import get_system
+        from schuler.reproduction import Reproduction
 
         reproduction = get_system(self.arguments[0]).reproduce()
+        if not isinstance(reproduction, Reproduction):
+            raise self.error(f"{self.arguments[0]}: reproduce() returned {type(reproduction).__name__}")
         rows = [[escape(r.quantity), escape(r.printed or "-"), escape(r.where), _number(r.computed), escape(r.unit),
                  escape(r.verdict), escape(r.note)] for r in reproduction.rows]
         out = [f"Constants: {escape(reproduction.constants)}.", ""]

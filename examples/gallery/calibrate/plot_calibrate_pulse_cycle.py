@@ -51,10 +51,10 @@ plt.show()
 # %%
 # One cycle's reading gives ω_d + ω_0; the two positions separate them, and
 # the two channels' apparent drifts give the azimuth:
-for shape in ("rectangular", "triangular"):
-    drift, apparent = separate_drift(rates[shape, 0.0], rates[shape, math.pi], k1, tau)
+for name in ("rectangular", "triangular"):
+    drift, apparent = separate_drift(rates[name, 0.0], rates[name, math.pi], k1, tau)
     found = azimuth_from_channels(apparent[0], apparent[1])
-    print(f"{shape:12s} rate of one cycle {rate_from_reading(rates[shape, 0.0][0], k1, tau) / DEG_PER_HOUR:+.4f} deg/h;"
+    print(f"{name:12s} rate of one cycle {rate_from_reading(rates[name, 0.0][0], k1, tau) / DEG_PER_HOUR:+.4f} deg/h;"
           f" own drift X {drift[0] / DEG_PER_HOUR:+.4f} deg/h, Y {drift[1] / DEG_PER_HOUR:+.4f} deg/h;"
           f" azimuth {math.degrees(found):.4f} deg")
 

@@ -65,8 +65,8 @@ class StreamingStatistics:
 
         Parameters
         ----------
-        samples : ndarray, shape (k, *shape)
-            One sample per member, in the unit of the statistic.
+        samples : ndarray
+            One sample per member, shape ``(k, *shape)``, in the unit of the statistic.
         """
         samples = np.asarray(samples, dtype=float)
         if samples.shape[1:] != self.shape:

@@ -151,6 +151,15 @@ at 1e7, measured on records of 200 to 2,000 s).
 def check_closed_form_reach(decay_rate, coefficient) -> None:
     """Raise InvalidParameter where lambda is so small that z0 exceeds :data:`MAX_BESSEL_ARGUMENT`.
 
+    Parameters
+    ----------
+    decay_rate : float or ndarray
+        lambda, the decay rate of the rotor's angular momentum during run-down, 1/s.
+    coefficient : float or ndarray
+        B = H_m Omega_h / J, 1/s^2.
+
+    Examples
+    --------
     >>> check_closed_form_reach(1e-9, 0.0135849)
     Traceback (most recent call last):
     ...
