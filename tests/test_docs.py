@@ -141,6 +141,37 @@ def test_the_api_reference_covers_every_package():
     assert not any(part.startswith("_") for name in schuler_api.public_modules() for part in name.split("."))
 
 
+def _complete_site(root: Path) -> None:
+    """A minimal built site holding everything :func:`schuler_api.site_problems` asks for."""
+    (root / "api" / "generated").mkdir(parents=True)
+    (root / "index.html").write_text('<html><script src="_static/a.js"></script></html>')
+    for name in SYSTEM_MODULES:
+        guide = get_system(name).guide
+        (root / "gallery" / guide).mkdir(parents=True)
+        (root / "guide").mkdir(exist_ok=True)
+        (root / "guide" / f"{guide}.html").write_text("<html></html>")
+        (root / "gallery" / guide / "plot_x.html").write_text(
+            '<img src="../../_images/sphx_glr_plot_x_001.png" alt="x"/>')
+    for top in {".".join(module.split(".")[:2]) for module in schuler_api.public_modules()}:
+        (root / "api" / "generated" / f"{top}.html").write_text("<html></html>")
+
+
+def test_the_site_check_catches_what_it_should(tmp_path):
+    _complete_site(tmp_path)
+    assert schuler_api.site_problems(tmp_path) == []
+    (tmp_path / "gallery" / "north" / "plot_x.html").write_text("<p>no figure</p>")
+    (tmp_path / "api" / "generated" / "schuler.core.html").unlink()
+    (tmp_path / "guide" / "fonts.html").write_text('<link rel="stylesheet" href="https://fonts.example/a.css">')
+    (tmp_path / "guide" / "cdn.html").write_text("<script src='//cdn.example/a.js'></script>")
+    (tmp_path / "guide" / "link.html").write_text('<a href="https://example.org">a link is fine</a>')
+    assert schuler_api.site_problems(tmp_path) == [
+        "north: no gallery page with a figure under gallery/north/ (examples/gallery/north/plot_*.py)",
+        "no API page for schuler.core",
+        "guide/cdn.html: loads an asset from another site",
+        "guide/fonts.html: loads an asset from another site",
+    ]
+
+
 GUIDE_PAGES = [DOCS / "getting-started.rst", *sorted((DOCS / "guide").glob("*.rst"))]
 
 

@@ -4,7 +4,8 @@ The API reference is autosummary over the installed ``schuler`` package: this
 module decides which modules and members are public (the same rule the
 docstring test in ``tests/test_docs.py`` applies) and writes ``api/index.rst``
 with one autosummary group per layer, so a new system subpackage gets its page
-without editing the documentation.
+without editing the documentation. :func:`site_problems` checks the built site
+for what the documentation promises (run at the end of every build).
 
 Public: every module whose dotted name has no part starting with ``_`` (the
 numba kernels and ``__main__`` are private), outside the command line
@@ -19,9 +20,12 @@ from __future__ import annotations
 import importlib
 import inspect
 import pkgutil
+import re
 from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
+
+from schuler.registry import SYSTEM_MODULES, get_system
 
 PACKAGE = "schuler"
 EXCLUDED = ("schuler.cli",)
@@ -128,3 +132,35 @@ def write_index(source_dir: Path) -> Path:
         if page.stem not in modules:
             page.unlink()
     return path
+
+
+_REMOTE_ASSET = re.compile(r"<(?:script|img|link|iframe|source)\b[^>]*\b(?:src|href)=[\"']?(https?:)?//", re.I)
+_GALLERY_IMAGE = re.compile(r"<img\b[^>]*\bsrc=\"[^\"]*/_images/sphx_glr_[^\"]+\.png\"")
+
+
+def site_problems(html_dir: Path) -> list[str]:
+    """What the built site under ``html_dir`` lacks of what the documentation promises.
+
+    A guide page and a gallery page with its figure for every registered system,
+    an API page for every subpackage and top-level module, and every script,
+    style sheet, image and font served by the site itself (none from
+    ``http(s)://`` or ``//``). ``make docs`` runs it after the build.
+    """
+    problems = []
+    if not (html_dir / "index.html").exists():
+        problems.append("index.html missing")
+    for name in SYSTEM_MODULES:
+        guide = get_system(name).guide
+        if not (html_dir / "guide" / f"{guide}.html").exists():
+            problems.append(f"{name}: no guide page guide/{guide}.html (System.guide = {guide!r})")
+        examples = sorted((html_dir / "gallery" / guide).glob("plot_*.html"))
+        if not any(_GALLERY_IMAGE.search(page.read_text(encoding="utf-8")) for page in examples):
+            problems.append(f"{name}: no gallery page with a figure under gallery/{guide}/ "
+                            f"(examples/gallery/{guide}/plot_*.py)")
+    tops = sorted({".".join(module.split(".")[:2]) for module in public_modules()})
+    problems += [f"no API page for {top}" for top in tops
+                 if not (html_dir / "api" / "generated" / f"{top}.html").exists()]
+    for page in sorted(html_dir.rglob("*.html")):
+        if _REMOTE_ASSET.search(page.read_text(encoding="utf-8")):
+            problems.append(f"{page.relative_to(html_dir)}: loads an asset from another site")
+    return problems

@@ -268,39 +268,9 @@ def _copy_mathjax(app, exception) -> None:
         copy_asset(_mathjax_files(), Path(app.outdir) / "_static" / "mathjax")
 
 
-_REMOTE_ASSET = re.compile(r"<(?:script|img|link|iframe|source)\b[^>]*\b(?:src|href)=[\"']?(https?:)?//", re.I)
-_GALLERY_IMAGE = re.compile(r"<img\b[^>]*\bsrc=\"[^\"]*/_images/sphx_glr_[^\"]+\.png\"")
-
-
-def site_problems(html_dir: Path) -> list[str]:
-    """What the built site lacks: a guide page and a gallery page with its figure per system, an API page per
-    subpackage and top-level module, and assets served from the site itself (no ``http(s)://`` script, style,
-    image or font)."""
-    from schuler.registry import SYSTEM_MODULES, get_system
-
-    problems = []
-    if not (html_dir / "index.html").exists():
-        problems.append("index.html missing")
-    for name in SYSTEM_MODULES:
-        guide = get_system(name).guide
-        if not (html_dir / "guide" / f"{guide}.html").exists():
-            problems.append(f"{name}: no guide page guide/{guide}.html (System.guide = {guide!r})")
-        examples = sorted((html_dir / "gallery" / guide).glob("plot_*.html"))
-        if not any(_GALLERY_IMAGE.search(page.read_text(encoding="utf-8")) for page in examples):
-            problems.append(f"{name}: no gallery page with a figure under gallery/{guide}/ "
-                            f"(examples/gallery/{guide}/plot_*.py)")
-    tops = sorted({".".join(module.split(".")[:2]) for module in schuler_api.public_modules()})
-    problems += [f"no API page for {top}" for top in tops
-                 if not (html_dir / "api" / "generated" / f"{top}.html").exists()]
-    for page in sorted(html_dir.rglob("*.html")):
-        if _REMOTE_ASSET.search(page.read_text(encoding="utf-8")):
-            problems.append(f"{page.relative_to(html_dir)}: loads an asset from another site")
-    return problems
-
-
 def _check_site(app, exception) -> None:
     if exception is None and app.builder.name == "html":
-        for problem in site_problems(Path(app.outdir)):
+        for problem in schuler_api.site_problems(Path(app.outdir)):
             logger.warning("site check: %s", problem)
 
 
