@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 OUT ?= results
 
-.PHONY: demo test lint bench docs clean
+.PHONY: demo test test-slow lint bench docs clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -41,9 +41,16 @@ lint: $(VENV)/.installed-test
 
 # one BLAS thread per test process: the models' matrices are small, and two
 # processes already use both cores
+PYTEST := SCHULER_PSINS_IMU="$(PSINS_IMU)" OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2 -q
+
+# the suite without the tests marked slow (long horizons, 1,000-member checks, fuzz per option)
 test: lint
-	@echo "== pytest: the suite (doctests included)"
-	SCHULER_PSINS_IMU="$(PSINS_IMU)" OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2 -q
+	@echo "== pytest: the suite (doctests included; slow tests: make test-slow)"
+	$(PYTEST) -m "not slow"
+
+test-slow: $(VENV)/.installed-test
+	@echo "== pytest: the tests marked slow"
+	$(PYTEST) -m slow
 
 # the site: user guide, gallery (its examples run), API reference; every warning is an error
 docs: $(VENV)/.installed-docs

@@ -9,7 +9,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from schuler.core.earth import MEAN_RADIUS, STANDARD_GRAVITY, schuler_period
-from schuler.core.lti import FinalOutputs, StateSpace, simulate, simulate_reduce, simulate_statistics, zoh_discretize
+from schuler.core.lti import (
+    FinalOutputs,
+    PeakOutputs,
+    StateSpace,
+    simulate,
+    simulate_reduce,
+    simulate_statistics,
+    zoh_discretize,
+)
 from schuler.core.stats import StreamingStatistics
 from schuler.exceptions import InvalidParameter
 
@@ -451,3 +459,14 @@ def test_block_exponentials_equal_exact_steps(problem):
     steps = simulate(system, t, x0, input_series=held).states
     scale = np.maximum(np.abs(steps).max(axis=1, keepdims=True), 1e-300)
     assert np.max(np.abs(blocks - steps) / scale) < 1e-10
+
+
+def test_peak_outputs_keep_the_final_value_and_the_largest_magnitude_of_every_member():
+    rng = np.random.default_rng(5)
+    system = StateSpace([[0.0, 1.0], [-1e-3, 0.0]], [[0.0], [1.0]], states=("x", "v"))
+    t = np.arange(0.0, 600.0, 2.0)
+    x0, u = rng.normal(size=(7, 2)), rng.normal(size=(7, 1))
+    peaks = simulate_reduce(system, t, x0, u, reducer=PeakOutputs(7, 2), chunk_size=3)
+    histories = simulate(system, t, x0, u).outputs
+    np.testing.assert_array_equal(peaks.final, histories[:, -1])
+    np.testing.assert_array_equal(peaks.peak, np.abs(histories).max(axis=1))

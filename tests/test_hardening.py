@@ -69,6 +69,18 @@ def test_a_fifo_is_written_in_place(tmp_path):
     assert received == ["through the pipe"] and stat.S_ISFIFO(fifo.stat().st_mode)
 
 
+def test_a_character_device_is_written_in_place():
+    # /dev/null must stay the device even when the writer runs as root
+    write_text(Path("/dev/null"), "discarded")
+    assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+
+
+def test_a_dash_writes_to_standard_output():
+    script = "from schuler.io import write_text; write_text('-', 'to stdout')"
+    completed = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
+    assert completed.stdout == "to stdout"
+
+
 def test_errors_name_the_users_path_not_the_temporary_file(tmp_path, run_cli):
     locked = tmp_path / "locked"
     locked.mkdir()

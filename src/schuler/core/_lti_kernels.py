@@ -4,6 +4,8 @@
   that changes every step, sequential by nature, for every member.
 * :func:`fill_blocks`: the samples of the block scheme, y = rows Phi^j Psi^b z0,
   which numpy would spread over many small matrix products per member.
+* :func:`final_and_peak`: a reducer's single pass over the histories
+  (numpy would make a temporary |y| and read each history twice).
 
 Everything else (discretisation, balancing, shapes, the choice of method) stays
 in :mod:`schuler.core.propagation`.
@@ -155,3 +157,26 @@ def fill_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray, z0: np.nd
                 following[c] = total
             for c in range(n_moving):
                 start[c] = following[c]
+
+
+@numba.njit(cache=True)
+def final_and_peak(outputs: np.ndarray, final: np.ndarray, peak: np.ndarray) -> None:
+    """Write each member's last sample and its largest magnitude over time, in one pass.
+
+    Parameters
+    ----------
+    outputs : ndarray, shape (k, T, p)
+        Histories (any strides; the engine's are contiguous along T).
+    final, peak : ndarray, shape (k, p)
+        Written: ``outputs[:, -1]`` and ``max_t |outputs[:, t]|``.
+    """
+    members, samples, channels = outputs.shape
+    for i in range(members):
+        for c in range(channels):
+            largest = 0.0
+            for t in range(samples):
+                value = abs(outputs[i, t, c])
+                if value > largest:
+                    largest = value
+            peak[i, c] = largest
+            final[i, c] = outputs[i, samples - 1, c]

@@ -3,12 +3,13 @@
 A reducer is any callable ``reducer(chunk, members)``: ``chunk`` is a batched
 :class:`~schuler.core.response.Response` of shape (k, T, .) holding members
 ``members`` (a slice of range(N)); it keeps what it needs and lets the
-histories go. Two common ones are here.
+histories go. Three common ones are here.
 
 Examples
 --------
 >>> import numpy as np
->>> from schuler.core.response import Response
+>>> from schuler.core._lti_kernels import final_and_peak
+from schuler.core.response import Response
 >>> t = np.array([0.0, 1.0])
 >>> chunk = Response(t, np.zeros((2, 2, 0)), np.array([[[0.0], [1.0]], [[0.0], [3.0]]]), (), ("y",), (), ("m",))
 >>> finals = FinalOutputs(2, 1)
@@ -23,6 +24,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from schuler.core._lti_kernels import final_and_peak
 from schuler.core.response import Response
 from schuler.core.stats import StreamingStatistics
 
@@ -50,6 +52,37 @@ class FinalOutputs:
 
     def __call__(self, chunk: Response, members: slice) -> None:
         self.values[members] = chunk.outputs[:, -1, :]
+
+
+class PeakOutputs:
+    """Every member's final outputs and their largest magnitude over the run (what a Monte Carlo keeps).
+
+    One compiled pass over each chunk's histories.
+
+    Parameters
+    ----------
+    members : int
+        N.
+    n_outputs : int
+        Outputs per member (those passed to the reducer).
+
+    Attributes
+    ----------
+    final : ndarray, shape (N, n_outputs)
+        Outputs at the last time point.
+    peak : ndarray, shape (N, n_outputs)
+        max over time of |output|.
+    """
+
+    def __init__(self, members: int, n_outputs: int):
+        self.final = np.full((members, n_outputs), np.nan)
+        self.peak = np.full((members, n_outputs), np.nan)
+
+    def __call__(self, chunk: Response, members: slice) -> None:
+        k = chunk.outputs.shape[0]
+        final, peak = np.empty((k, self.final.shape[1])), np.empty((k, self.final.shape[1]))
+        final_and_peak(chunk.outputs, final, peak)
+        self.final[members], self.peak[members] = final, peak
 
 
 class OutputStatistics:
