@@ -8,8 +8,7 @@ histories go. Three common ones are here.
 Examples
 --------
 >>> import numpy as np
->>> from schuler.core._lti_kernels import final_and_peak
-from schuler.core.response import Response
+>>> from schuler.core.response import Response
 >>> t = np.array([0.0, 1.0])
 >>> chunk = Response(t, np.zeros((2, 2, 0)), np.array([[[0.0], [1.0]], [[0.0], [3.0]]]), (), ("y",), (), ("m",))
 >>> finals = FinalOutputs(2, 1)
