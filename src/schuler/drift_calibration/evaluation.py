@@ -174,7 +174,13 @@ _INSTRUMENT = ("mode", "positions", "cycles", "pulse_shape", "pulse_duration", "
 
 
 def stabilizer_of(case) -> Stabilizer:
-    """The instrument of a case: H = 0.1 N m s, i = 10 mA and K_M from the pulse rate (K_M / H) i."""
+    """The instrument of a case: H = 0.1 N m s, i = 10 mA and K_M from the pulse rate (K_M / H) i.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     return Stabilizer(
         k1=case["sensor_gain"], torquer_gain=case["pulse_rate"] * ANGULAR_MOMENTUM / PULSE_CURRENT,
         angular_momentum=ANGULAR_MOMENTUM, pulse_current=PULSE_CURRENT, tau=case["pulse_duration"],
@@ -198,7 +204,15 @@ def member_bytes(case) -> int:
 
 
 def check_observable(latitude: np.ndarray, max_latitude: np.ndarray) -> None:
-    """Raise :class:`NotObservable` beyond the latitude limit; warn when the accuracy degrades."""
+    """Raise :class:`NotObservable` beyond the latitude limit; warn when the accuracy degrades.
+
+    Parameters
+    ----------
+    latitude : ndarray
+        Latitude of each case, rad.
+    max_latitude : ndarray
+        The azimuth limit of each case (``--max-latitude``), rad.
+    """
     phi = np.abs(np.asarray(latitude, dtype=float))
     if phi.size == 0:
         return
