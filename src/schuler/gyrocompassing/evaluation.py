@@ -125,7 +125,13 @@ _CASE_FIELDS = ("latitude", "azimuth", "drift_east", "drift_north", "drift_x", "
 
 
 def alignment_case(cases: Cases) -> AlignmentCase:
-    """The :class:`~schuler.gyrocompassing.AlignmentCase` of a batch, random terms drawn for members."""
+    """The :class:`~schuler.gyrocompassing.AlignmentCase` of a batch, random terms drawn for members.
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values; random terms from ``cases.random``).
+    """
     arrays = {name: cases.float(name) for name in _CASE_FIELDS}
     arrays["accel_error_x"] = cases.float("accel_bias_x")
     arrays["accel_error_y"] = cases.float("accel_bias_y")
