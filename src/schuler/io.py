@@ -152,7 +152,7 @@ def smallest_font_px(fig, dpi: float) -> float:
     fig : matplotlib.figure.Figure
         The figure.
     dpi : float
-        Resolution, dots per inch.
+        Resolution, dpi (dots per inch).
     """
     from matplotlib.text import Text
 
