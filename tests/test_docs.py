@@ -65,6 +65,9 @@ def unit_problems(function) -> list[str]:
         return ["no Parameters section"]
     problems, documented = [], set()
     for entry in entries:
+        if entry.name.startswith(">>>"):
+            problems.append("a doctest read as a parameter: put it under an Examples header")
+            continue
         names = [name.strip().lstrip("*") for name in entry.name.split(",")]
         documented.update(names)
         numeric = bool(NUMERIC.search(entry.type)) or not (entry.type.strip() or entry.name.startswith("*"))
@@ -154,6 +157,19 @@ def test_the_unit_check_catches_what_it_should():
     assert unit_problems(no_section) == ["no Parameters section"]
     assert unit_problems(no_unit) == ["latitude: no unit"]
     assert unit_problems(fine) == []
+
+    def doctest_in_parameters(latitude):
+        """A function.
+
+        Parameters
+        ----------
+        latitude : float
+            phi, rad.
+
+        >>> doctest_in_parameters(0.5)
+        """
+
+    assert unit_problems(doctest_in_parameters) == ["a doctest read as a parameter: put it under an Examples header"]
 
 
 def test_the_api_reference_covers_every_package():
