@@ -13,11 +13,14 @@
    random numbers.
 
 The exit code checks what does not depend on the machine's load (memory and
-agreement); speeds are printed beside their targets, measured in this run.
+agreement); speeds are printed beside their targets, measured in this run, with
+the load average before and after and the simulation's CPU time: on a shared
+machine the wall-clock rate falls with the load, the rate per CPU second far less.
 """
 
 from __future__ import annotations
 
+import os
 import resource
 import sys
 import time
@@ -92,20 +95,21 @@ def every_term_model():
     return replace(model, gyro=gyro, accel=accel, name="tactical, every term on")
 
 
-def simulate(workers: int, members: int, length: int) -> float:
+def simulate(workers: int, members: int, length: int) -> tuple[float, float]:
+    """Wall-clock and CPU seconds (all threads) of a simulation of ``members`` x ``length`` samples."""
     truth = static_truth(0.8, 0.3)
     simulator = ImuSimulator(every_term_model(), DT, true_gyro_rad_s=truth[0], true_accel_m_s2=truth[1], seed=7,
                              workers=workers)
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     for _ in iter_simulation(simulator, np.arange(members), length, member_chunk=members):
         pass
-    return time.perf_counter() - start
+    return time.perf_counter() - start, time.process_time() - cpu
 
 
 def bench_simulation() -> float:
     members, length = 8, 1 << 20
     simulate(1, 1, 1 << 16)  # compile and warm the kernels
-    seconds = simulate(2, members, length)
+    seconds, cpu_seconds = simulate(2, members, length)
     rate = members * length / seconds
     # the share of random-number generation, from a single-threaded run with the generator timed
     spent, drawn = [0.0], [0]
@@ -120,7 +124,7 @@ def bench_simulation() -> float:
 
     addressed_random.RandomStreams.normal_series = timed
     try:
-        single = simulate(1, 2, length)
+        single, _ = simulate(1, 2, length)
     finally:
         addressed_random.RandomStreams.normal_series = original
     streams = addressed_random.RandomStreams(3)
@@ -133,6 +137,9 @@ def bench_simulation() -> float:
           f"six-axis sample, which bounds one thread to {normals / per_sample / 1e6:.2f} M six-axis samples/s")
     print(f"  2 workers                    : {seconds:8.2f} s = {rate / 1e6:6.2f} M six-axis samples/s "
           f"(target >= 2)")
+    per_cpu = members * length / cpu_seconds
+    print(f"  2 workers, CPU time          : {cpu_seconds:8.2f} s = {per_cpu / 1e6:6.2f} M six-axis samples per "
+          f"CPU second (two free cores at most {2 * per_cpu / 1e6:.2f} M/s)")
     print(f"  1 worker                     : {2 * length / single / 1e6:6.2f} M six-axis samples/s; random numbers "
           f"{100 * spent[0] / single:.0f} % of the time")
     return rate
@@ -140,11 +147,14 @@ def bench_simulation() -> float:
 
 def main() -> int:
     start = time.perf_counter()
+    print("load average (1, 5, 15 min) at the start: {:.2f}, {:.2f}, {:.2f} on {} cores".format(
+        *os.getloadavg(), os.cpu_count()))
     _, memory = bench_allan_big()
     print(f"  peak resident memory         : {memory:8.2f} GB (target < 1.5 GB)")
     worst, _ = bench_allan_against_allantools()
     bench_simulation()
     print(f"total benchmark time: {time.perf_counter() - start:.0f} s")
+    print("load average (1, 5, 15 min) at the end: {:.2f}, {:.2f}, {:.2f}".format(*os.getloadavg()))
     return 0 if memory < 1.5 and worst <= 1e-12 else 1
 
 

@@ -32,6 +32,7 @@ QUICK = {
     "align": ["--duration", "600"],
     "north": ["--duration", "600"],
     "calibrate": [],
+    "imu": ["--duration", "120"],
 }
 """Options that keep each system's base case short; the fuzzed option comes after them."""
 
@@ -94,7 +95,7 @@ def run_careless(run_cli, system: str, command: str, option: str, value: str, wo
     args = [system, command]
     if command == "run":
         args += QUICK[system]
-    if command in ("identify",):
+    if command in ("identify", "info", "allan"):
         record = workdir / "record.csv"
         record.write_bytes(b"\x00\x01binary\xff\xfe")
         args.append(record)

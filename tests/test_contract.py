@@ -26,7 +26,8 @@ from schuler.study.sweep import run_sweep
 NAMES = list(SYSTEM_MODULES)
 
 MISSPELT = {"errors": ("magnitud", "magnitude"), "vertical": ("latitud", "latitude"),
-            "calibrate": ("latitud", "latitude"), "align": ("latitud", "latitude"), "north": ("latitud", "latitude")}
+            "calibrate": ("latitud", "latitude"), "align": ("latitud", "latitude"), "north": ("latitud", "latitude"),
+            "imu": ("latitud", "latitude")}
 """A misspelt parameter of each system and the name it must suggest (issue 11)."""
 
 LIGHT = {
@@ -35,6 +36,7 @@ LIGHT = {
     "calibrate": {},
     "align": {"duration": 600.0},
     "north": {"duration": 600.0, "readout_noise": math.radians(1 / 3600)},
+    "imu": {"duration": 120.0},
 }
 """SI values that keep a system's default case quick (short durations)."""
 
@@ -44,6 +46,7 @@ VARIATIONS = {
     "calibrate": [{"latitude": math.radians(40.0), "azimuth": math.radians(200.0)}],
     "align": [{"latitude": math.radians(20.0), "drift_east": 1e-7}, {"model": "simplified", "azimuth": 1.0}],
     "north": [{"latitude": math.radians(30.0)}],
+    "imu": [{"grade": "industrial", "azimuth": 1.0}, {"imu_rate": 200.0, "latitude": math.radians(-30.0)}],
 }
 """Further cases per system on which run and evaluate must agree."""
 

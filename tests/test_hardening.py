@@ -134,3 +134,13 @@ def test_sigterm_ends_a_sweep_cleanly(tmp_path):
     assert stderr.strip().splitlines()[-1] == "schuler: error: terminated (SIGTERM); partial files were removed"
     assert "Traceback" not in stderr
     assert not list(out_dir.rglob("*.part"))
+
+
+@pytest.mark.parametrize(
+    "command", [["align", "run"], ["report"], ["sweep", str(EXAMPLES / "align_gyrocompassing.toml")]]
+)
+def test_an_output_folder_named_like_an_option_is_refused(run_cli, tmp_path, command, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = run_cli(*command, "--out", "--help")
+    assert result.code == 2 and "looks like an option" in result.stderr
+    assert not (tmp_path / "--help").exists()

@@ -157,5 +157,6 @@ def test_allan_result_json_keys_and_units():
     gyro_x = data["noise"]["gyro_x"]
     assert {"N", "B", "K", "Q", "R", "tau_s", "adev", "adev_lower", "adev_upper", "edf"} <= set(gyro_x)
     assert len(gyro_x["tau_s"]) == len(gyro_x["adev"])
-    assert data["units"]["noise.gyro_*.N"] == "rad/s^0.5" and data["units"]["noise.accel_*.B"] == "m/s^2"
+    assert data["units"]["N"] == "rad/s^0.5 (gyro_*), m/s^1.5 (accel_*)"
+    assert data["units"]["B"] == "rad/s (gyro_*), m/s^2 (accel_*)"
     assert gyro_x["N"] == pytest.approx(0.125 * math.pi / 180 / 60, rel=0.05)

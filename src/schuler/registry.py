@@ -19,6 +19,7 @@ SYSTEM_MODULES: dict[str, str] = {
     "calibrate": "schuler.drift_calibration.api",
     "align": "schuler.gyrocompassing.api",
     "north": "schuler.ground_gyrocompass.api",
+    "imu": "schuler.imu.api",
 }
 """Command name of each system -> module holding its ``SYSTEM``."""
 
@@ -39,7 +40,7 @@ def get_system(name: str) -> System:
     Traceback (most recent call last):
     ...
     schuler.exceptions.InvalidParameter: system: 'allign' is not a system; did you mean 'align'?
-    choose from errors, vertical, calibrate, align, north
+    choose from errors, vertical, calibrate, align, north, imu
     """
     if name not in SYSTEM_MODULES:
         hint = difflib.get_close_matches(str(name), SYSTEM_MODULES, n=1)

@@ -82,12 +82,20 @@ def options_named(parameters):
         raise type(error)(f"{options[name]}: {rest}") from None
 
 
+def folder_not_option(ctx, param, value: Path | None) -> Path | None:
+    """Refuse a folder named like an option (``--out --help`` would create a folder "--help")."""
+    if value is not None and str(value).startswith("-"):
+        raise click.BadParameter(f"{str(value)!r} looks like an option, not a folder (write ./{value} if meant)")
+    return value
+
+
 json_option = click.option("--json", "as_json", is_flag=True, help="Print a machine-readable JSON result on stdout.")
 out_option = click.option(
     "--out",
     "out_dir",
     type=click.Path(file_okay=False, path_type=Path),
     default=None,
+    callback=folder_not_option,
     help="Folder for figures and data files (created if missing).",
 )
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from schuler import __version__
-from schuler.cli.common import emit, json_option
+from schuler.cli.common import emit, folder_not_option, json_option
 from schuler.registry import SYSTEM_MODULES
 
 _SCENARIO = click.argument("scenario", metavar="SCENARIO.toml", type=click.Path(dir_okay=False, path_type=Path))
@@ -20,6 +20,7 @@ _SCENARIO = click.argument("scenario", metavar="SCENARIO.toml", type=click.Path(
     "--out",
     "out_dir",
     type=click.Path(file_okay=False, path_type=Path),
+    callback=folder_not_option,
     default=None,
     help="Folder for figures and data files (default: the scenario's [outputs] directory, if any).",
 )
@@ -67,6 +68,7 @@ def run_scenario(scenario: Path, out_dir: Path | None, as_json: bool):
     "--out",
     "out_dir",
     type=click.Path(file_okay=False, path_type=Path),
+    callback=folder_not_option,
     required=True,
     help="Folder for results.csv, results.parquet, summary.json, plots and the chunk files. "
     "Re-running into the same folder resumes: finished chunks are skipped.",
@@ -124,6 +126,7 @@ def sweep(scenario, params, monte_carlo, out_dir, scheduler, workers, chunk_size
     "--out",
     "out_dir",
     type=click.Path(file_okay=False, path_type=Path),
+    callback=folder_not_option,
     default=Path("results"),
     show_default=True,
     help="Folder for index.html and its figures.",

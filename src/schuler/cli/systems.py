@@ -1,7 +1,8 @@
 """The command line of every system, generated from its :class:`~schuler.contract.System`.
 
 ``schuler NAME run`` (the system's parameters, ``--monte-carlo``, ``--seed``,
-``--fidelity`` where offered), ``schuler NAME reproduce`` and the system's own
+``--fidelity`` where offered, ``--imu`` where the IMU layer maps to the system:
+:mod:`schuler.imu.instrument`), ``schuler NAME reproduce`` and the system's own
 actions: each parses its options with the system's
 :class:`~schuler.params.ParameterSet`, calls one function of the system and
 hands the result to :func:`~schuler.cli.common.emit`. No numerics here.
@@ -22,6 +23,8 @@ from schuler.cli.common import (
     progress_reporter,
 )
 from schuler.contract import RUN_OPTIONS, Action, System
+from schuler.exceptions import InvalidParameter
+from schuler.imu.instrument import apply_instrument, instrument_options
 from schuler.params import Case, ParameterSet
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
@@ -49,35 +52,58 @@ def _given(case) -> dict:
 
 
 def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fidelity: str | None,
-                out_dir: Path | None, as_json: bool, draw=None) -> None:
-    """What ``schuler NAME run`` and ``schuler run SCENARIO`` do with a parsed case."""
+                out_dir: Path | None, as_json: bool, draw=None, instrument: Case | None = None) -> None:
+    """What ``schuler NAME run`` and ``schuler run SCENARIO`` do with a parsed case.
+
+    ``instrument``: the ``--imu`` options that set part of the case (shown in the JSON inputs).
+    """
     with options_named(system.parameters + RUN_OPTIONS), \
             progress_reporter(f"{system.name} Monte Carlo", enabled=not as_json) as progress:
         result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
                             **_given(case))
     files = system.write_files(result, out_dir) if out_dir is not None else []
     inputs = dict(case)
+    parameters = system.parameters
+    if instrument is not None:
+        inputs.update({name: instrument[name] for name in instrument.given})
+        parameters = parameters + instrument_options(system.name)
     if monte_carlo:
         inputs.update(monte_carlo=monte_carlo, seed=seed)
     if system.fidelities:
         inputs["fidelity"] = system.check_fidelity(fidelity)
-    emit(result, as_json, inputs=inputs, parameters=system.parameters, files=files)
+    emit(result, as_json, inputs=inputs, parameters=parameters, files=files)
+
+
+def _with_instrument(system: System, case: Case, options: Case) -> tuple[Case, Case | None]:
+    """The case with the IMU's values where the user set none (``--imu``); the options if they were used."""
+    if not options.given:
+        return case, None
+    if "imu" not in options.given:
+        extra = sorted(options.given)[0]
+        raise InvalidParameter("--" + extra.replace("_", "-"), "applies with --imu only")
+    with options_named(system.parameters + instrument_options(system.name)):
+        case, _ = apply_instrument(system.name, system.parameters, case, options["imu"],
+                                   window_s=options.get("imu_window"), latitude_rad=options.get("imu_latitude"))
+    return case, options
 
 
 def _run_command(system: System) -> click.Command:
     run_options = ParameterSet(RUN_OPTIONS, owner=system.name)
+    instrument = instrument_options(system.name)  # --imu where the IMU layer maps to the system
 
     def run(out_dir: Path | None, as_json: bool, fidelity: str | None = None, **raw):
         options = run_options.parse({k: raw.pop(k) for k in run_options.names}, labels="option")
+        imu_options = instrument.parse({k: raw.pop(k) for k in instrument.names}, labels="option")
         case = system.parameters.parse(raw, labels="option")
+        case, used = _with_instrument(system, case, imu_options)
         execute_run(system, case, monte_carlo=options["monte_carlo"], seed=options["seed"], fidelity=fidelity,
-                    out_dir=out_dir, as_json=as_json)
+                    out_dir=out_dir, as_json=as_json, instrument=used)
 
     command = click.Command("run", callback=run, context_settings=_CONTEXT,
                             help=f"One case: {system.title}. The headline numbers; figures and data with --out.\n\n"
                                  "Bare numbers are in each option's display unit (shown below); values with "
                                  "units are converted. --monte-carlo N adds N random members around the case.")
-    decorated = parameter_options(system.parameters + RUN_OPTIONS)(command.callback)
+    decorated = parameter_options(system.parameters + RUN_OPTIONS + instrument)(command.callback)
     for param in reversed(getattr(decorated, "__click_params__", [])):
         command.params.append(param)
     if system.fidelities:

@@ -17,5 +17,15 @@ through :mod:`schuler.units`.
 - :mod:`~schuler.imu.characterise`: six-channel analysis, grade, round trip, the PSINS reproduction;
 - :mod:`~schuler.imu.system_inputs`: error model -> parameters of align, calibrate, north, errors;
 - :mod:`~schuler.imu.results`, :mod:`~schuler.imu.plots`: typed results and figures;
+- :mod:`~schuler.imu.static`: latitude and attitude of a record at rest from its mean rates;
 - :mod:`~schuler.imu._kernels`: the numba time loops.
+
+The system on the contract (``schuler imu``):
+
+- :mod:`~schuler.imu.api`: ``SYSTEM``;
+- :mod:`~schuler.imu.evaluation`: parameters, outputs, ``evaluate`` and ``run_case``;
+- :mod:`~schuler.imu.actions`: ``info``, ``allan`` and ``simulate``;
+- :mod:`~schuler.imu.run_results`: what ``run`` and ``simulate`` return and write;
+- :mod:`~schuler.imu.reproduction`: the grade figures round-tripped and the PSINS recording, the report section;
+- :mod:`~schuler.imu.instrument`: ``--imu`` on align, calibrate, north and errors (and ``[instrument]``).
 """

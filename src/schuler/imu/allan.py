@@ -233,7 +233,7 @@ class AllanAccumulator:
         self.samples += chunk.shape[0]
 
     def curves(self, with_confidence: bool = True, max_lag: int | None = None) -> list[AllanCurve]:
-        """One :class:`AllanCurve` per channel, over the lags (up to ``max_lag``) with at least one second difference.
+        """One :class:`AllanCurve` per channel, over the lags (up to ``max_lag``) with a second difference.
 
         Parameters
         ----------
@@ -243,6 +243,7 @@ class AllanAccumulator:
             Largest lag, in samples.
         """
         valid = self._counts[0] > 0
+        offsets = [0.0] * self.channels if self._offsets is None else [float(v) for v in self._offsets]
         if max_lag is not None:
             valid &= self.lags <= max(1, int(max_lag))
         lags = self.lags[valid]
@@ -258,7 +259,7 @@ class AllanAccumulator:
                 edf, lower, upper = (np.full(tau.size, np.nan) for _ in range(3))
             out.append(AllanCurve(tau_s=tau, adev=adev, adev_lower=lower, adev_upper=upper, edf=edf, alpha=alpha,
                                   terms=self._counts[c, valid].copy(), samples=self.samples,
-                                  sample_interval_s=self.dt, offset=float(self._offsets[c])))
+                                  sample_interval_s=self.dt, offset=offsets[c]))
         return out
 
 

@@ -93,7 +93,7 @@ def classify_grade(noise: dict) -> tuple[str | None, dict[str, float]]:
             worst = max(worst, float(np.max(expected / upper)))
         margins[grade] = worst
     consistent = [grade for grade in GRADES if margins[grade] <= GRADE_ALLOWANCE]
-    return (max(consistent, key=margins.get) if consistent else None), margins
+    return (max(consistent, key=margins.__getitem__) if consistent else None), margins
 
 
 def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, kind: str = "rate",
@@ -145,7 +145,7 @@ def analyse_source(source: RecordSource, per_octave: int = 2,
         yield first
         yield from chunks
 
-    return analyse_chunks(all_chunks(), sample_interval_s=source.sample_interval_s,
+    return analyse_chunks(all_chunks(), sample_interval_s=source.interval_s(),
                           expected_samples=source.estimated_samples, kind=source.kind, source=source.path.name,
                           per_octave=per_octave, max_fraction=max_fraction)
 
@@ -155,7 +155,8 @@ def analyse_file(path, per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FR
     return analyse_source(open_record(path, **options), per_octave=per_octave, max_fraction=max_fraction)
 
 
-def _true_terms(errors: SensorErrors, axis: int) -> dict[str, float]:
+def true_terms(errors: SensorErrors, axis: int) -> dict[str, float]:
+    """The IEEE 952 terms a model puts on one axis, SI (B only for flicker: a Gauss-Markov bias has no single B)."""
     return {"Q": errors.quantization[axis], "N": errors.random_walk[axis],
             "B": errors.bias_instability[axis] if errors.gm_sigma[axis] == 0 else 0.0,
             "K": errors.rate_random_walk[axis], "R": 0.0}
@@ -176,7 +177,7 @@ def expected_terms(errors: SensorErrors, axis: int, curve: AllanCurve) -> dict[s
 
 
 def round_trip(model: ErrorModel | str, *, duration_s: float, sample_interval_s: float, seed: int = 0,
-               latitude_rad: float = math.radians(45.0)) -> RoundTripResult:
+               member: int = 0, latitude_rad: float = math.radians(45.0), heading_rad: float = 0.0) -> RoundTripResult:
     """Simulate a record from known terms, identify them, and check each within its tolerance.
 
     Parameters
@@ -185,8 +186,10 @@ def round_trip(model: ErrorModel | str, *, duration_s: float, sample_interval_s:
         A model or a grade name.
     duration_s, sample_interval_s : float
         Record length and dt, s.
-    seed : int
-    latitude_rad : float
+    seed, member : int
+        Address of the record's random numbers.
+    latitude_rad, heading_rad : float
+        Site latitude and heading of the body x axis, rad.
 
     Returns
     -------
@@ -196,13 +199,13 @@ def round_trip(model: ErrorModel | str, *, duration_s: float, sample_interval_s:
     """
     model = preset(model) if isinstance(model, str) else model
     record = simulate_record(model, duration_s=duration_s, sample_interval_s=sample_interval_s, seed=seed,
-                             latitude_rad=latitude_rad)
+                             member=member, latitude_rad=latitude_rad, heading_rad=heading_rad)
     analysis = analyse_record(record)
     checks = []
     for name in CHANNELS:
         errors = model.gyro if sensor_of(name) == "gyro" else model.accel
         axis = "xyz".index(name[-1])
-        truth = _true_terms(errors, axis)
+        truth = true_terms(errors, axis)
         terms = analysis.noise[name].terms
         expected = expected_terms(errors, axis, analysis.noise[name].curve)
         for term in TERMS:
@@ -215,7 +218,7 @@ def round_trip(model: ErrorModel | str, *, duration_s: float, sample_interval_s:
                                     sigma=terms.sigma[term], method_bias=float(method_bias),
                                     tolerance=float(tolerance),
                                     within=bool(abs(identified - truth[term]) <= tolerance)))
-    return RoundTripResult(model=model.name, seed=seed, duration_s=record.duration_s,
+    return RoundTripResult(model=model.name, seed=seed, member=member, duration_s=record.duration_s,
                            sample_interval_s=record.sample_interval_s, checks=checks, analysis=analysis,
                            all_within=all(c.within for c in checks))
 

@@ -230,7 +230,8 @@ class SensorErrors:
             try:
                 value = np.broadcast_to(value, shape).copy()
             except ValueError:
-                raise InvalidParameter(f.name, f"shape {value.shape} does not fit {shape} (one value or one per axis)")
+                raise InvalidParameter(
+                    f.name, f"shape {value.shape} does not fit {shape} (one value or one per axis)") from None
             if not np.all(np.isfinite(value)) or np.any(value < 0):
                 raise InvalidParameter(f.name, f"must be finite and >= 0 (1-sigma magnitudes), got {value.tolist()}")
             if f.name == "gm_correlation_time_s" and np.any(value <= 0):
@@ -254,7 +255,8 @@ class SensorErrors:
         q, n, k = self.quantization[axis], self.random_walk[axis], self.rate_random_walk[axis]
         variance = 3 * q**2 / tau**2 + n**2 / tau + k**2 * tau / 3
         if self.gm_sigma[axis] > 0:
-            variance = variance + gauss_markov_allan_variance(tau, self.gm_sigma[axis], self.gm_correlation_time_s[axis])
+            variance = variance + gauss_markov_allan_variance(
+                tau, self.gm_sigma[axis], self.gm_correlation_time_s[axis])
         if self.bias_instability[axis] > 0:
             for sigma, time in zip(*flicker_terms(self.bias_instability[axis], self.flicker_tau_range_s)):
                 variance = variance + gauss_markov_allan_variance(tau, sigma, time)
@@ -285,7 +287,8 @@ class ErrorModel:
 
     def __post_init__(self):
         if np.any(self.accel.g_sensitivity):
-            raise InvalidParameter("accel.g_sensitivity", "g-sensitivity is a gyro error; leave it 0 for accelerometers")
+            raise InvalidParameter("accel.g_sensitivity",
+                                   "g-sensitivity is a gyro error; leave it 0 for accelerometers")
 
     def scaled(self, factor: float) -> ErrorModel:
         """Every error magnitude times ``factor`` (a first-order check halves them and expects half the effect)."""

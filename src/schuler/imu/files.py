@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from schuler.exceptions import InvalidParameter
 from schuler.imu.native import open_parquet, write_parquet
 from schuler.imu.readers import (
@@ -20,7 +22,7 @@ from schuler.imu.readers import (
     open_psins,
     write_csv,
 )
-from schuler.imu.record import ImuRecord
+from schuler.imu.record import ImuInfo, ImuRecord, info_from_means
 
 
 def open_record(path, **options) -> RecordSource:
@@ -41,6 +43,26 @@ def open_record(path, **options) -> RecordSource:
 def read_record(path, max_memory_bytes: int = DEFAULT_MAX_MEMORY_BYTES, **options) -> ImuRecord:
     """Read an IMU file into memory (see :func:`open_record`); refuses files over ``max_memory_bytes``."""
     return open_record(path, **options).read(max_memory_bytes)
+
+
+def file_info(path, **options) -> ImuInfo:
+    """What an IMU file holds (:class:`~schuler.imu.record.ImuInfo`), streamed: memory bounded by a chunk.
+
+    Every chunk is read and checked (time steps, finite values), so a damaged
+    line is reported wherever it is; ``options`` as for :func:`open_record`.
+    """
+    source = open_record(path, **options)
+    samples, gyro, accel = 0, np.zeros(3), np.zeros(3)
+    for _, g, a in source.chunks():
+        samples += g.shape[0]
+        gyro += g.sum(axis=0)
+        accel += a.sum(axis=0)
+    if samples < 2:
+        raise ImuFileError(source.path, f"a record needs at least 2 samples, the file has {samples}")
+    scale = samples * (source.interval_s() if source.kind == "increment" else 1.0)
+    keys = ("latitude_rad", "longitude_rad", "height_m", "initial_attitude_rad", "gravity_m_s2")
+    return info_from_means(source.path.name, samples, source.kind, source.interval_s(), gyro / scale,
+                           accel / scale, **{k: source.metadata.get(k) for k in keys})
 
 
 def write_record(record: ImuRecord, path) -> Path:

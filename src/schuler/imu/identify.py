@@ -189,7 +189,11 @@ def identify_terms(curve: AllanCurve, terms=TERMS, passes: int = 4) -> NoiseTerm
         covariance[np.ix_(active, active)] = np.linalg.pinv(information[np.ix_(active, active)])
     full = np.linalg.pinv(information)
 
-    values, sigma, upper, resolved, dominant = {}, {}, {}, {}, {}
+    values: dict[str, float] = {}
+    sigma: dict[str, float] = {}
+    upper: dict[str, float] = {}
+    resolved: dict[str, bool] = {}
+    dominant: dict[str, tuple[float, float] | None] = {}
     shares = basis * coefficients / np.maximum(fitted, 1e-300)[:, None]
     index = 0
     for term, used in zip(TERMS, chosen):

@@ -118,7 +118,7 @@ def open_parquet(path) -> RecordSource:
     try:
         handle = pq.ParquetFile(path)
     except Exception as error:  # pyarrow raises several types for a damaged or foreign file
-        raise ImuFileError(path, f"not a Parquet file ({type(error).__name__}: {error})")
+        raise ImuFileError(path, f"not a Parquet file ({type(error).__name__}: {error})") from None
     raw = (handle.schema_arrow.metadata or {}).get(_METADATA_KEY)
     if raw is None:
         raise ImuFileError(path, "a Parquet file without schuler IMU metadata (write it with write_parquet)")

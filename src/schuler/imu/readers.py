@@ -42,9 +42,9 @@ import difflib
 import io
 import math
 import os
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterator
 
 import numpy as np
 
@@ -102,9 +102,8 @@ class RecordSource:
     kind: str
     sample_interval_s: float | None
     estimated_samples: int
+    _chunks: Callable[[int], Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]] = field(repr=False)
     metadata: dict = field(default_factory=dict)
-    _chunks: Callable[[int], Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]] | None = field(
-        default=None, repr=False)
 
     def chunks(self, rows: int = CHUNK_ROWS) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """Yield ``(time_s, gyro, accel)`` chunks of at most ``rows`` samples, checked for continuity."""
@@ -116,6 +115,12 @@ class RecordSource:
             if self.sample_interval_s is None:
                 self.sample_interval_s = checker.dt
             yield time_s, gyro, accel
+
+    def interval_s(self) -> float:
+        """The sample interval, s: stated by the file, or measured once the first chunk is read."""
+        if self.sample_interval_s is None:
+            raise ImuFileError(self.path, "the sample interval is measured from the samples: read a chunk first")
+        return self.sample_interval_s
 
     def estimated_bytes(self) -> int:
         """Memory an in-memory :class:`ImuRecord` of this file needs while being built, bytes."""
@@ -136,7 +141,7 @@ class RecordSource:
             raise ImuFileError(self.path, f"a record needs at least 2 samples, the file has {time_s.size}")
         keys = ("latitude_rad", "longitude_rad", "height_m", "initial_attitude_rad", "gravity_m_s2")
         return ImuRecord(time_s=time_s, gyro=gyro, accel=accel, kind=self.kind,
-                         sample_interval_s=self.sample_interval_s, source=self.path.name,
+                         sample_interval_s=self.interval_s(), source=self.path.name,
                          **{k: self.metadata.get(k) for k in keys})
 
 
@@ -144,7 +149,9 @@ class _TimeCheck:
     """Time stamps must increase by one sample interval: names the line of the first that does not."""
 
     def __init__(self, path, dt: float | None, first_line: int):
-        self.path, self.dt, self.line, self.last = path, dt, first_line, None
+        self.path, self.line = path, first_line
+        self.dt: float | None = dt
+        self.last: float | None = None
 
     def check(self, time_s: np.ndarray) -> None:
         if time_s.size == 0:
@@ -157,6 +164,11 @@ class _TimeCheck:
             self.dt = float(np.median(steps))
             if not self.dt > 0:
                 raise ImuFileError(self.path, "time does not increase", line=self.line, column=1)
+            # a regular chunk's span over its steps is exact to rounding; single differences of
+            # time stamps written as decimals are not (0.02 - 0.01 = 0.009999999999999998...)
+            span = float(series[-1] - series[0]) / steps.size
+            if abs(span - self.dt) <= 1e-6 * self.dt:
+                self.dt = span
         offset = self.line - (0 if self.last is None else 1)  # line of series[0]
         backwards = np.flatnonzero(steps <= 0)
         gaps = np.flatnonzero(steps > 1.5 * self.dt)
@@ -187,7 +199,7 @@ def detect_encoding(path) -> str:
         with open(path, "rb") as handle:
             head = handle.read(1 << 16)
     except OSError as error:
-        raise ImuFileError(path, f"cannot open: {error.strerror or error}")
+        raise ImuFileError(path, f"cannot open: {error.strerror or error}") from None
     if head.startswith(b"\xef\xbb\xbf"):
         return "utf-8-sig"
     if head.startswith((b"\xff\xfe", b"\xfe\xff")) and not head.startswith(b"\xff\xfe\x00\x00"):
@@ -214,7 +226,7 @@ def _decode_guard(path, iterator):
         yield from iterator
     except UnicodeDecodeError as error:
         raise ImuFileError(path, f"not valid text in the detected encoding ({error.reason} at byte "
-                           f"{error.start} of a read block); convert the file to UTF-8")
+                           f"{error.start} of a read block); convert the file to UTF-8") from None
 
 
 def _estimate_rows(path: Path, header_bytes: int, sample_lines: list[str]) -> int:
@@ -245,9 +257,10 @@ def _read_numeric_chunks(path: Path, encoding: str, skip_lines: int, names, sep:
             yield values
             line += len(frame)
     except pd.errors.ParserError as error:
-        raise ImuFileError(path, f"malformed line: {str(error).strip()} (lines counted from the file's start)")
+        raise ImuFileError(
+            path, f"malformed line: {str(error).strip()} (lines counted from the file's start)") from None
     except UnicodeDecodeError as error:
-        raise ImuFileError(path, f"not valid text in {encoding} ({error.reason}); convert the file to UTF-8")
+        raise ImuFileError(path, f"not valid text in {encoding} ({error.reason}); convert the file to UTF-8") from None
     except pd.errors.EmptyDataError:
         return
 
@@ -346,7 +359,8 @@ def _csv_header(path: Path, encoding: str):
                 break
             sample = [line.rstrip("\r\n") for _, line in zip(range(1000), handle)]
         except UnicodeDecodeError as error:
-            raise ImuFileError(path, f"not valid text in {encoding} ({error.reason}); convert the file to UTF-8")
+            raise ImuFileError(
+                path, f"not valid text in {encoding} ({error.reason}); convert the file to UTF-8") from None
     if not header:
         raise ImuFileError(path, "no header line (expected " + ",".join(CSV_HEADER) + ")")
     return header, comments, sample, header_bytes
@@ -445,7 +459,8 @@ def open_psins(path) -> RecordSource:
 
 
 def _psins_header(path: Path, encoding: str):
-    headers, line_number, header_bytes = [], 0, 0
+    headers: list[list[float]] = []
+    line_number, header_bytes = 0, 0
     with _open_text(path, encoding) as handle:
         try:
             for line in handle:
@@ -458,7 +473,7 @@ def _psins_header(path: Path, encoding: str):
                     numbers = [float(v) for v in text.split()]
                 except ValueError:
                     raise ImuFileError(path, f"header line {len(headers) + 1} is not numeric: {text[:60]!r}",
-                                       line=line_number)
+                                       line=line_number) from None
                 if len(numbers) != 6 or not all(math.isfinite(v) for v in numbers):
                     raise ImuFileError(path, f"header line {len(headers) + 1} must hold 6 finite numbers, "
                                        f"it holds {len(numbers)}", line=line_number)
@@ -467,7 +482,8 @@ def _psins_header(path: Path, encoding: str):
                     break
             sample = [line.rstrip("\r\n") for _, line in zip(range(1000), handle)]
         except UnicodeDecodeError as error:
-            raise ImuFileError(path, f"not valid text in {encoding} ({error.reason}); convert the file to UTF-8")
+            raise ImuFileError(
+                path, f"not valid text in {encoding} ({error.reason}); convert the file to UTF-8") from None
     if len(headers) < 3:
         raise ImuFileError(path, f"a PSINS file has 3 numeric header lines, found {len(headers)}")
     return headers, line_number, header_bytes, sample

@@ -213,7 +213,7 @@ class ImuInfo(Result):
     earth_rate_down_rad_s: float | None = None
     initial_attitude_rad: tuple[float, float, float] | None = None
 
-    units = {"mean_gyro_rad_s": "rad/s, body x forward, y right, z down",
+    units = {"samples": "1", "mean_gyro_rad_s": "rad/s, body x forward, y right, z down",
              "mean_accel_m_s2": "m/s^2, specific force, body x forward, y right, z down",
              "earth_rate_horizontal_rad_s": "Omega cos(latitude)",
              "earth_rate_down_rad_s": "-Omega sin(latitude), the NED down component"}
@@ -238,7 +238,8 @@ class ImuInfo(Result):
         table.add_row("|specific force|", f"{self.specific_force_m_s2:.5f} m/s^2")
         if self.latitude_rad is not None:
             table.add_row("site latitude", f"{math.degrees(self.latitude_rad):.6f} deg")
-            table.add_row("Omega cos L (expected horizontal)", f"{to_unit(self.earth_rate_horizontal_rad_s, 'deg/h'):.4f} deg/h")
+            horizontal = to_unit(self.earth_rate_horizontal_rad_s, "deg/h")
+            table.add_row("Omega cos L (expected horizontal)", f"{horizontal:.4f} deg/h")
             table.add_row("-Omega sin L (expected down)", f"{to_unit(self.earth_rate_down_rad_s, 'deg/h'):+.4f} deg/h")
         if self.longitude_rad is not None:
             table.add_row("site longitude", f"{math.degrees(self.longitude_rad):.6f} deg")
@@ -265,25 +266,39 @@ def record_info(record: ImuRecord) -> ImuInfo:
         SI fields; the expected Earth-rate components when the latitude is known
         (Omega = 7.292115e-5 rad/s, WGS-84).
     """
-    gyro = record.gyro_rate_rad_s.mean(axis=0)
-    accel = record.accel_m_s2.mean(axis=0)
-    latitude = record.latitude_rad
+    return info_from_means(record.source, record.samples, record.kind, record.sample_interval_s,
+                           record.gyro_rate_rad_s.mean(axis=0), record.accel_m_s2.mean(axis=0),
+                           latitude_rad=record.latitude_rad, longitude_rad=record.longitude_rad,
+                           height_m=record.height_m, gravity_m_s2=record.gravity_m_s2,
+                           initial_attitude_rad=record.initial_attitude_rad)
+
+
+def info_from_means(source: str, samples: int, kind: str, sample_interval_s: float, mean_gyro_rad_s,
+                    mean_accel_m_s2, **site) -> ImuInfo:
+    """An :class:`ImuInfo` from a record's size and mean rates (what a streamed file gives).
+
+    ``site``: ``latitude_rad``, ``longitude_rad``, ``height_m``, ``gravity_m_s2``,
+    ``initial_attitude_rad`` where known.
+    """
+    gyro = np.asarray(mean_gyro_rad_s, dtype=float)
+    accel = np.asarray(mean_accel_m_s2, dtype=float)
+    latitude = site.get("latitude_rad")
     return ImuInfo(
-        source=record.source,
-        samples=record.samples,
-        kind=record.kind,
-        sample_interval_s=record.sample_interval_s,
-        sample_rate_hz=1.0 / record.sample_interval_s,
-        duration_s=record.duration_s,
-        mean_gyro_rad_s=tuple(float(v) for v in gyro),
-        mean_accel_m_s2=tuple(float(v) for v in accel),
+        source=source,
+        samples=int(samples),
+        kind=kind,
+        sample_interval_s=float(sample_interval_s),
+        sample_rate_hz=1.0 / sample_interval_s,
+        duration_s=round(samples * sample_interval_s, 12),
+        mean_gyro_rad_s=(float(gyro[0]), float(gyro[1]), float(gyro[2])),
+        mean_accel_m_s2=(float(accel[0]), float(accel[1]), float(accel[2])),
         horizontal_gyro_rad_s=float(math.hypot(gyro[0], gyro[1])),
         specific_force_m_s2=float(np.linalg.norm(accel)),
         latitude_rad=latitude,
-        longitude_rad=record.longitude_rad,
-        height_m=record.height_m,
-        gravity_m_s2=record.gravity_m_s2,
+        longitude_rad=site.get("longitude_rad"),
+        height_m=site.get("height_m"),
+        gravity_m_s2=site.get("gravity_m_s2"),
         earth_rate_horizontal_rad_s=None if latitude is None else EARTH_RATE * math.cos(latitude),
         earth_rate_down_rad_s=None if latitude is None else -EARTH_RATE * math.sin(latitude),
-        initial_attitude_rad=record.initial_attitude_rad,
+        initial_attitude_rad=_vector3(site.get("initial_attitude_rad"), "initial_attitude_rad"),
     )

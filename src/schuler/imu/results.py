@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from schuler.imu.allan import AllanCurve
 from schuler.imu.identify import TERMS, NoiseTerms
 from schuler.imu.record import ImuInfo
+from schuler.imu.spec import GRADES
 from schuler.results import Footnotes, Result, json_safe
 
 CHANNELS = ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
@@ -29,6 +30,20 @@ DISPLAY_UNITS = {
     "accel": {"N": "m/s/h^0.5", "B": "ug", "K": "ug/h^0.5", "Q": "mm/s", "R": "ug/h"},
 }
 """Display unit of each term in tables and plots."""
+
+NOISE_UNITS: dict[str, str] = {
+    **{term: f"{TERM_UNITS['gyro'][term]} (gyro_*), {TERM_UNITS['accel'][term]} (accel_*)"
+       for term in ("N", "B", "K", "Q", "R")},
+    "noise.*.sigma.*": "the term's unit", "noise.*.upper_bound.*": "the term's unit",
+    "noise.*.dominant_tau_s.*": "s (first, last)",
+    **{name: "rad/s (gyro_*), m/s^2 (accel_*)" for name in ("adev", "adev_lower", "adev_upper")},
+    "edf": "1", "chi2_per_point": "1",
+}
+"""Units of the ``noise.<channel>`` JSON: each term by its key (N, B, K, Q, R wherever they appear), the curves."""
+
+GRADE_MARGIN_UNITS = {"grade_margin": "1: largest ratio of the grade's Allan deviation to the record's upper bound",
+                      **{grade: "1" for grade in GRADES}}
+"""Units of the ``grade_margin`` JSON (one plain ratio per grade)."""
 
 _SHOWN = {"deg/h^0.5": "deg/√h", "deg/h^1.5": "deg/h/√h", "m/s/h^0.5": "m/s/√h", "ug/h^0.5": "µg/√h", "ug": "µg",
           "ug/h": "µg/h"}
@@ -87,11 +102,7 @@ class AllanResult(Result):
     grade: str | None = None
     grade_margin: dict[str, float] = field(default_factory=dict)
 
-    units = {"noise.gyro_*.N": "rad/s^0.5", "noise.gyro_*.B": "rad/s", "noise.gyro_*.K": "rad/s^1.5",
-             "noise.gyro_*.Q": "rad", "noise.gyro_*.R": "rad/s^2", "noise.accel_*.N": "m/s^1.5",
-             "noise.accel_*.B": "m/s^2", "noise.accel_*.K": "m/s^2.5", "noise.accel_*.Q": "m/s",
-             "noise.accel_*.R": "m/s^3", "noise.*.tau_s": "s", "noise.gyro_*.adev": "rad/s",
-             "noise.accel_*.adev": "m/s^2"}
+    units = {**NOISE_UNITS, **GRADE_MARGIN_UNITS, "samples": "1"}
 
     def to_dict(self) -> dict:
         return {"source": self.source, "samples": self.samples, "sample_interval_s": self.sample_interval_s,
@@ -142,6 +153,11 @@ class TermCheck:
     within: bool
 
 
+CHECK_UNITS = {name: "the SI unit of the check's term (see N, B, K, Q, R)"
+               for name in ("true", "identified", "sigma", "method_bias", "tolerance")}
+"""Units of a round trip's ``checks`` JSON."""
+
+
 @dataclass
 class RoundTripResult(Result):
     """A record simulated from known terms, characterised, and the identified terms beside the true ones.
@@ -160,12 +176,13 @@ class RoundTripResult(Result):
     checks: list[TermCheck] = field(repr=False)
     analysis: AllanResult = field(repr=False)
     all_within: bool = True
+    member: int = 0
 
     def to_dict(self) -> dict:
         return {"model": self.model, "seed": self.seed, "duration_s": self.duration_s,
                 "sample_interval_s": self.sample_interval_s, "all_within": self.all_within,
-                "checks": json_safe(self.checks), "noise": self.analysis.to_dict()["noise"],
-                "units": {"checks.*.true": "SI unit of the term (see noise units)"}}
+                "member": self.member, "checks": json_safe(self.checks), "noise": self.analysis.to_dict()["noise"],
+                "units": {**NOISE_UNITS, **CHECK_UNITS, "seed": "1", "member": "1"}}
 
     def render(self):
         from rich.table import Table

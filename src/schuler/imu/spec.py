@@ -40,6 +40,7 @@ import difflib
 import math
 import tomllib
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -96,7 +97,7 @@ def sensor_errors_from_spec(table: dict, sensor: str) -> SensorErrors:
     units = GYRO_UNITS if sensor == "gyro" else ACCEL_UNITS
     if not isinstance(table, dict):
         raise InvalidParameter(sensor, "must be a table of figures")
-    values = {}
+    values: dict[str, Any] = {}  # SensorErrors fields: arrays, or the flicker range as a pair
     for key, value in table.items():
         if key not in units:
             raise _unknown(key, units, f"{sensor}.")
@@ -161,17 +162,17 @@ def load_spec_file(path) -> ErrorModel:
     try:
         text = path.read_bytes().decode("utf-8-sig")
     except OSError as error:
-        raise ScenarioError(f"{path.name}: cannot read ({error.strerror or error})")
+        raise ScenarioError(f"{path.name}: cannot read ({error.strerror or error})") from None
     except UnicodeDecodeError:
-        raise ScenarioError(f"{path.name}: a spec file must be UTF-8 text")
+        raise ScenarioError(f"{path.name}: a spec file must be UTF-8 text") from None
     try:
         spec = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        raise ScenarioError(f"{path.name}: not valid TOML ({error})")
+        raise ScenarioError(f"{path.name}: not valid TOML ({error})") from None
     try:
         return error_model_from_spec(spec, name=path.stem)
     except InvalidParameter as error:
-        raise InvalidParameter(error.name, f"{error.reason} (in {path.name})")
+        raise InvalidParameter(error.name, f"{error.reason} (in {path.name})") from None
 
 
 PRESET_SPECS: dict[str, dict] = {

@@ -1,10 +1,17 @@
 """From an error model to the inputs of the other systems: one documented mapping, SI values.
 
 Conventions (spec 06, Groves 2013 ch. 14): sensor bias = measured - true, body
-axes x forward, y right, z down; NED navigation frame; a level platform with
+axes x forward, y right, z down; NED navigation frame; a level IMU with
 heading psi has C_b^n = R_z(psi). A **platform drift** is the rotation rate the
-gyro errors give the platform, epsilon = -C_b^n b_g, expressed here as
-east, north and up components (``drift_up`` = -epsilon_down).
+gyro errors give the platform, epsilon = -C b_g (the seeds' "own drift").
+
+**Platform axes.** ``align`` (KPI manual) and ``calibrate`` (pulse method) use
+a level platform frame x, y, z with z up and the azimuth A of the y axis
+clockwise from north (align: U_y = U cos(phi) cos A; calibrate: A0 of the Y
+axis). The IMU is that platform's sensor triad, mounted x forward along the
+platform y axis: platform x = body y (right), platform y = body x (forward),
+platform z = -body z (up). So a platform x accelerometer bias is the body y
+one, and the drift about platform z is -(-b_gz) = +b_gz.
 
 Which bias counts as **residual**: the error left after the system has measured
 what it can. Gyro turn-on biases are what drift calibration (``calibrate``)
@@ -14,18 +21,20 @@ difference of two consecutive averages over ``window_s`` is sqrt(2) times the
 Allan deviation of the slow terms (flicker B, Gauss-Markov, K; white noise N and
 quantisation Q average out and enter separately as random walk). Accelerometer
 turn-on biases stay: at rest a bias is indistinguishable from a tilt, so nothing
-before navigation removes it.
+before navigation removes it. ``calibrate`` itself gets the whole turn-on bias:
+that is the drift it is there to measure.
 
 Values and sigmas: ``values`` is one representative case, every body-axis
-error at +1 sigma, resolved into the frames the system uses; ``sigmas`` are the
-1-sigma spreads for Monte Carlo draws (independent axes).
+error at +1 sigma, resolved into the frames the system uses, plus the
+system's Monte Carlo sigmas where it has them (``sigma_drift`` ...);
+``sigmas`` are the 1-sigma spreads of the error values (independent axes).
 
 Examples
 --------
 >>> from schuler.imu.spec import preset
 >>> inputs = calibrate_inputs(preset("tactical"))
->>> round(inputs.values["drift_x"] / 4.84813681109536e-06, 6)   # 1 deg/h
-1.0
+>>> round(inputs.values["drift_x"] / 4.84813681109536e-06, 6)   # -(1 deg/h): drift = -bias
+-1.0
 """
 
 from __future__ import annotations
@@ -55,9 +64,11 @@ class SystemInputs(Result):
     model : str
         The error model's name.
     values : dict
-        Parameter name -> SI value (one representative +1-sigma case).
+        Parameter name -> SI value (one representative +1-sigma case, and the
+        system's Monte Carlo sigmas where it has them); for ``errors``, source
+        name -> magnitude.
     sigmas : dict
-        Parameter name -> 1-sigma for Monte Carlo (random quantities only).
+        Name -> 1-sigma spread of the error value (random quantities only).
     parameter_units : dict
         Parameter name -> SI unit.
     notes : list of str
@@ -85,9 +96,9 @@ class SystemInputs(Result):
         return table
 
 
-def _check_window(window_s: float) -> float:
+def _check_window(window_s: float, name: str = "window") -> float:
     if not (math.isfinite(window_s) and window_s > 0):
-        raise InvalidParameter("window", f"must be finite and > 0 s, got {window_s!r}")
+        raise InvalidParameter(name, f"must be finite and > 0 s, got {window_s!r}")
     return float(window_s)
 
 
@@ -117,15 +128,20 @@ def _level_rotation(heading_rad: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def _horizontal_rms(values: np.ndarray) -> float:
+    """One figure for the two horizontal axes: sqrt((v_x^2 + v_y^2) / 2)."""
+    return float(math.sqrt((values[0] ** 2 + values[1] ** 2) / 2.0))
+
+
 def align_inputs(model: ErrorModel, *, heading_rad: float = 0.0, window_s: float = DEFAULT_WINDOW_S,
                  calibrated_gyros: bool = True) -> SystemInputs:
-    """``align`` (gyrocompassing) inputs: residual platform drifts and accelerometer biases.
+    """``align`` (gyrocompassing) inputs: residual platform drifts, accelerometer biases and their sigmas.
 
     Parameters
     ----------
     model : ErrorModel
     heading_rad : float
-        Heading of the body x axis, rad (the platform is level).
+        Heading of the body x axis, rad: align's azimuth A of the platform y axis.
     window_s : float
         Time between the gyro calibration and the alignment, s.
     calibrated_gyros : bool
@@ -134,57 +150,71 @@ def align_inputs(model: ErrorModel, *, heading_rad: float = 0.0, window_s: float
     Returns
     -------
     SystemInputs
-        ``drift_east``, ``drift_north``, ``drift_up`` (rad/s), epsilon = -C_b^n b_g
-        for b_g = +1 sigma on each axis; ``accel_bias_x``, ``accel_bias_y`` (m/s^2,
-        platform axes = body x, y): turn-on bias and its change over the window.
+        ``drift_east``, ``drift_north`` (rad/s): epsilon = -C_b^n b_g for b_g at
+        +1 sigma on each axis, NED east and north components; ``drift_z`` (rad/s,
+        platform z = up): -epsilon_down = +b_gz; ``accel_bias_x``, ``accel_bias_y``
+        (m/s^2, platform x = body y, platform y = body x): turn-on bias and its
+        change over the window; ``sigma_drift`` (rms of the horizontal residual
+        drifts), ``sigma_drift_z`` and ``sigma_accel`` (rms of the two horizontal
+        accelerometers) for align's Monte Carlo.
     """
     gyro = residual_bias(model.gyro, window_s, include_turn_on=not calibrated_gyros)
     accel = residual_bias(model.accel, window_s, include_turn_on=True)
     rotation = _level_rotation(heading_rad)
     drift_ned = -rotation @ gyro
     spread_ned = np.sqrt((rotation**2) @ gyro**2)
-    values = {"drift_east": float(drift_ned[1]), "drift_north": float(drift_ned[0]), "drift_up": float(-drift_ned[2]),
-              "accel_bias_x": float(accel[0]), "accel_bias_y": float(accel[1])}
-    sigmas = {"drift_east": float(spread_ned[1]), "drift_north": float(spread_ned[0]), "drift_up": float(spread_ned[2]),
-              "accel_bias_x": float(accel[0]), "accel_bias_y": float(accel[1])}
-    units = {k: "rad/s" for k in ("drift_east", "drift_north", "drift_up")}
-    units.update(accel_bias_x="m/s^2", accel_bias_y="m/s^2")
-    notes = [f"drift = -C_b^n b_g with b_g at +1 sigma, heading {math.degrees(heading_rad):g} deg",
+    values = {"drift_east": float(drift_ned[1]) + 0.0, "drift_north": float(drift_ned[0]) + 0.0,
+              "drift_z": float(-drift_ned[2]) + 0.0,  # + 0.0: no negative zero in tables and JSON
+              "accel_bias_x": float(accel[1]), "accel_bias_y": float(accel[0]),
+              "sigma_drift": _horizontal_rms(gyro), "sigma_drift_z": float(gyro[2]),
+              "sigma_accel": _horizontal_rms(accel)}
+    sigmas = {"drift_east": float(spread_ned[1]), "drift_north": float(spread_ned[0]), "drift_z": float(gyro[2]),
+              "accel_bias_x": float(accel[1]), "accel_bias_y": float(accel[0])}
+    units = {name: "rad/s" for name in ("drift_east", "drift_north", "drift_z", "sigma_drift", "sigma_drift_z")}
+    units.update(accel_bias_x="m/s^2", accel_bias_y="m/s^2", sigma_accel="m/s^2")
+    notes = [f"drift = -C_b^n b_g with b_g at +1 sigma, heading (align's azimuth) {math.degrees(heading_rad):g} deg",
              f"gyro turn-on bias {'removed by calibration' if calibrated_gyros else 'kept'}; change over "
              f"{window_s:g} s = sqrt(2) x slow-term Allan deviation",
-             "accelerometer turn-on bias kept (indistinguishable from tilt at rest)"]
+             "accelerometer turn-on bias kept (indistinguishable from tilt at rest); platform x, y = body y, x"]
     return SystemInputs("align", model.name, values, sigmas, units, notes)
 
 
 def calibrate_inputs(model: ErrorModel) -> SystemInputs:
-    """``calibrate`` (pulse drift calibration) inputs: the X gyro's drift to measure and its angle random walk.
+    """``calibrate`` (pulse drift calibration) inputs: the drifts to measure and the gyros' angle random walk.
 
-    ``drift_x`` (rad/s) is the 1-sigma turn-on bias of the x gyro (what the
-    procedure estimates); ``angle_random_walk`` (rad/sqrt(s)) is its N.
+    ``drift_x``, ``drift_y`` (rad/s) are the own drifts -b_g of the platform X
+    (= body y) and Y (= body x) gyros for the 1-sigma turn-on bias: what the
+    procedure estimates; ``angle_random_walk`` (rad/sqrt(s)) is the rms of
+    their N.
     """
-    values = {"drift_x": float(model.gyro.bias[0]), "angle_random_walk": float(model.gyro.random_walk[0])}
-    return SystemInputs("calibrate", model.name, values, {"drift_x": float(model.gyro.bias[0])},
-                        {"drift_x": "rad/s", "angle_random_walk": "rad/s^0.5"},
-                        ["drift_x: 1-sigma turn-on bias of the x gyro (calibration estimates it)"])
+    bias, walk = model.gyro.bias, model.gyro.random_walk
+    values = {"drift_x": float(-bias[1]), "drift_y": float(-bias[0]), "angle_random_walk": _horizontal_rms(walk)}
+    return SystemInputs("calibrate", model.name, values, {"drift_x": float(bias[1]), "drift_y": float(bias[0])},
+                        {"drift_x": "rad/s", "drift_y": "rad/s", "angle_random_walk": "rad/s^0.5"},
+                        ["drift = -b_g for the 1-sigma turn-on bias (calibration estimates it); "
+                         "platform X, Y = body y, x"])
 
 
 def north_inputs(model: ErrorModel, *, step_s: float) -> SystemInputs:
-    """``north`` (ground gyrocompass) input: the read-out noise of one azimuth observation, rad.
+    """``north`` (ground gyrocompass) input: ``readout_noise``, the noise of one azimuth observation, rad.
 
     An angle obtained by integrating the rate over a sample step h carries the
     angle random walk N sqrt(h) and the angle quantisation Q (IEEE 952, white
     angle noise of standard deviation Q): noise = sqrt(Q^2 + N^2 h) (z gyro, the
     azimuth axis).
     """
-    step_s = _check_window(step_s)
+    step_s = _check_window(step_s, "output_step")
     q, n = model.gyro.quantization[2], model.gyro.random_walk[2]
     noise = float(math.sqrt(q**2 + n**2 * step_s))
-    return SystemInputs("north", model.name, {"noise": noise}, {"noise": noise}, {"noise": "rad"},
-                        [f"sqrt(Q^2 + N^2 h) of the z gyro at h = {step_s:g} s"])
+    return SystemInputs("north", model.name, {"readout_noise": noise}, {"readout_noise": noise},
+                        {"readout_noise": "rad"}, [f"sqrt(Q^2 + N^2 h) of the z gyro at h = {step_s:g} s"])
 
 
 def errors_inputs(model: ErrorModel, *, latitude_rad: float, window_s: float = DEFAULT_WINDOW_S) -> SystemInputs:
-    """``errors`` (Schuler-loop navigation errors) inputs: the five sources' 1-sigma magnitudes, SI.
+    """``errors`` (Schuler-loop navigation errors) inputs: each source's 1-sigma magnitude, SI, keyed by source.
+
+    ``errors`` takes one source and its ``magnitude``; the caller picks the
+    value of the source it runs.
 
     * ``drift`` (rad/s): residual horizontal gyro drift (rms of x and y, see :func:`residual_bias`);
     * ``accelerometer`` (m/s^2): horizontal accelerometer bias (rms of x and y, turn-on kept);
@@ -196,9 +226,9 @@ def errors_inputs(model: ErrorModel, *, latitude_rad: float, window_s: float = D
     latitude_rad = _check_latitude(latitude_rad)
     gyro = residual_bias(model.gyro, window_s, include_turn_on=False)
     accel = residual_bias(model.accel, window_s, include_turn_on=True)
-    drift = float(math.sqrt((gyro[0] ** 2 + gyro[1] ** 2) / 2.0))
-    bias = float(math.sqrt((accel[0] ** 2 + accel[1] ** 2) / 2.0))
-    azimuth = math.hypot(drift / (EARTH_RATE * math.cos(latitude_rad)), bias * math.tan(latitude_rad) / STANDARD_GRAVITY)
+    drift, bias = _horizontal_rms(gyro), _horizontal_rms(accel)
+    azimuth = math.hypot(drift / (EARTH_RATE * math.cos(latitude_rad)),
+                         bias * math.tan(latitude_rad) / STANDARD_GRAVITY)
     values = {"tilt": bias / STANDARD_GRAVITY, "velocity": 0.0, "accelerometer": bias, "drift": drift,
               "azimuth": float(azimuth)}
     units = {"tilt": "rad", "velocity": "m/s", "accelerometer": "m/s^2", "drift": "rad/s", "azimuth": "rad"}

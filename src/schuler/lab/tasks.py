@@ -27,7 +27,7 @@ from dash.exceptions import PreventUpdate
 
 from schuler.contract import System
 from schuler.exceptions import SchulerError
-from schuler.gyrocompassing.study import MAX_BETA, MAX_DELTA, MAX_DELTA_RATE
+from schuler.gyrocompassing.simulation import MAX_BETA, MAX_DELTA, MAX_DELTA_RATE
 from schuler.lab import figures, manual, views
 from schuler.lab.controls import controls, error_owner, parse_typed, typed_values
 from schuler.lab.system_page import POLL_MS, internal_error

@@ -28,6 +28,11 @@ as the command-line options (underscores instead of dashes)::
     [monte_carlo.uniform]   # two values: lower and upper end
     latitude = ["40 deg", "60 deg"]
 
+    [instrument]        # optional, align, calibrate, north and errors: an IMU sets the
+    imu = "tactical"    # instrument parameters the file does not set (like --imu): a grade,
+    imu_window = "10 min"   # a TOML spec or a recording (paths relative to the scenario's
+                        # folder); imu_window, imu_latitude as the options of that name
+
 The file is validated against a schema built from the system's
 :class:`~schuler.params.Parameter` definitions, with unknown keys forbidden.
 Every problem raises :class:`~schuler.exceptions.ScenarioError` with one line
@@ -38,7 +43,7 @@ Examples
 >>> parse_scenario('system = "compass"', source="s.toml")
 Traceback (most recent call last):
 ...
-schuler.exceptions.ScenarioError: s.toml: system: 'compass' is not one of errors, vertical, calibrate, align, north
+schuler.exceptions.ScenarioError: s.toml: system: 'compass' is not one of errors, vertical, calibrate, align, north, imu
 """
 
 from __future__ import annotations
@@ -66,6 +71,7 @@ from scipy.special import ndtri
 from schuler.contract import System
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter, ScenarioError
+from schuler.imu.instrument import apply_instrument, instrument_options
 from schuler.params import Case, Parameter
 from schuler.registry import SYSTEM_MODULES, get_system
 from schuler.study.systems import load_system
@@ -194,6 +200,8 @@ class Scenario:
         The ``[simulation] fidelity`` (None: the system's default).
     source : str
         Where the scenario came from (file name), used in messages.
+    instrument : dict
+        The ``[instrument]`` table as written (its values are already in ``values``).
     """
 
     system: str
@@ -206,6 +214,7 @@ class Scenario:
     monte_carlo: MonteCarlo | None = None
     fidelity: str | None = None
     source: str = "<scenario>"
+    instrument: dict[str, Any] = field(default_factory=dict)
 
     def definition(self) -> System:
         """The :class:`~schuler.registry.System` this scenario runs."""
@@ -302,6 +311,16 @@ def scenario_model(system: System) -> type[ScenarioTables]:
         "simulation": (simulation_table | None, None),
         "monte_carlo": (monte_carlo_table | None, None),
     }
+    instrument = instrument_options(system.name)
+    if len(instrument):
+        instrument_fields: dict[str, Any] = {spec.name: (Value | None, None) for spec in instrument}
+        instrument_fields["imu"] = (StrictStr, ...)
+        checked = {spec.name: spec for spec in instrument if spec.name != "imu"}
+        instrument_table = create_model(
+            f"{system.name}_instrument", __config__=_STRICT,
+            __validators__=_validators(checked, {k: v for k, v in instrument_fields.items() if k != "imu"}),
+            **instrument_fields)
+        narrowed["instrument"] = (instrument_table | None, None)
     return create_model(f"{system.name}_scenario", __base__=ScenarioTables, **narrowed)
 
 
@@ -325,6 +344,7 @@ _TABLE_TITLES = {
     "simulation": "[simulation]",
     "outputs": "[outputs]",
     "monte_carlo": "[monte_carlo]",
+    "instrument": "[instrument]",
 }
 
 
@@ -394,6 +414,11 @@ def _build(parsed: ScenarioTables, system: System, source: str) -> Scenario:
         values = system.parameters.parse(written)
     except InvalidParameter as error:
         raise ScenarioError(f"{source}: [parameters] {error}") from None
+    instrument = getattr(parsed, "instrument", None)
+    instrument_written = {} if instrument is None else {k: v for k, v in instrument.model_dump().items()
+                                                        if v is not None}
+    if instrument_written:
+        values = _with_instrument(system, values, instrument_written, source)
     outputs = parsed.outputs or OutputsTable()
     return Scenario(
         system=system.name,
@@ -406,7 +431,22 @@ def _build(parsed: ScenarioTables, system: System, source: str) -> Scenario:
         monte_carlo=_monte_carlo(parsed.monte_carlo, specs, source),
         fidelity=fidelity,
         source=source,
+        instrument=instrument_written,
     )
+
+
+def _with_instrument(system: System, values: Case, written: dict[str, Any], source: str) -> Case:
+    """``values`` with the ``[instrument]`` IMU's parameters where the file sets none (as ``--imu`` does)."""
+    options = instrument_options(system.name)
+    folder = Path(source).parent if Path(source).is_file() else None
+    try:
+        parsed = options.parse(written)
+        case, _ = apply_instrument(system.name, system.parameters, values, parsed["imu"],
+                                   window_s=parsed.get("imu_window"), latitude_rad=parsed.get("imu_latitude"),
+                                   base=folder)
+    except (InvalidParameter, ScenarioError) as error:
+        raise ScenarioError(f"{source}: [instrument] {error}") from None
+    return case
 
 
 def _monte_carlo(table, specs: dict[str, Parameter], source: str) -> MonteCarlo | None:

@@ -1,0 +1,184 @@
+"""The ``schuler imu`` commands beyond ``run`` and ``reproduce``: ``info``, ``allan`` and ``simulate``.
+
+Each is a function of validated SI values (and the file paths) returning a
+typed result; :data:`ACTIONS` declares them for the command line.
+
+* ``info FILE``: what a file holds (:class:`~schuler.imu.record.ImuInfo`), streamed
+  chunk by chunk, so any size is read in bounded memory; every line is checked.
+* ``allan FILE``: Allan curves and IEEE 952 terms of the six channels
+  (:class:`~schuler.imu.results.AllanResult`), streamed; the memory it holds
+  (the longest lag's angles per channel) is estimated and refused beyond the budget first.
+* ``simulate -o FILE``: a record of a grade or spec file at rest; ``.parquet``
+  is written window by window (memory bounded), ``.csv`` in memory after an
+  estimate; either appears atomically.
+
+CSV files: the project's header (rates, SI) unless ``--columns`` maps each
+channel to the file's column and ``--units`` gives their units
+(``--units gyro=deg/s,accel=g,time=ms``; ``gyro`` and ``accel`` stand for
+their three axes), ``--kind increment`` for angle and velocity increments,
+``--axes`` where the file's axes point (``RFU``: x right, y forward, z up).
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+from schuler.contract import Action, Argument
+from schuler.exceptions import InvalidParameter
+from schuler.imu.characterise import analyse_source
+from schuler.imu.evaluation import PARAMETERS, case_model, sample_interval
+from schuler.imu.files import file_info, open_record, write_record
+from schuler.imu.readers import CHANNELS, CHUNK_ROWS
+from schuler.imu.record import KINDS, ImuInfo
+from schuler.imu.results import AllanResult
+from schuler.imu.run_results import SimulationResult
+from schuler.imu.simulate import simulate_record, write_simulation
+from schuler.memory import require
+from schuler.params import Parameter, ParameterSet
+
+ALLAN_BYTES_PER_SAMPLE = 32
+"""Memory an Allan analysis holds per sample of the file: six channels' angles over twice the longest lag
+(1/8 of the samples), and their copy while a chunk is added, bytes."""
+
+CHUNK_BYTES = CHUNK_ROWS * 7 * 8 * 4
+"""Memory one chunk of a file holds while read and converted, bytes."""
+
+CSV_BYTES_PER_SAMPLE = 600
+"""Memory a simulated record written as CSV holds per sample: the simulation, the table and its text, bytes."""
+
+PARQUET_BYTES_PER_SAMPLE = 56
+"""Disk a native file takes per sample: seven float64 columns, bytes (before compression)."""
+
+CSV_FILE_BYTES_PER_SAMPLE = 180
+"""Disk a CSV file takes per sample: seven numbers of 17 significant digits and their separators, bytes."""
+
+FILE_ARGUMENT = Argument("file", "IMU file: the project's CSV (or any CSV with --columns and --units), PSINS .imu, "
+                                 "or .parquet")
+
+CSV_OPTIONS = (
+    Parameter("kind", "", None, "CSV only: what the sensor columns hold (not set: rate).", choices=KINDS,
+              kind="choice"),
+    Parameter("axes", "", None, "CSV only: where the file's x, y, z axes point, three of F B R L D U (not set: FRD).",
+              kind="text"),
+    Parameter("columns", "", None, "CSV only: the file's column of each channel, e.g. 'time=t,gyro_x=wx,gyro_y=wy,"
+              "gyro_z=wz,accel_x=ax,accel_y=ay,accel_z=az' (not set: the project's header).", kind="text"),
+    Parameter("units", "", None, "CSV only: units of the columns, e.g. 'gyro=deg/s,accel=g,time=ms' (gyro and accel "
+              "set their three axes; not set: s, rad/s, m/s^2).", kind="text"),
+    Parameter("latitude", "deg", None, "CSV only: site latitude (a CSV file does not carry it).", minimum=-90,
+              maximum=90),
+)
+
+INFO_PARAMETERS = ParameterSet(CSV_OPTIONS, owner="imu info")
+ALLAN_PARAMETERS = ParameterSet((*CSV_OPTIONS, Parameter(
+    "per_octave", "", 2, "Averaging times per octave of tau.", minimum=1, maximum=16, kind="integer")),
+    owner="imu allan")
+SIMULATE_PARAMETERS = PARAMETERS + ParameterSet((Parameter(
+    "seed", "", 0, "Seed of the record's random numbers.", minimum=0, kind="integer"),))
+
+
+def _pairs(text: str, name: str) -> dict[str, str]:
+    pairs = {}
+    for part in (p.strip() for p in text.split(",")):
+        key, equals, value = part.partition("=")
+        if not equals or not key.strip() or not value.strip():
+            raise InvalidParameter(name, f"{part!r} is not channel=value; write e.g. 'gyro=deg/s,accel=g'")
+        pairs[key.strip()] = value.strip()
+    return pairs
+
+
+def csv_options(file: Path, kind=None, axes=None, columns=None, units=None, latitude=None) -> dict:
+    """The keyword options of :func:`~schuler.imu.readers.open_csv` the user set; refused for other formats."""
+    given = [name for name, value in (("kind", kind), ("axes", axes), ("columns", columns), ("units", units),
+                                      ("latitude", latitude)) if value not in (None, "")]
+    suffix = Path(file).suffix.lower()
+    if given and suffix in (".imu", ".parquet"):
+        raise InvalidParameter(given[0], f"applies to CSV files only; {Path(file).name} is {suffix} and states its "
+                               "own layout")
+    options: dict = {}
+    if kind is not None:
+        options["kind"] = kind
+    if axes:
+        options["axes"] = axes
+    if columns:
+        options["columns"] = _pairs(columns, "columns")
+    if units:
+        written = _pairs(units, "units")
+        expanded = {}
+        for key, unit in written.items():
+            targets = [f"{key}_{axis}" for axis in "xyz"] if key in ("gyro", "accel") else [key]
+            unknown = [t for t in targets if t not in ("time", *CHANNELS)]
+            if unknown:
+                raise InvalidParameter("units", f"unknown channel {key!r}; channels are time, gyro, accel, "
+                                       + ", ".join(CHANNELS))
+            expanded.update({target: unit for target in targets})
+        options["units"] = expanded
+    if latitude is not None:
+        options["latitude_rad"] = latitude
+    return options
+
+
+def info(file: Path, **options) -> ImuInfo:
+    """What an IMU file holds: samples, rate, duration, mean rates (body x forward, y right, z down), site."""
+    return file_info(file, **csv_options(file, **options))
+
+
+def allan(file: Path, per_octave: int = 2, **options) -> AllanResult:
+    """Allan deviation with confidence intervals and IEEE 952 terms of the six channels of a file, streamed."""
+    source = open_record(file, **csv_options(file, **options))
+    require(source.estimated_samples * ALLAN_BYTES_PER_SAMPLE + CHUNK_BYTES, "this Allan analysis",
+            "the file (analyse a part of it)")
+    return analyse_source(source, per_octave=per_octave)
+
+
+def simulate(output: Path, grade=None, spec=None, duration=3600.0, imu_rate=100.0, output_step=None,
+             latitude=math.radians(45.0), azimuth=0.0, seed: int = 0) -> SimulationResult:
+    """Simulate a record of a grade or spec file at rest into ``output`` (.parquet streamed, .csv in memory)."""
+    output = Path(output)
+    suffix = output.suffix.lower()
+    if suffix not in (".parquet", ".csv"):
+        raise InvalidParameter("--output", f"{output.name}: write .parquet (native, streamed) or .csv")
+    model = case_model(grade, spec)
+    dt = sample_interval(imu_rate, output_step)
+    samples = int(round(duration / dt))
+    if samples < 2:
+        raise InvalidParameter("duration", f"{duration:g} s at {dt:g} s per sample gives fewer than 2 samples")
+    folder = output.resolve().parent
+    folder.mkdir(parents=True, exist_ok=True)
+    needed_disk = samples * (PARQUET_BYTES_PER_SAMPLE if suffix == ".parquet" else CSV_FILE_BYTES_PER_SAMPLE)
+    free = shutil.disk_usage(folder).free
+    if needed_disk > free:
+        raise InvalidParameter("duration", f"the file would take about {needed_disk / 1e9:.3g} GB, more than the "
+                               f"{free / 1e9:.3g} GB free in {folder}")
+    site = {"latitude_rad": latitude, "heading_rad": azimuth}
+    if suffix == ".parquet":
+        write_simulation(output, model, duration_s=samples * dt, sample_interval_s=dt, seed=seed, **site)
+    else:
+        require(samples * CSV_BYTES_PER_SAMPLE, "this CSV file", "--duration or --imu-rate (or write .parquet, which "
+                                                                 "streams)")
+        record = simulate_record(model, duration_s=samples * dt, sample_interval_s=dt, seed=seed,
+                                 max_memory_bytes=samples * CSV_BYTES_PER_SAMPLE, **site)
+        write_record(record, output)
+    return SimulationResult(path=str(output), model=model.name, model_source=model.source, samples=samples,
+                            duration_s=samples * dt, sample_interval_s=dt, seed=seed, latitude_rad=latitude,
+                            azimuth_rad=azimuth, file_size_bytes=output.stat().st_size, files=[output])
+
+
+ACTIONS = (
+    Action("info", "What an IMU file holds: samples, rate, duration, mean rates and site.\n\n"
+                   "Mean rates are body-frame, x forward, y right, z down; at rest they show the Earth rate and "
+                   "-g on z. The file is read chunk by chunk (any size) and every line is checked.",
+           info, INFO_PARAMETERS, arguments=(FILE_ARGUMENT,)),
+    Action("allan", "Allan deviation and IEEE 952 noise terms of the six channels of an IMU file.\n\n"
+                    "Overlapping Allan deviation with confidence intervals, the terms N, B, K, Q, R by weighted "
+                    "least squares (unresolved ones as upper bounds), and the grade the gyro curves belong to. "
+                    "--out writes the figures and the curves (CSV).",
+           allan, ALLAN_PARAMETERS, arguments=(FILE_ARGUMENT,)),
+    Action("simulate", "Simulate a record of an IMU at rest from a grade or a TOML spec file.\n\n"
+                       "Body frame x forward, y right, z down, level, heading --azimuth; rates in SI. .parquet is "
+                       "written window by window (any length); .csv is built in memory.",
+           simulate, SIMULATE_PARAMETERS,
+           output_file="Output file: .parquet (native, streamed) or .csv (the project's format)."),
+)
+"""The IMU system's own commands."""

@@ -1,0 +1,46 @@
+"""The IMU layer on the contract: ``SYSTEM`` (``schuler imu``).
+
+Sources: the grade presets' data sheets (:mod:`~schuler.imu.spec`), IEEE Std
+952-1997 Annex C for the Allan-variance terms, the PSINS toolbox's
+``lasergyro.imu`` for the real recording. The pieces:
+:mod:`~schuler.imu.evaluation` (parameters, outputs, ``evaluate``,
+``run_case``), :mod:`~schuler.imu.reproduction` (``reproduce``, ``report``),
+:mod:`~schuler.imu.run_results` (the result types and ``write_files``),
+:mod:`~schuler.imu.actions` (``info``, ``allan``, ``simulate``).
+
+Examples
+--------
+>>> r = SYSTEM.run(grade="consumer", duration=600.0)
+>>> r.to_dict()["noise"]["gyro_x"]["N"] > 0, r.round_trip.all_within
+(True, True)
+"""
+
+from __future__ import annotations
+
+from schuler.contract import System
+from schuler.imu.actions import ACTIONS
+from schuler.imu.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case
+from schuler.imu.reproduction import REPRODUCE_PARAMETERS, report, reproduce
+from schuler.imu.run_results import write_files
+
+SYSTEM = System(
+    name="imu",
+    title="IMU recordings, spec-sheet error models and Allan variance",
+    reference="IEEE Std 952-1997, \"IEEE Standard Specification Format Guide and Test Procedure for Single-Axis "
+              "Interferometric Fiber Optic Gyros\", Annex C, 1998; N. El-Sheimy, H. Hou, X. Niu, \"Analysis and "
+              "modeling of inertial sensors using Allan variance\", IEEE Trans. Instrum. Meas. 57(1), 2008",
+    parameters=PARAMETERS,
+    outputs=OUTPUTS,
+    evaluate=evaluate,
+    run_case=run_case,
+    reproduce=reproduce,
+    reproduce_parameters=REPRODUCE_PARAMETERS,
+    write_files=write_files,
+    report=report,
+    actions=ACTIONS,
+    random_terms=True,
+    member_bytes=member_bytes,
+    guide="imu",
+)
+
+__all__ = ["SYSTEM"]
