@@ -33,6 +33,8 @@ QUICK = {
     "north": ["--duration", "600"],
     "calibrate": [],
     "imu": ["--duration", "120"],
+    "navigate": ["--duration", "600", "--imu-rate", "10", "--output-step", "60"],
+    "mission": ["--duration", "1200", "--output-step", "600"],
 }
 """Options that keep each system's base case short; the fuzzed option comes after them."""
 

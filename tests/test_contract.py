@@ -27,7 +27,8 @@ NAMES = list(SYSTEM_MODULES)
 
 MISSPELT = {"errors": ("magnitud", "magnitude"), "vertical": ("latitud", "latitude"),
             "calibrate": ("latitud", "latitude"), "align": ("latitud", "latitude"), "north": ("latitud", "latitude"),
-            "imu": ("latitud", "latitude")}
+            "imu": ("latitud", "latitude"), "navigate": ("latitud", "latitude"),
+            "mission": ("alignement", "alignment")}
 """A misspelt parameter of each system and the name it must suggest (issue 11)."""
 
 LIGHT = {
@@ -37,6 +38,9 @@ LIGHT = {
     "align": {"duration": 600.0},
     "north": {"duration": 600.0, "readout_noise": math.radians(1 / 3600)},
     "imu": {"duration": 120.0},
+    "navigate": {"duration": 600.0, "imu_rate": 10.0, "output_step": 60.0, "velocity_error_north": 0.1,
+                 "sigma_gyro_bias": 1e-7},
+    "mission": {"duration": 1200.0, "output_step": 600.0, "imu_rate": 0.5},
 }
 """SI values that keep a system's default case quick (short durations)."""
 
@@ -47,6 +51,11 @@ VARIATIONS = {
     "align": [{"latitude": math.radians(20.0), "drift_east": 1e-7}, {"model": "simplified", "azimuth": 1.0}],
     "north": [{"latitude": math.radians(30.0)}],
     "imu": [{"grade": "industrial", "azimuth": 1.0}, {"imu_rate": 200.0, "latitude": math.radians(-30.0)}],
+    "navigate": [{"mode": "platform", "heading_error": 1e-3, "vertical_channel": "free"},
+                 {"trajectory": "great-circle", "speed": 200.0, "heading": 1.0, "gyro_bias_x": 1e-7,
+                  "imu": "tactical"}],
+    "mission": [{"grade": "navigation", "trajectory": "stationary"},
+                {"alignment": "gyrocompass", "calibration": "multi-position", "alignment_duration": 600.0}],
 }
 """Further cases per system on which run and evaluate must agree."""
 

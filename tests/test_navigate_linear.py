@@ -49,7 +49,8 @@ CASES = [
     ("stationary, platform", Stationary(latitude=math.radians(-30.0)), 3 * 3600.0, 10.0, 10.0,
      {"mode": "platform", "vertical_channel": "off"}),
     ("manoeuvring, held", load_profile(PROFILE), 3600.0, 50.0, 2.0, {"mode": "strapdown", "vertical_channel": "off"}),
-    ("manoeuvring, platform", load_profile(PROFILE), 3600.0, 50.0, 2.0, {"mode": "platform", "vertical_channel": "off"}),
+    ("manoeuvring, platform", load_profile(PROFILE), 3600.0, 50.0, 2.0,
+     {"mode": "platform", "vertical_channel": "off"}),
     ("manoeuvring, free", load_profile(PROFILE), 3600.0, 50.0, 2.0, {"mode": "strapdown", "vertical_channel": "free"}),
 ]
 

@@ -35,7 +35,7 @@ def _alignment_residual(scale: float) -> np.ndarray:
 
 
 def test_the_corrected_117_is_the_linearisation_of_the_nonlinear_platform():
-    # source 003's (1.17) as corrected in spec 04: halving every error quarters the difference
+    # the KPI manual's (1.17) as corrected in spec 04: halving every error quarters the difference
     full, half = _alignment_residual(1.0), _alignment_residual(0.5)
     np.testing.assert_allclose(full / half, 4.0, rtol=0.02)
 

@@ -168,7 +168,7 @@ def test_every_parameter_value_is_checked_by_its_parameter(tmp_path):
     assert np.isfinite(scenario.definition().run(**scenario.given()).azimuth_error_rad)
 
 
-@pytest.mark.parametrize("name", ["errors", "vertical", "calibrate", "align", "north"])
+@pytest.mark.parametrize("name", ["errors", "vertical", "calibrate", "align", "north", "navigate"])
 def test_every_real_system_gets_a_schema_from_its_parameters(name, tmp_path, run_cli):
     from schuler.study.systems import load_system
 

@@ -20,6 +20,8 @@ SYSTEM_MODULES: dict[str, str] = {
     "align": "schuler.gyrocompassing.api",
     "north": "schuler.ground_gyrocompass.api",
     "imu": "schuler.imu.api",
+    "navigate": "schuler.navigate.api",
+    "mission": "schuler.mission.api",
 }
 """Command name of each system -> module holding its ``SYSTEM``."""
 
@@ -40,7 +42,7 @@ def get_system(name: str) -> System:
     Traceback (most recent call last):
     ...
     schuler.exceptions.InvalidParameter: system: 'allign' is not a system; did you mean 'align'?
-    choose from errors, vertical, calibrate, align, north, imu
+    choose from errors, vertical, calibrate, align, north, imu, navigate, mission
     """
     if name not in SYSTEM_MODULES:
         hint = difflib.get_close_matches(str(name), SYSTEM_MODULES, n=1)

@@ -2,8 +2,8 @@
 
 Systems: ``errors`` (INS error propagation), ``vertical`` (gyro vertical),
 ``calibrate`` (pulse drift calibration), ``align`` (gyrocompassing), ``north``
-(ground gyrocompass), ``imu`` (IMU recordings, error models, Allan variance);
-each has ``run`` and ``reproduce``. Studies: ``run
+(ground gyrocompass), ``imu`` (IMU recordings, error models, Allan variance),
+``navigate`` (the nonlinear INS); each has ``run`` and ``reproduce``. Studies: ``run
 SCENARIO.toml``, ``sweep``, ``report``. Commands are loaded lazily so that
 ``schuler --help`` is quick.
 
@@ -31,6 +31,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "align": ("system", "Physical gyrocompassing of a platform INS."),
     "north": ("system", "Ground gyrocompass during rotor run-down."),
     "imu": ("system", "IMU recordings, spec-sheet error models and Allan variance."),
+    "navigate": ("system", "Nonlinear strapdown or platform INS on WGS-84."),
+    "mission": ("system", "Calibrate, align, navigate: a mission's error budget."),
     "run": ("schuler.cli.study:run_scenario", "Run a scenario file (TOML)."),
     "sweep": ("schuler.cli.study:sweep", "Sweep parameters or Monte Carlo over a scenario."),
     "report": ("schuler.cli.study:report", "Build the HTML report of all systems."),

@@ -233,7 +233,7 @@ def frame_step(s, c, r_e, inv_sqrt_w, inv_rn_h, inv_re_h, inv_c, h, vn, ve, vd, 
     omega_ie = (ie_n, 0, ie_d) (rad/s; Omega (cos L, 0, -sin L) at the computed
     or an entered latitude): ``coriolis`` = 1 and ``centripetal`` = 0 for a
     correct computer; 0 and 1 leave the Coriolis and centripetal terms
-    uncompensated (source 000's W*).
+    uncompensated (Drozdovich (1959): W*).
     """
     vn_m = 1.5 * vn - 0.5 * vn_prev
     ve_m = 1.5 * ve - 0.5 * ve_prev

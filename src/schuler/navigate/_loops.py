@@ -100,7 +100,7 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
     entered_earth_rate : (n, 2)
         Omega cos L, -Omega sin L (rad/s) at the true latitude at the start of each
         interval, used instead of the computed latitude's when ``use_entered``
-        (an Earth-rate compensation from an entered latitude, as source 000's (8)).
+        (an Earth-rate compensation from an entered latitude, as Drozdovich (1959), eq. (8)).
     """
     n_members = state.shape[0]
     n = increments.shape[0]
@@ -188,7 +188,7 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
     increment (m/s), and ``gyro`` rows holding (I + S + M)^-1. With ``slave_azimuth``
     the platform's turn about its vertical is removed after every step (the
     twist of q_pn about z): an external azimuth reference, leaving the gyros
-    only the level axes (source 000's two-axis gyro vertical).
+    only the level axes (the two-axis gyro vertical of Drozdovich (1959)).
     """
     n_members = state.shape[0]
     n = nav_increments.shape[0]

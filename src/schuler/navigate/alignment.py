@@ -1,6 +1,6 @@
 """Physical gyrocompassing of the platform, nonlinear: the KPI manual's control law (1.6) on a fixed base.
 
-Source 003 (KPI lab manual) aligns a semi-analytic platform in azimuth by
+The KPI manual (Meleshko, n.d.) aligns a semi-analytic platform in azimuth by
 driving it with its own accelerometers. This module simulates that platform
 without linearisation: its orientation is a rotation (any size), the
 accelerometers sense gravity through the true orientation, and the torquers
@@ -25,7 +25,7 @@ the linear models follow from this one by linearisation (tested).
 
 References
 ----------
-KPI laboratory manual on physical gyrocompassing of a semi-analytic INS (source 003, Meleshko),
+Meleshko, V. V. (compiler), "Physical gyrocompassing of a semi-analytic INS", KPI laboratory manual, n.d.,
 Sec. 2: control law (1.6), models (1.17)-(1.19), steady state (1.21), transient (1.22)-(1.24).
 
 Examples
@@ -286,7 +286,7 @@ def kpi_gyrocompassing(initial_azimuth_errors=None, *, latitude: float = KYIV_LA
                        drift_up: float = 0.0, latitude_error: float = 0.0, accel_error_x: float = 0.0,
                        accel_error_y: float = 0.0, initial_beta: float = 0.0, initial_alpha: float = 0.0,
                        duration: float = 2400.0, time_step: float = 0.1) -> GyrocompassingComparison:
-    """Source 003's linear gyrocompassing models beside the nonlinear platform for growing initial azimuth errors.
+    """The KPI manual's linear gyrocompassing models beside the nonlinear platform for growing initial azimuth errors.
 
     Parameters
     ----------

@@ -132,6 +132,13 @@ class InitialErrors:
         return latitude + d_lat, longitude + d_lon, height + dh
 
 
+MAX_SCALE_FACTOR = 0.5
+"""Largest |scale-factor error| of :class:`SensorErrors` (dimensionless)."""
+
+MAX_MISALIGNMENT = 0.2
+"""Largest |misalignment| of :class:`SensorErrors`, rad."""
+
+
 @dataclass(frozen=True)
 class SensorErrors:
     """Constant sensor errors, body axes, SI (bias = measured - true), shared or one per member.
@@ -146,6 +153,13 @@ class SensorErrors:
         Dimensionless scale-factor errors S (1e-6 = 1 ppm).
     gyro_misalignment, accel_misalignment : array, shape (3, 3) or (N, 3, 3)
         Off-diagonal misalignment M, rad (the diagonal must be zero: that is S).
+
+    Notes
+    -----
+    Scale factors within +/-0.5 and misalignments within +/-0.2 rad keep I + S + M
+    diagonally dominant (0.5 > 2 x 0.2), hence invertible as the platform needs;
+    they leave room for the draws of a consumer-grade model (3 % and 20 mrad at
+    1 sigma, :mod:`schuler.imu.spec`).
     """
 
     gyro_bias: ArrayLike = (0.0, 0.0, 0.0)
@@ -155,8 +169,9 @@ class SensorErrors:
     gyro_misalignment: ArrayLike = ((0.0,) * 3,) * 3
     accel_misalignment: ArrayLike = ((0.0,) * 3,) * 3
 
-    _TAILS: ClassVar[dict[str, tuple[int, ...]]] = {"gyro_bias": (3,), "accel_bias": (3,), "gyro_scale_factor": (3,), "accel_scale_factor": (3,),
-              "gyro_misalignment": (3, 3), "accel_misalignment": (3, 3)}
+    _TAILS: ClassVar[dict[str, tuple[int, ...]]] = {
+        "gyro_bias": (3,), "accel_bias": (3,), "gyro_scale_factor": (3,), "accel_scale_factor": (3,),
+        "gyro_misalignment": (3, 3), "accel_misalignment": (3, 3)}
 
     def __post_init__(self):
         for f in fields(self):
@@ -164,11 +179,12 @@ class SensorErrors:
         for name in ("gyro_misalignment", "accel_misalignment"):
             if np.any(np.diagonal(getattr(self, name), axis1=-2, axis2=-1) != 0.0):
                 raise InvalidParameter(name, "the diagonal must be zero (scale-factor errors go in *_scale_factor)")
-            if np.any(np.abs(getattr(self, name)) > 0.1):
-                raise InvalidParameter(name, "misalignments must stay within 0.1 rad")
+            if np.any(np.abs(getattr(self, name)) > MAX_MISALIGNMENT):
+                raise InvalidParameter(name, f"misalignments must stay within {MAX_MISALIGNMENT:g} rad")
         for name in ("gyro_scale_factor", "accel_scale_factor"):
-            if np.any(np.abs(getattr(self, name)) > 0.1):
-                raise InvalidParameter(name, "scale-factor errors must stay within 0.1 (100,000 ppm)")
+            if np.any(np.abs(getattr(self, name)) > MAX_SCALE_FACTOR):
+                raise InvalidParameter(name, f"scale-factor errors must stay within {MAX_SCALE_FACTOR:g} "
+                                             f"({MAX_SCALE_FACTOR * 1e6:,.0f} ppm)")
 
     @property
     def members(self) -> int | None:
@@ -178,10 +194,9 @@ class SensorErrors:
     def rows(self, sensor: str, members: int, invert: bool = False) -> np.ndarray:
         """Kernel rows (members, 12): the matrix I + S + M (or its inverse), row-major, then the bias."""
         scale = np.broadcast_to(getattr(self, f"{sensor}_scale_factor"), (members, 3))
-        matrix = np.broadcast_to(getattr(self, f"{sensor}_misalignment"), (members, 3, 3)) + \
+        forward = np.broadcast_to(getattr(self, f"{sensor}_misalignment"), (members, 3, 3)) + \
             np.eye(3) * (1.0 + scale)[:, None, :]
-        if invert:
-            matrix = np.linalg.inv(matrix)
+        matrix = np.linalg.inv(forward) if invert else forward
         bias = np.broadcast_to(getattr(self, f"{sensor}_bias"), (members, 3))
         return np.ascontiguousarray(np.concatenate([matrix.reshape(members, 9), bias], axis=1))
 

@@ -223,14 +223,14 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
     coriolis_compensation, centripetal_compensation : bool
         Whether the computer subtracts the Coriolis acceleration 2 omega_ie x v and
         uses gravity (with the centrifugal part) rather than gravitation. Turning
-        both off gives source 000's uncompensated W*.
+        both off gives the uncompensated W* of Drozdovich (1959).
     earth_rate_latitude : {"computed", "true"}
         The latitude of the computer's Earth rate: its own (an INS) or the true
-        one, entered from outside (source 000's compensation torques (8)).
+        one, entered from outside (the compensation torques of Drozdovich (1959), eq. (8)).
     azimuth_reference : bool
         Platform only: slave the platform's azimuth to the true heading (an
         external azimuth reference), so that only its level axes answer to the
-        gyros, as source 000's two-axis gyro vertical.
+        gyros, as the two-axis gyro vertical of Drozdovich (1959).
     baro_error : float
         Constant barometric height error, m (``vertical_channel="baro"``).
     baro_time_constant : float

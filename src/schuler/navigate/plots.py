@@ -1,17 +1,19 @@
 """Figures of the nonlinear INS (matplotlib, Agg; SI in, display units on the axes).
 
-Every function returns a matplotlib Figure; writing it is the caller's job
-(:func:`schuler.io.save_figure_formats`).
+Every function returns a matplotlib Figure at most 7 in wide with matplotlib's
+default fonts (legible in the report at its natural size); writing it is the
+caller's job (:func:`schuler.io.save_figure_formats`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from schuler.navigate.results import ERROR_CHANNELS, VERTICAL_CHANNELS_OUTPUT
+from schuler.navigate.channels import DISPLAY_UNITS, shown_channels, suffix
 from schuler.units import to_unit
 
-_LABELS = {"m": ("m", "position"), "m_s": ("m/s", "velocity"), "rad": ("arcsec", "attitude")}
+WIDTH = 7.0
+"""Width of every figure, in."""
 
 
 def _figure(*args, **kwargs):
@@ -23,8 +25,15 @@ def _figure(*args, **kwargs):
     return plt.subplots(*args, **kwargs)
 
 
-def _unit(name: str) -> str:
-    return "m_s" if name.endswith("_m_s") else name.rsplit("_", 1)[-1]
+def _label_bottom(axes, used: int, label: str) -> None:
+    """Hide the panels beyond ``used``; label the time axis of the lowest panel of each column."""
+    rows, columns = axes.shape
+    for index, axis in enumerate(axes.flat):
+        if index >= used:
+            axis.set_visible(False)
+        elif index + columns >= used:  # nothing below it
+            axis.xaxis.set_tick_params(labelbottom=True)
+            axis.set_xlabel(label)
 
 
 def plot_errors(result, channels=None, hours: bool = True):
@@ -36,61 +45,77 @@ def plot_errors(result, channels=None, hours: bool = True):
     ----------
     result : NavigationResult
     channels : sequence of str, optional
-        Names from :data:`~schuler.navigate.results.ERROR_CHANNELS` (default: all, the vertical
+        Names from :data:`~schuler.navigate.channels.ERROR_CHANNELS` (default: all, the vertical
         ones only when the vertical channel is on).
     hours : bool
         Time axis in hours (else seconds).
     """
-    names = list(channels or [c for c in ERROR_CHANNELS
-                              if result.vertical_channel != "off" or c not in VERTICAL_CHANNELS_OUTPUT])
-    rows = (len(names) + 2) // 3
-    fig, axes = _figure(rows, 3, figsize=(13, 2.8 * rows), sharex=True, squeeze=False)
+    names = list(channels or shown_channels(result.vertical_channel))
+    rows = (len(names) + 1) // 2
+    fig, axes = _figure(rows, 2, figsize=(WIDTH, 2.1 * rows + 0.6), sharex=True, squeeze=False)
     t = result.t_s / 3600.0 if hours else result.t_s
     for axis, name in zip(axes.flat, names):
-        unit, _ = _LABELS[_unit(name)]
+        unit = DISPLAY_UNITS[suffix(name)]
         values = to_unit(np.asarray(result.channel(name)), unit)
+        if values.ndim == 2 and values.shape[0] == 1:  # a batch of one member is a single run
+            values = values[0]
         if values.ndim == 2:
             mean, spread = values.mean(axis=0), values.std(axis=0)
             axis.fill_between(t, mean - spread, mean + spread, color="C0", alpha=0.25, lw=0, label="+/- 1 sigma")
             axis.plot(t, mean, color="C0", lw=1.2, label="mean")
         else:
             axis.plot(t, values, color="C0", lw=1.2)
-        axis.set_title(name.removesuffix("_" + _unit(name)).replace("_", " "), fontsize=10)
+        axis.set_title(name.removesuffix("_" + suffix(name)).replace("_", " "))
         axis.set_ylabel(unit)
         axis.grid(True, alpha=0.3)
-    for axis in axes.flat[len(names):]:
-        axis.set_visible(False)
-    for axis in axes[-1]:
-        axis.set_xlabel("time [h]" if hours else "time [s]")
-    fig.suptitle(f"{result.mode} INS errors (computed - true), vertical channel {result.vertical_channel}")
+    _label_bottom(axes, len(names), "time [h]" if hours else "time [s]")
+    fig.suptitle(f"{result.mode} INS errors (computed - true)")
+    fig.tight_layout()
+    return fig
+
+
+def plot_final_errors(horizontal_m):
+    """Histogram of the Monte Carlo members' final horizontal position errors (m)."""
+    fig, axis = _figure(figsize=(WIDTH, 4.0))
+    values = np.asarray(horizontal_m, dtype=float)
+    axis.hist(values, bins=min(60, max(10, values.size // 20)), color="C0", alpha=0.8)
+    axis.axvline(float(np.sqrt(np.mean(values**2))), color="C3", ls="--", label="rms")
+    axis.set_xlabel("final horizontal position error [m]")
+    axis.set_ylabel("members")
+    axis.grid(True, alpha=0.3)
+    axis.legend()
     fig.tight_layout()
     return fig
 
 
 def plot_bollay(comparison):
-    """Source 002's five error sources: nonlinear WGS-84 beside the closed forms (:func:`~schuler.navigate.seeds.bollay_error_sources`)."""
-    fig, axes = _figure(2, 3, figsize=(14, 7), sharex=True)
-    t = comparison.t_s
+    """Bollay's (1966) five error sources: nonlinear WGS-84 beside the closed forms.
+
+    ``comparison`` is :func:`~schuler.navigate.seeds.bollay_error_sources`'s.
+    """
+    fig, axes = _figure(3, 2, figsize=(WIDTH, 8.5), sharex=True)
+    hours = comparison.t_s / 3600.0
     for axis, i in zip(axes.flat, range(len(comparison.sources))):
-        axis.plot(t, comparison.closed_bollay_m[i], color="C3", lw=1.2, ls="--", label="closed form, Bollay's R, T")
-        axis.plot(t, comparison.closed_local_m[i], color="C1", lw=1.2, label="closed form, flight's R, g_eff")
-        every = max(1, t.size // 60)
-        axis.plot(t[::every], comparison.nonlinear_m[i][::every], "o", ms=3, color="C0", label="nonlinear INS, WGS-84")
+        axis.plot(hours, comparison.closed_bollay_m[i] / 1e3, color="C3", lw=1.2, ls="--",
+                  label="closed form, Bollay's R and T")
+        axis.plot(hours, comparison.closed_local_m[i] / 1e3, color="C1", lw=1.2,
+                  label="closed form, the flight's R and g_eff")
+        every = max(1, hours.size // 40)
+        axis.plot(hours[::every], comparison.nonlinear_m[i][::every] / 1e3, "o", ms=3, color="C0",
+                  label="nonlinear INS, WGS-84")
         axis.set_title(comparison.sources[i])
-        axis.set_ylabel("error [m]")
+        axis.set_ylabel("error [km]")
         axis.grid(True, alpha=0.3)
-    axes.flat[0].legend(fontsize=8)
-    axes.flat[-1].set_visible(False)
-    for axis in axes[-1]:
-        axis.set_xlabel("time since launch [s]")
-    fig.suptitle("Bollay's error sources: launch due east on the equator, 0.5 mi/s for 10,120 s")
+    _label_bottom(axes, len(comparison.sources), "time since launch [h]")
+    fig.legend(*axes.flat[0].get_legend_handles_labels(), loc="center", bbox_to_anchor=(0.75, 0.16))
+    fig.suptitle("Bollay's five error sources, 0.5 mi/s due east on the equator")
     fig.tight_layout()
     return fig
 
 
 def plot_drozdovich(comparison):
-    """Source 000's worked example on the nonlinear platform: velocity error along track beside (29)."""
-    fig, axis = _figure(figsize=(10, 4.2))
+    """The worked example of Drozdovich (1959) on the nonlinear platform: velocity error along track beside (29)."""
+    fig, axis = _figure(figsize=(WIDTH, 5.2))
     hours = comparison.t_s / 3600.0
     axis.plot(hours, comparison.nonlinear_dv_along_m_s, color="C0", lw=0.9, label="nonlinear platform, along track")
     axis.plot(hours, comparison.nonlinear_dv_across_m_s, color="C2", lw=0.9, label="nonlinear platform, across track")
@@ -98,23 +123,23 @@ def plot_drozdovich(comparison):
     axis.axhline(comparison.nonlinear_dv_along_mean_m_s, color="C0", ls=":", label="nonlinear mean, along track")
     axis.set_xlabel("time [h]")
     axis.set_ylabel("velocity error [m/s]")
-    axis.set_title("10 m/s due west at 60 deg, Coriolis and centripetal terms uncompensated")
+    axis.set_title("10 m/s due west at 60 deg, W* uncompensated")
     axis.grid(True, alpha=0.3)
-    axis.legend(fontsize=8)
+    axis.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
     fig.tight_layout()
     return fig
 
 
 def plot_gyrocompassing(comparison):
     """KPI gyrocompassing: azimuth transients and the departures of steady state and settling time."""
-    fig, (transients, departures) = _figure(1, 2, figsize=(13, 4.5))
+    fig, (transients, departures) = _figure(2, 1, figsize=(WIDTH, 8.0))
     arcmin = 180.0 * 60.0 / np.pi
     t = comparison.t_s
     for i in (0, comparison.initial_azimuth_errors_rad.size // 2, -1):
         delta0 = comparison.initial_azimuth_errors_rad[i]
         scale = 1.0 / (delta0 - comparison.steady_full_rad)
         transients.plot(t, (comparison.azimuth_error_nonlinear_rad[i] - comparison.steady_full_rad) * scale, lw=1.2,
-                        label=f"nonlinear, delta0 = {delta0 * arcmin:,.0f}'")
+                        label=f"nonlinear, delta0 = {delta0 * arcmin:,.0f} arcmin")
     transients.plot(t, (comparison.azimuth_error_full_rad[0] - comparison.steady_full_rad)
                     / (comparison.initial_azimuth_errors_rad[0] - comparison.steady_full_rad), "k--", lw=1,
                     label="(1.17), any delta0")
@@ -122,7 +147,7 @@ def plot_gyrocompassing(comparison):
     transients.set_xlabel("time [s]")
     transients.set_ylabel("(delta - delta_ss) / (delta0 - delta_ss)")
     transients.grid(True, alpha=0.3)
-    transients.legend(fontsize=8)
+    transients.legend()
     delta0 = comparison.initial_azimuth_errors_rad * arcmin
     for values, label in ((comparison.steady_departure_full, "steady state vs (1.17)"),
                           (comparison.steady_departure_simplified, "steady state vs (1.19)"),
@@ -135,7 +160,7 @@ def plot_gyrocompassing(comparison):
     departures.set_xlabel("initial azimuth error delta0 [arcmin]")
     departures.set_ylabel("nonlinear - linear [%]")
     departures.grid(True, alpha=0.3, which="both")
-    departures.legend(fontsize=8)
+    departures.legend()
     fig.suptitle("Gyrocompassing: nonlinear platform against the KPI models")
     fig.tight_layout()
     return fig

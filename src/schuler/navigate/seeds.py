@@ -1,21 +1,22 @@
 """The seeds' linear models held against the nonlinear INS on WGS-84: data for tables and figures.
 
-* :func:`bollay_error_sources`: source 002's five error sources (Problem 3:
+* :func:`bollay_error_sources`: Bollay's (1966) five error sources (Problem 3:
   0.01 deg tilt, 1 ft/s, 1e-4 g, 0.01 deg/h, 0.01 deg azimuth; 0.5 mi/s for
   10,120 s) flown on WGS-84 by the nonlinear strapdown INS, beside Bollay's
   closed forms with his constants and with the flight's own radius and
   effective gravity.
-* :func:`drozdovich_worked_example`: source 000's worked example (10 m/s due
+* :func:`drozdovich_worked_example`: the worked example of Drozdovich (1959) (10 m/s due
   west at 60 deg) on the nonlinear platform whose computer leaves the Coriolis
   and centripetal terms uncompensated, beside the slowly-varying (29).
 
-The gyrocompassing comparison (source 003) is :func:`schuler.navigate.alignment.kpi_gyrocompassing`.
+The gyrocompassing comparison (the KPI manual) is :func:`schuler.navigate.alignment.kpi_gyrocompassing`.
 
 References
 ----------
-W. Bollay, "The Story of 84 Minutes" (source 002), Problems 1-4.
-M. I. Drozdovich, "On an inertial method of measuring velocities", 1959, JPRS 2912 (source 000),
-eqs. (8), (13), (19)-(29).
+Bollay, W., "A Critical Meeting on the Development of Inertial Navigation - Related to 'The Story of 84 Minutes'",
+Engineering Case Library, Stanford University, 1966, Problems 1-4.
+Drozdovich, V. N., "On an inertial method of measuring velocities", Izvestiya VUZ, Priborostroyeniye, no. 3,
+pp. 29-39, 1959 (English translation JPRS 2912, 1960), eqs. (8), (13), (19)-(29).
 
 Examples
 --------
@@ -28,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
@@ -41,9 +43,9 @@ from schuler.core.earth import (
     transverse_radius,
 )
 from schuler.gyro_vertical.model import GyroVertical
-from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, SpeedProfile
 from schuler.gyro_vertical.quasi_steady import quasi_steady_response
 from schuler.gyro_vertical.reproduction import worked_example
+from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, SpeedProfile
 from schuler.navigate.errors import InitialErrors, SensorErrors
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.trajectory import GreatCircle, WaypointProfile
@@ -60,7 +62,7 @@ DROZDOVICH_SPEED = 10.0
 
 @dataclass
 class BollayComparison(Result):
-    """Source 002's five error sources: nonlinear WGS-84 beside the closed forms, at the output step.
+    """Bollay's (1966) five error sources: nonlinear WGS-84 beside the closed forms, at the output step.
 
     Each array has one row per source of :data:`~schuler.navigation_errors.single_channel.SOURCES`,
     the error in the source's channel of a flight due east along the equator
@@ -85,7 +87,7 @@ class BollayComparison(Result):
         """Per source: the error at the end and the largest |error| of each curve, m."""
         rows = []
         for i, source in enumerate(self.sources):
-            row = {"source": source}
+            row: dict[str, str | float] = {"source": source}
             for name in ("nonlinear_m", "closed_bollay_m", "closed_local_m"):
                 curve = getattr(self, name)[i]
                 row[f"{name[:-2]}_final_m"] = float(curve[-1])
@@ -109,7 +111,7 @@ class BollayComparison(Result):
 
 def bollay_error_sources(imu_rate: float = 10.0, output_step: float = 10.0, earth_rate: float = EARTH_RATE,
                          boost_time: float = BOOST_TIME) -> BollayComparison:
-    """Fly source 002's Problem 3 on WGS-84 with each error source alone, beside the closed forms.
+    """Fly Bollay's (1966) Problem 3 on WGS-84 with each error source alone, beside the closed forms.
 
     The missile is launched due east on the equator (a great circle of the
     ellipsoid), boosted from rest to 0.5 mi/s in ``boost_time`` along a C^2 speed
@@ -140,8 +142,9 @@ def bollay_error_sources(imu_rate: float = 10.0, output_step: float = 10.0, eart
     BollayComparison
     """
     east = math.radians(90.0)
-    profile = WaypointProfile(latitude=0.0, longitude=0.0, height=0.0, times=[0.0, boost_time, FLIGHT_TIME],
-                              speeds=[0.0, SPEED, SPEED], headings=[east] * 3, flight_path_angles=[0.0] * 3,
+    profile = WaypointProfile(latitude=0.0, longitude=0.0, height=0.0, times=np.array([0.0, boost_time, FLIGHT_TIME]),
+                              speeds=np.array([0.0, SPEED, SPEED]), headings=np.full(3, east),
+                              flight_path_angles=np.zeros(3),
                               name="Bollay Problem 3: launch due east on the equator")
     tilt, velocity, drift, azimuth = (MAGNITUDES[s] for s in ("tilt", "velocity", "drift", "azimuth"))
     accelerometer = 1e-4 * STANDARD_GRAVITY
@@ -170,7 +173,7 @@ def bollay_error_sources(imu_rate: float = 10.0, output_step: float = 10.0, eart
 
 @dataclass
 class DrozdovichComparison(Result):
-    """Source 000's worked example on the nonlinear platform (WGS-84) beside (29).
+    """The worked example of Drozdovich (1959) on the nonlinear platform (WGS-84) beside (29).
 
     Velocity errors are resolved in the source's frame along the track: x0 to
     the right of the velocity (north at the start), y0 along it (west). Means
@@ -220,7 +223,7 @@ def drozdovich_worked_example(duration: float = 48 * 3600.0, imu_rate: float = 1
     The computer integrates f + gravitation - omega_en x v: it omits 2 omega_ie x v
     and models gravitation (normal gravity minus the centrifugal acceleration),
     so W* = Omega^2 (R_E + h) sin L cos L north + 2 omega_ie x v stays in its
-    velocity, as in source 000's device (21). Its Earth-rate compensation uses
+    velocity, as in the device of Drozdovich (1959), (21). Its Earth-rate compensation uses
     the true latitude, entered as in (8): a platform tilted by beta_r = W*/g
     then sees the vertical Earth rate omega_2 = Omega sin L turn the tilt, which
     the velocity error must hold by torquing: the systematic error (29),
@@ -251,11 +254,10 @@ def drozdovich_worked_example(duration: float = 48 * 3600.0, imu_rate: float = 1
     g_start = float(somigliana_gravity(DROZDOVICH_LATITUDE))
     # levelled on the accelerometers: tilted about east (the body's -x, heading west) until g phi_E = -W*_N
     levelled = InitialErrors(roll_error=-w_start[0] / g_start)
-    common = {"imu_rate": imu_rate, "output_step": output_step, "mode": "platform", "earth_rate_latitude": "true",
-              "azimuth_reference": True}
-    run = navigate(path, duration, coriolis_compensation=False, centripetal_compensation=False,
-                   initial_errors=levelled, **common)
-    compensated = navigate(path, duration, **common)
+    common = partial(navigate, path, duration, imu_rate=imu_rate, output_step=output_step, mode="platform",
+                     earth_rate_latitude="true", azimuth_reference=True)
+    run = common(coriolis_compensation=False, centripetal_compensation=False, initial_errors=levelled)
+    compensated = common()
     v = run.truth.velocity_ned_m_s
     errors = np.stack([run.velocity_error_north_m_s, run.velocity_error_east_m_s], axis=1)
     across, along = _track_components(errors, v)

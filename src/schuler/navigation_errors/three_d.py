@@ -455,7 +455,8 @@ def propagate_along(time, latitude, height, velocity_ned, specific_force_ned, in
         raise InvalidParameter("initial_state", f"expected shape ({n},) or (N, {n}), got {x0.shape}")
     u = np.zeros(6) if inputs is None else np.asarray(inputs, dtype=float)
     if u.shape[-1] != 6 or not np.all(np.isfinite(u)):
-        raise InvalidParameter("inputs", f"expected finite values of shape (6,), ({K}, 6) or (N, {K}, 6), got {u.shape}")
+        raise InvalidParameter("inputs",
+                               f"expected finite values of shape (6,), ({K}, 6) or (N, {K}, 6), got {u.shape}")
     u = np.broadcast_to(u, (*x0.shape[:-1], K, 6)) if u.ndim < 3 else u
     out = np.empty((*x0.shape[:-1], K + 1, n))
     x = x0.copy()

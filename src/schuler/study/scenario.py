@@ -43,7 +43,8 @@ Examples
 >>> parse_scenario('system = "compass"', source="s.toml")
 Traceback (most recent call last):
 ...
-schuler.exceptions.ScenarioError: s.toml: system: 'compass' is not one of errors, vertical, calibrate, align, north, imu
+schuler.exceptions.ScenarioError: s.toml: system: 'compass' is not one of errors, vertical, calibrate, align, north,
+imu, navigate, mission
 """
 
 from __future__ import annotations

@@ -1,0 +1,13 @@
+"""The mission study: an inertial system's life, calibrate -> align -> navigate, and its error budget.
+
+Conventions: NED navigation frame, body x forward / y right / z down, errors =
+computed - true, sensor bias = measured - true, SI inside.
+
+- :mod:`~schuler.mission.setup`  the instrument (grade or spec file), calibration, alignment, trajectory, sources;
+- :mod:`~schuler.mission.stages`  the alignment's residuals as a linear map of the sources;
+- :mod:`~schuler.mission.coefficients`  the trajectory's kinematics averaged over each step;
+- :mod:`~schuler.mission.covariance`  the budget on the WGS-84 psi-angle model, source by source;
+- :mod:`~schuler.mission.monte_carlo`  the nonlinear INS over members drawn from the same sources;
+- :mod:`~schuler.mission.evaluation`, :mod:`~schuler.mission.results`, :mod:`~schuler.mission.plots`,
+  :mod:`~schuler.mission.reproduction`, :mod:`~schuler.mission.api`  the system on the contract.
+"""

@@ -1,0 +1,178 @@
+"""Monte Carlo of the nonlinear INS over a mission, members drawn from the covariance analysis's sources.
+
+Each member draws every constant source of :mod:`schuler.mission.setup` once
+(normal, its 1-sigma) and the alignment's noise-limited residuals from the
+covariance they leave (:func:`schuler.mission.stages.alignment_noise`); its
+initial errors are the same linear map of its draws as in the covariance
+analysis (:func:`schuler.mission.stages.initial_state_map`), turned into
+roll, pitch and heading errors of the computed attitude
+C_computed = exp(-[phi x]) C_true. Its sensors carry the drawn biases and
+scale factors (:class:`schuler.navigate.errors.SensorErrors`) and white noise of
+the error model's angle and velocity random walks per axis
+(:class:`BlockWhiteNoise`). The strapdown INS then runs along the trajectory
+(:func:`schuler.navigate.mechanization.navigate`), batched over members.
+
+A reduced IMU rate is allowed: the white noise enters as increments of
+standard deviation N sqrt(dt), exact at any rate, and the smooth trajectories
+need no high rate (the covariance analysis has none either).
+
+Every draw is addressed by (seed, stream, member) (:mod:`schuler.core.random`):
+the members do not depend on how a Monte Carlo is cut into chunks.
+"""
+
+from __future__ import annotations
+
+import zlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from schuler.core.earth import EARTH_RATE, radii_of_curvature
+from schuler.core.random import RandomStreams
+from schuler.mission.setup import CONSTANT_SOURCES, MissionSetup
+from schuler.mission.stages import alignment_noise, initial_state_map
+from schuler.navigate.attitude import (
+    euler_from_quaternion,
+    quaternion_from_rotation_vector,
+    quaternion_multiply,
+    rotation_matrix,
+    wrap_angle,
+)
+from schuler.navigate.errors import InitialErrors, SensorErrors
+from schuler.navigate.mechanization import navigate
+from schuler.navigate.results import NavigationResult
+
+NOISE_BLOCK = 256
+"""IMU intervals per addressed noise block: short, so that a chunk of the run redraws little."""
+
+
+SCALE_FACTOR_LIMIT = 0.1
+"""Largest scale-factor error a member flies with (the navigate layer's limit); larger draws are clipped."""
+
+
+def _stream_key(seed: int, stream: str) -> int:
+    return int(np.random.SeedSequence([seed, zlib.crc32(stream.encode())]).generate_state(1, np.uint64)[0])
+
+
+@dataclass(frozen=True)
+class BlockWhiteNoise:
+    """White rate noise per body axis, addressed by (seed, sensor, member, block): the navigate SensorNoise interface.
+
+    The increments of IMU intervals [256 b, 256 (b + 1)) of member m are the
+    normals of a Philox generator (counter-based; Salmon et al., "Parallel
+    random numbers: as easy as 1, 2, 3", SC 2011) keyed by (sensor stream, m) and
+    started at counter (0, b, 0, 0), times N sqrt(dt) per axis: the same
+    numbers however the run is chunked, at the generator's speed (one state
+    reset per member and block instead of a new generator).
+
+    Parameters
+    ----------
+    gyro_density, accel_density : array (3,)
+        N per axis: rad/sqrt(s) and m/s/sqrt(s).
+    seed : int
+
+    Examples
+    --------
+    >>> noise = BlockWhiteNoise(np.full(3, 1e-5), np.zeros(3), seed=1)
+    >>> whole, _ = noise.increments(np.arange(2), 0, 600, 0.5)
+    >>> part, _ = noise.increments(np.arange(2), 250, 600, 0.5)
+    >>> bool(np.array_equal(whole[:, 250:], part))
+    True
+    """
+
+    gyro_density: np.ndarray
+    accel_density: np.ndarray
+    seed: int = 0
+
+    def increments(self, members, start: int, stop: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        members = np.asarray(members, dtype=np.int64)
+        first, last = start // NOISE_BLOCK, max(start, stop - 1) // NOISE_BLOCK
+        width = (last - first + 1) * NOISE_BLOCK
+        offset = start - first * NOISE_BLOCK
+        bit_generator = np.random.Philox(0)
+        generator = np.random.Generator(bit_generator)
+        block = np.empty((width, 3))
+        out = []
+        for sensor, density in (("gyro", self.gyro_density), ("accel", self.accel_density)):
+            values = np.zeros((members.size, stop - start, 3))
+            scale = np.asarray(density, dtype=float) * np.sqrt(dt)
+            if stop > start and np.any(scale > 0):
+                key = _stream_key(self.seed, f"mission/{sensor}")
+                for row, member in enumerate(members):
+                    for b in range(first, last + 1):
+                        bit_generator.state = {
+                            "bit_generator": "Philox",
+                            "state": {"counter": np.array([0, b, 0, 0], dtype=np.uint64),
+                                      "key": np.array([key, member], dtype=np.uint64)},
+                            "buffer": np.zeros(4, dtype=np.uint64), "buffer_pos": 4, "has_uint32": 0,
+                            "uinteger": 0}
+                        at = (b - first) * NOISE_BLOCK
+                        generator.standard_normal(out=block[at:at + NOISE_BLOCK])
+                    values[row] = block[offset:offset + stop - start] * scale
+            out.append(values)
+        return out[0], out[1]
+
+
+def member_draws(setup: MissionSetup, members, streams: RandomStreams, n_states: int,
+                 start_rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each member's constant sources (N, n_sources, SI) and initial psi-model state (N, n_states)."""
+    members = np.asarray(members, dtype=np.int64)
+    unit = np.stack([streams.normal(f"mission/{name}", members) for name in CONSTANT_SOURCES], axis=1)
+    draws = unit * setup.constant_sigmas
+    x0 = draws @ (initial_state_map(setup, start_rotation, n_states))
+    for name, covariance in alignment_noise(setup, start_rotation, n_states).items():
+        values, vectors = np.linalg.eigh(covariance)
+        factor = vectors * np.sqrt(np.clip(values, 0.0, None))
+        noise = np.stack([streams.normal(f"mission/alignment/{name}/{i}", members) for i in range(n_states)], axis=1)
+        x0 = x0 + noise @ factor.T
+    return draws, x0
+
+
+def initial_errors(x0: np.ndarray, setup: MissionSetup, start_quaternion: np.ndarray) -> InitialErrors:
+    """The navigate layer's initial errors of psi-model states x0 (N, n) at rest (velocity error zero)."""
+    L, h = setup.latitude, setup.height
+    radius_north, radius_east = radii_of_curvature(L)
+    north, east = x0[:, 0], x0[:, 1]
+    delta_theta = np.stack([east / (radius_east + h), -north / (radius_north + h),
+                            -east * np.tan(L) / (radius_east + h)], axis=1)
+    phi = x0[:, -3:] + delta_theta
+    computed = quaternion_multiply(quaternion_from_rotation_vector(-phi), start_quaternion)
+    angles = euler_from_quaternion(computed) - euler_from_quaternion(start_quaternion)[None, :]
+    return InitialErrors(position_error_north=north, position_error_east=east,
+                         roll_error=wrap_angle(angles[:, 0]), pitch_error=angles[:, 1],
+                         heading_error=wrap_angle(angles[:, 2]))
+
+
+def run_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate: float,
+                output_step: float | None = None) -> NavigationResult:
+    """The nonlinear INS of the given members (global numbers), batched: their error histories."""
+    members = np.asarray(members, dtype=np.int64)
+    trajectory = setup.trajectory()
+    start_quaternion = trajectory.kinematics(np.array([0.0]))[1][0]
+    n = 9 if setup.vertical_channel == "free" else 7
+    draws, x0 = member_draws(setup, members, streams, n, rotation_matrix(start_quaternion))
+    column = {name: i for i, name in enumerate(CONSTANT_SOURCES)}
+
+    def triad(family: str) -> np.ndarray:
+        values = np.stack([draws[:, column[f"{family}_{axis}"]] for axis in "xyz"], axis=1)
+        if "scale_factor" in family:
+            # the navigate layer accepts |S| <= 0.1: a consumer IMU's 3 % draws past it beyond 3.3 sigma
+            values = np.clip(values, -SCALE_FACTOR_LIMIT, SCALE_FACTOR_LIMIT)
+        return values
+
+    sensors = SensorErrors(gyro_bias=triad("gyro_bias"), accel_bias=triad("accel_bias"),
+                           gyro_scale_factor=triad("gyro_scale_factor"),
+                           accel_scale_factor=triad("accel_scale_factor"))
+    noisy = np.any(setup.gyro_random_walk) or np.any(setup.accel_random_walk)
+    noise = BlockWhiteNoise(setup.gyro_random_walk, setup.accel_random_walk, streams.seed) if noisy else None
+    return navigate(trajectory, setup.duration, imu_rate=imu_rate, output_step=output_step or setup.output_step,
+                    mode="strapdown", vertical_channel=setup.vertical_channel,
+                    initial_errors=initial_errors(x0, setup, start_quaternion), sensor_errors=sensors,
+                    noise=noise, member_ids=members,
+                    earth_rate=EARTH_RATE)
+
+
+def final_horizontal_errors(result: NavigationResult) -> np.ndarray:
+    """Each member's final horizontal position error sqrt(north^2 + east^2), m."""
+    return np.hypot(np.atleast_2d(result.position_error_north_m)[:, -1],
+                    np.atleast_2d(result.position_error_east_m)[:, -1])

@@ -1,0 +1,108 @@
+"""What ``schuler mission run`` returns and writes: :class:`MissionResult` and :func:`write_files`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+from schuler.mission.covariance import CovarianceBudget
+from schuler.mission.setup import SOURCES
+from schuler.reproduction import Reproduction
+from schuler.results import Result, RunResult
+from schuler.units import to_unit
+
+
+@dataclass
+class MissionResult(RunResult):
+    """One mission: the covariance analysis's final 1-sigma errors and the error budget (SI).
+
+    ``budget`` maps every source to its share of the final horizontal
+    position-error variance (the shares sum to 1); ``history`` holds every
+    source's contribution at every output step (not in ``to_dict``; written by
+    :func:`write_files`). With a Monte Carlo, ``to_dict()["monte_carlo"]`` also
+    holds ``position_error_sigma_m``: the root mean square of the members' final
+    horizontal position errors (nonlinear INS).
+    """
+
+    position_error_sigma_m: float
+    position_error_north_sigma_m: float
+    position_error_east_sigma_m: float
+    velocity_error_sigma_m_s: float
+    heading_error_sigma_rad: float
+    initial_heading_error_sigma_rad: float
+    initial_tilt_sigma_rad: float
+    dominant_share: float
+    member_position_error_m: float
+    budget: dict[str, float]
+    dominant_source: str
+    instrument: str
+    history: CovarianceBudget | None = field(default=None, repr=False)
+
+    # the budget's keys are source names whose values are shares (the units map is flat by key)
+    units: ClassVar[dict[str, str]] = {"dominant_share": "1", "budget": "1", **{name: "1" for name in SOURCES}}
+
+    def to_dict(self) -> dict[str, Any]:
+        data = super().to_dict()
+        if self.monte_carlo is not None and isinstance(data.get("monte_carlo"), dict):
+            rms = self.monte_carlo.statistics["member_position_error_m"]["rms"]
+            data["monte_carlo"]["position_error_sigma_m"] = rms
+        return data
+
+    def render(self):
+        from rich.console import Group
+        from rich.table import Table
+
+        table = Table(title=f"Mission error budget ({self.instrument})", show_header=True)
+        table.add_column("quantity")
+        table.add_column("value", justify="right")
+        rows = [
+            ("horizontal position error, 1-sigma (covariance)", f"{self.position_error_sigma_m:,.4g} m"),
+            ("  north, east", f"{self.position_error_north_sigma_m:,.4g} m, {self.position_error_east_sigma_m:,.4g} m"),
+            ("horizontal velocity error, 1-sigma", f"{self.velocity_error_sigma_m_s:.4g} m/s"),
+            ("heading error, 1-sigma: after alignment, at the end",
+             f"{to_unit(self.initial_heading_error_sigma_rad, 'arcmin'):.4g} arcmin, "
+             f"{to_unit(self.heading_error_sigma_rad, 'arcmin'):.4g} arcmin"),
+            ("tilt after alignment, 1-sigma", f"{to_unit(self.initial_tilt_sigma_rad, 'arcsec'):.4g} arcsec"),
+            ("dominant source", f"{self.dominant_source} ({100 * self.dominant_share:.1f} %)"),
+        ]
+        if self.monte_carlo is not None:
+            stats = self.monte_carlo.statistics["member_position_error_m"]
+            rows.append((f"Monte Carlo ({self.monte_carlo.members} members, nonlinear INS): RMS",
+                         f"{stats['rms']:,.4g} m"))
+        for name, value in rows:
+            table.add_row(name, value)
+        shares = Table(title="Share of the final horizontal position-error variance", show_header=True)
+        shares.add_column("source")
+        shares.add_column("share", justify="right")
+        for name, share in sorted(self.budget.items(), key=lambda item: -item[1]):
+            if share >= 1e-4:
+                shares.add_row(name, f"{100 * share:.2f} %")
+        return Group(table, shares)
+
+
+def write_files(result: Result, out_dir: Path) -> list[Path]:
+    """The stacked budget plot (PNG, SVG) and the budget's histories (CSV) of a run."""
+    import pandas as pd
+
+    from schuler.io import write_dataframe_csv
+    from schuler.mission import plots
+
+    out_dir = Path(out_dir)
+    if isinstance(result, Reproduction):
+        return []
+    if not isinstance(result, MissionResult):
+        raise TypeError(f"mission writes no files for {type(result).__name__}")
+    if result.history is None:
+        return []
+    history = result.history
+    files = plots.write_figures({"mission_budget": plots.stacked_budget(history)}, out_dir)
+    columns: dict[str, Any] = {"t_s": history.time,
+                               "position_error_sigma_m": history.sigma("horizontal_position"),
+                               "velocity_error_sigma_m_s": history.sigma("horizontal_velocity"),
+                               "heading_error_sigma_rad": history.sigma("heading")}
+    horizontal = history.horizontal()
+    for i, name in enumerate(history.sources):
+        columns[f"variance_{name}_m2"] = horizontal[:, i]
+    files.append(write_dataframe_csv(pd.DataFrame(columns), out_dir / "mission_budget.csv"))
+    return files

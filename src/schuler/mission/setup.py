@@ -1,0 +1,211 @@
+"""A mission resolved from its parameters: the instrument, the stages, the trajectory and the error sources.
+
+Conventions (docs/conventions.md): NED navigation frame, body x forward / y
+right / z down, errors = computed - true, sensor bias = measured - true, SI.
+
+The life of the instrument, in the order the stages happen:
+
+1. **Calibration** leaves a residual gyro bias per axis (and, for the
+   multi-position method, residual accelerometer biases and scale factors):
+
+   * ``pulse`` (system 3, alternating torque pulses, gyros only): the drift is
+     measured with the method's relative error rho (the source's 0.34 %) and
+     the angle-random-walk floor of averaging over the calibration time T_c:
+     sigma_b^2 = (rho b)^2 + N_g^2 / T_c. Accelerometer biases and all scale
+     factors keep their spec-sheet values.
+   * ``multi-position`` (a static test in +/- positions of every axis over T_c,
+     each axis seeing each sign for T_c / 2): the least-squares standard error
+     of a bias from white noise, sigma_b = N / sqrt(T_c) (gyros and
+     accelerometers), and of an accelerometer scale factor from the +/- g
+     positions, sigma_S = N_a / (g sqrt(T_c)). Gyro scale factors keep their
+     spec-sheet values (the Earth rate is too small to calibrate them without a
+     rate table).
+
+   Either way the slow terms (bias instability, rate random walk) change the
+   bias after calibration; their change over the rest of the mission (alignment
+   plus navigation) is added as sqrt(2) sigma_A(window) (IEEE 952; the IMU
+   layer's :func:`~schuler.imu.system_inputs.residual_bias`) and held constant,
+   the approximation the Monte Carlo makes too.
+
+2. **Alignment** at rest at the start point, over T_a (closed forms in
+   :mod:`schuler.mission.stages`).
+
+3. **Navigation** along the trajectory (nonlinear INS or its psi-angle model).
+
+Sources of error (independent, each one name in the budget): ``gyro_bias_x|y|z``,
+``accel_bias_x|y|z`` (what calibration leaves), ``gyro_scale_factor_x|y|z``,
+``accel_scale_factor_x|y|z``, ``north_reference`` (ground gyrocompass only),
+``initial_position_north|east`` (constant, each with its 1-sigma) and the white
+noises ``gyro_random_walk``, ``accel_random_walk`` (angle / velocity random walk,
+acting during alignment and during navigation). Misalignments, g-sensitivity
+and quantization are left out of this study.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from schuler.core.earth import STANDARD_GRAVITY
+from schuler.exceptions import InvalidParameter
+from schuler.imu.error_model import ErrorModel
+from schuler.imu.spec import load_spec_file, preset
+from schuler.imu.system_inputs import residual_bias
+from schuler.navigate.trajectory import GreatCircle, Stationary, WaypointProfile
+
+CALIBRATIONS = ("pulse", "multi-position")
+ALIGNMENTS = ("kalman", "gyrocompass", "ground-gyrocompass")
+TRAJECTORIES = ("stationary", "cruise", "flight")
+VERTICAL_CHANNELS = ("off", "free")
+
+AXES = ("x", "y", "z")
+CONSTANT_SOURCES = (
+    *(f"gyro_bias_{a}" for a in AXES), *(f"accel_bias_{a}" for a in AXES),
+    *(f"gyro_scale_factor_{a}" for a in AXES), *(f"accel_scale_factor_{a}" for a in AXES),
+    "north_reference", "initial_position_north", "initial_position_east",
+)
+"""Constant error sources, in the order of :attr:`MissionSetup.constant_sigmas`."""
+WHITE_SOURCES = ("gyro_random_walk", "accel_random_walk")
+"""White-noise sources (angle and velocity random walk)."""
+SOURCES = CONSTANT_SOURCES + WHITE_SOURCES
+"""Every source of the budget."""
+
+FLIGHT_ACCELERATION_TIME = 300.0
+"""Take-off run of the ``flight`` profile: 0 to cruise speed, s."""
+FLIGHT_TURN_TIME = 120.0
+"""Duration of each turn of the ``flight`` profile, s."""
+
+
+@dataclass(frozen=True)
+class MissionSetup:
+    """One mission: the instrument's error model, the stage choices and the trajectory (SI).
+
+    Build it with :func:`mission_setup` from a case's values.
+    """
+
+    error_model: ErrorModel
+    latitude: float
+    longitude: float
+    height: float
+    calibration: str
+    calibration_duration: float
+    pulse_relative_error: float
+    alignment: str
+    alignment_duration: float
+    gyrocompass_time_constant: float
+    gyrocompass_damping: float
+    north_reference_error: float
+    trajectory_kind: str
+    duration: float
+    speed: float
+    heading: float
+    vertical_channel: str
+    output_step: float
+    initial_position_error: float
+
+    @property
+    def gravity(self) -> float:
+        return STANDARD_GRAVITY
+
+    def trajectory(self):
+        """The vehicle's trajectory (:mod:`schuler.navigate.trajectory`).
+
+        ``stationary``: at rest, level, at the heading. ``cruise``: a geodesic at
+        the speed and height from the start. ``flight``: at rest at t = 0, a
+        take-off run to the speed over 300 s, a 90-deg right turn at 35 % and a
+        90-deg left turn at 70 % of the mission (120 s each), level at the height.
+        """
+        if self.trajectory_kind == "stationary":
+            return Stationary(latitude=self.latitude, longitude=self.longitude, height=self.height,
+                              heading=self.heading)
+        if self.trajectory_kind == "cruise":
+            return GreatCircle(latitude=self.latitude, longitude=self.longitude, height=self.height,
+                               heading=self.heading, speed=self.speed, duration=self.duration)
+        d = self.duration
+        shortest = 4 * (FLIGHT_ACCELERATION_TIME + FLIGHT_TURN_TIME)
+        if d < shortest:
+            raise InvalidParameter("duration", f"a flight needs at least {shortest:g} s (take-off run and two turns), "
+                                   f"got {d:g} s")
+        times = [0.0, FLIGHT_ACCELERATION_TIME, 0.35 * d, 0.35 * d + FLIGHT_TURN_TIME, 0.7 * d,
+                 0.7 * d + FLIGHT_TURN_TIME]
+        speeds = [0.0] + [self.speed] * 5
+        quarter = math.pi / 2
+        headings = [self.heading] * 3 + [self.heading + quarter] * 2 + [self.heading]
+        return WaypointProfile(latitude=self.latitude, longitude=self.longitude, height=self.height,
+                               times=np.array(times), speeds=np.array(speeds), headings=np.array(headings),
+                               flight_path_angles=np.zeros(6), name="flight")
+
+    @property
+    def window(self) -> float:
+        """Time from calibration to the end of the mission, s (what the slow bias terms act over)."""
+        return self.alignment_duration + self.duration
+
+    def gyro_bias_sigma(self) -> np.ndarray:
+        """1-sigma gyro bias per body axis left by calibration and the slow terms, rad/s."""
+        gyro = self.error_model.gyro
+        slow = residual_bias(gyro, self.window, include_turn_on=False)
+        if self.calibration == "pulse":
+            calibrated = np.hypot(self.pulse_relative_error * gyro.bias,
+                                  gyro.random_walk / math.sqrt(self.calibration_duration))
+        else:
+            calibrated = gyro.random_walk / math.sqrt(self.calibration_duration)
+        return np.hypot(calibrated, slow)
+
+    def accel_bias_sigma(self) -> np.ndarray:
+        """1-sigma accelerometer bias per body axis, m/s^2 (spec sheet, or multi-position residual)."""
+        accel = self.error_model.accel
+        if self.calibration == "multi-position":
+            slow = residual_bias(accel, self.window, include_turn_on=False)
+            return np.hypot(accel.random_walk / math.sqrt(self.calibration_duration), slow)
+        return residual_bias(accel, self.window, include_turn_on=True)
+
+    def accel_scale_factor_sigma(self) -> np.ndarray:
+        accel = self.error_model.accel
+        if self.calibration == "multi-position":
+            return accel.random_walk / (self.gravity * math.sqrt(self.calibration_duration))
+        return accel.scale_factor.copy()
+
+    @property
+    def constant_sigmas(self) -> np.ndarray:
+        """1-sigma of each of :data:`CONSTANT_SOURCES`, SI."""
+        north = self.north_reference_error if self.alignment == "ground-gyrocompass" else 0.0
+        return np.concatenate([self.gyro_bias_sigma(), self.accel_bias_sigma(), self.error_model.gyro.scale_factor,
+                               self.accel_scale_factor_sigma(),
+                               [north, self.initial_position_error, self.initial_position_error]])
+
+    @property
+    def gyro_random_walk(self) -> np.ndarray:
+        """Angle random walk per body axis, rad/sqrt(s)."""
+        return np.asarray(self.error_model.gyro.random_walk, dtype=float)
+
+    @property
+    def accel_random_walk(self) -> np.ndarray:
+        """Velocity random walk per body axis, m/s/sqrt(s)."""
+        return np.asarray(self.error_model.accel.random_walk, dtype=float)
+
+
+def error_model(grade: str, imu_spec: str | None) -> ErrorModel:
+    """The instrument: a spec file (TOML, :mod:`schuler.imu.spec`) when given, else the grade's preset."""
+    if imu_spec:
+        return load_spec_file(imu_spec)
+    return preset(grade)
+
+
+def mission_setup(values) -> MissionSetup:
+    """A :class:`MissionSetup` from a case's SI values (a mapping with every parameter of the system)."""
+    return MissionSetup(
+        error_model=error_model(values["grade"], values["imu_spec"]),
+        latitude=float(values["latitude"]), longitude=float(values["longitude"]), height=float(values["height"]),
+        calibration=str(values["calibration"]), calibration_duration=float(values["calibration_duration"]),
+        pulse_relative_error=float(values["pulse_relative_error"]),
+        alignment=str(values["alignment"]), alignment_duration=float(values["alignment_duration"]),
+        gyrocompass_time_constant=float(values["gyrocompass_time_constant"]),
+        gyrocompass_damping=float(values["gyrocompass_damping"]),
+        north_reference_error=float(values["north_reference_error"]),
+        trajectory_kind=str(values["trajectory"]), duration=float(values["duration"]),
+        speed=float(values["speed"]), heading=float(values["heading"]),
+        vertical_channel=str(values["vertical_channel"]), output_step=float(values["output_step"]),
+        initial_position_error=float(values["initial_position_error"]),
+    )

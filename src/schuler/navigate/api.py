@@ -1,0 +1,41 @@
+"""The nonlinear INS on the contract: ``SYSTEM`` (``schuler navigate``).
+
+The pieces: :mod:`~schuler.navigate.evaluation` (parameters, outputs,
+``evaluate``, ``run_case``), :mod:`~schuler.navigate.reproduction` (the seeds'
+linear models against the nonlinear INS: ``reproduce``, ``report``),
+:mod:`~schuler.navigate.results` (the result types and ``write_files``).
+
+Examples
+--------
+>>> import math
+>>> r = SYSTEM.run(latitude=math.radians(45), velocity_error_north=0.1, duration=600.0, imu_rate=10.0,
+...                output_step=60.0)
+>>> round(r.errors["final_position_error_north_m"], 1)   # (dV / w_s) sin(w_s t) at 45 deg
+54.6
+"""
+
+from __future__ import annotations
+
+from schuler.contract import System
+from schuler.navigate.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case
+from schuler.navigate.reproduction import report, reproduce
+from schuler.navigate.results import write_files
+from schuler.references import GROVES_2013
+
+SYSTEM = System(
+    name="navigate",
+    title="Nonlinear strapdown or platform INS on WGS-84",
+    reference=GROVES_2013.citation,
+    parameters=PARAMETERS,
+    outputs=OUTPUTS,
+    evaluate=evaluate,
+    run_case=run_case,
+    reproduce=reproduce,
+    write_files=write_files,
+    report=report,
+    random_terms=True,
+    member_bytes=member_bytes,
+    guide="navigate",
+)
+
+__all__ = ["SYSTEM"]
