@@ -5,6 +5,12 @@ The pieces: :mod:`~schuler.navigate.evaluation` (parameters, outputs,
 linear models against the nonlinear INS: ``reproduce``, ``report``),
 :mod:`~schuler.navigate.results` (the result types and ``write_files``).
 
+``imu`` is a grade, a spec file, or a recorded IMU file
+(:mod:`~schuler.navigate.recording`): a recording is a static vehicle, its
+increments navigated in place of the ideal IMU and its errors (computed - true)
+taken against a stationary truth at its site and initial attitude, for its
+length and at its rate; one member, so no Monte Carlo.
+
 Examples
 --------
 >>> import math

@@ -6,7 +6,11 @@ profile ``FILE.toml``, :mod:`schuler.navigate.profile`), a mechanization
 true) and sensor errors (measured - true, body axes): the biases given and,
 with ``imu``, the full error model of a grade or a spec file
 (:mod:`schuler.navigate.imu_noise`). Without ``imu`` the IMU is ideal apart
-from the biases given.
+from the biases given. With ``imu`` naming a recorded IMU file
+(:mod:`schuler.navigate.recording`) the vehicle is static: the computer
+integrates the record's increments (plus the biases given) and the errors are
+against a stationary truth at the record's site and attitude; such a case is
+one member (no Monte Carlo).
 
 :func:`evaluate` runs the cases of a batch that share a trajectory and a time
 grid as the members of one batched :func:`~schuler.navigate.mechanization.navigate`
@@ -49,6 +53,7 @@ from schuler.navigate.mechanization import (
     output_interval,
 )
 from schuler.navigate.profile import load_profile
+from schuler.navigate.recording import is_recording, replay
 from schuler.navigate.results import NavigateResult, NavigationResult
 from schuler.navigate.trajectory import GreatCircle, Stationary
 from schuler.navigate.truth import DEFAULT_CHUNK, TruthGenerator
@@ -60,6 +65,7 @@ TRAJECTORIES = ("stationary", "great-circle")
 DEFAULT_LATITUDE = math.radians(45.0)
 DEFAULT_SPEED = 250.0
 """Ground speed of a great circle when ``speed`` is not set, m/s."""
+DEFAULT_IMU_RATE = 100.0
 DEFAULT_DURATION = 3600.0
 """Simulated time of a stationary or great-circle case when ``duration`` is not set, s."""
 MAX_DURATION = 10 * 86400.0
@@ -95,9 +101,11 @@ PARAMETERS = ParameterSet((
               "(not set: 0 deg).", minimum=-360, maximum=360),
     Parameter("speed", "m/s", None, f"Ground speed along the great circle (not set: {DEFAULT_SPEED:g} m/s).",
               minimum=0, maximum=1e4),
-    Parameter("duration", "s", None, f"Simulated time (not set: {DEFAULT_DURATION:g} s, or a profile's last "
-              "waypoint time).", minimum=0, exclusive_minimum=True, maximum=MAX_DURATION),
-    Parameter("imu_rate", "Hz", 100.0, "IMU sample rate.", minimum=0, exclusive_minimum=True, maximum=1e5),
+    Parameter("duration", "s", None, f"Simulated time (not set: {DEFAULT_DURATION:g} s, a profile's last "
+              "waypoint time, or a recording's length in whole output steps; at most the recording's).",
+              minimum=0, exclusive_minimum=True, maximum=MAX_DURATION),
+    Parameter("imu_rate", "Hz", None, f"IMU sample rate (not set: {DEFAULT_IMU_RATE:g} Hz, or a recording's "
+              "rate, the only one allowed with it).", minimum=0, exclusive_minimum=True, maximum=1e5),
     Parameter("output_step", "s", 10.0, "Step of the error histories, a whole number of IMU intervals "
               "(the largest errors are taken at these times).", minimum=0, exclusive_minimum=True, maximum=86400),
     Parameter("vertical_channel", "", "off", "free (pure inertial, unstable), off (height held to the truth) or "
@@ -122,7 +130,11 @@ PARAMETERS = ParameterSet((
                 minimum=-_ACCEL_BIAS, maximum=_ACCEL_BIAS) for a in _AXES),
     Parameter("imu", "", None, "Full sensor error model: a grade (navigation, tactical, industrial, consumer) or "
               "a spec file SPEC.toml (schuler.imu.spec); its constant errors at +1 sigma, and drawn with noise "
-              "for Monte Carlo members (not set: ideal apart from the biases given).", kind="text"),
+              "for Monte Carlo members (not set: ideal apart from the biases given). Or a recorded IMU file "
+              "(CSV, PSINS .imu, Parquet; schuler.navigate.recording): a static vehicle whose recorded increments "
+              "are navigated, errors against a stationary truth at the record's site and attitude (--latitude, "
+              "--longitude, --height, --heading override them), at the record's rate and length; one member, "
+              "no Monte Carlo.", kind="text"),
     Parameter("sigma_position_error", "m", 0.0, "Monte Carlo: 1-sigma of the north and east initial position "
               "errors.", minimum=0, maximum=1e5),
     Parameter("sigma_velocity_error", "m/s", 0.0, "Monte Carlo: 1-sigma of the north and east initial velocity "
@@ -167,6 +179,8 @@ class Setup:
     mode: str
     vertical_channel: str
     model: ErrorModel | None
+    recorded: np.ndarray | None = None
+    """(dtheta, dv) per IMU interval of a recording replayed instead of the ideal IMU (None: synthetic)."""
 
     @property
     def output_count(self) -> int:
@@ -187,7 +201,11 @@ def _profile(text: str):
 
 
 def setup(case: Case) -> Setup:
-    """The shared part of a case (its trajectory built and checked, its error model loaded)."""
+    """The shared part of a case (its trajectory built and checked, its error model or recording loaded)."""
+    if case["imu"] is not None and is_recording(case["imu"].strip()):
+        recording = replay(case["imu"].strip(), case)
+        return Setup(recording.trajectory, recording.duration, recording.imu_rate, case["output_step"],
+                     case["mode"], case["vertical_channel"], None, recording.increments)
     name = case["trajectory"].strip()
     duration = case["duration"]
     if name in TRAJECTORIES:
@@ -211,7 +229,8 @@ def setup(case: Case) -> Setup:
         trajectory = profile
         duration = profile.duration if duration is None else duration
     model = imu_noise.load_error_model(case["imu"].strip()) if case["imu"] is not None else None
-    return Setup(trajectory, float(duration), case["imu_rate"], case["output_step"], case["mode"],
+    imu_rate = DEFAULT_IMU_RATE if case["imu_rate"] is None else case["imu_rate"]
+    return Setup(trajectory, float(duration), imu_rate, case["output_step"], case["mode"],
                  case["vertical_channel"], model)
 
 
@@ -255,11 +274,18 @@ def bytes_per_member(shared: Setup, noisy: ErrorModel | None) -> int:
     return held
 
 
+def _refuse_monte_carlo():
+    raise InvalidParameter("monte_carlo", "--imu names a recording, which is one member (its own sensor errors, "
+                                          "recorded once): run it without --monte-carlo")
+
+
 def runs(cases: Cases, shared: Setup) -> Iterator[tuple[np.ndarray, NavigationResult]]:
     """Run the cases as members of batched ``navigate`` calls, in parts that fit the memory budget.
 
     Yields (indices into ``cases``, the part's result with arrays of shape (members, outputs)).
     """
+    if shared.recorded is not None and cases.random is not None:
+        _refuse_monte_carlo()
     generator = TruthGenerator(shared.trajectory, shared.duration, shared.imu_rate)
     rate, force = imu_noise.initial_inputs(generator, shared.mode)
     noisy = _noise_model(shared, cases)
@@ -279,7 +305,7 @@ def runs(cases: Cases, shared: Setup) -> Iterator[tuple[np.ndarray, NavigationRe
                               output_step=shared.output_step, mode=shared.mode,
                               vertical_channel=shared.vertical_channel, initial_errors=initial,
                               sensor_errors=sensors, noise=noise, member_ids=part.members,
-                              max_memory=budget())
+                              max_memory=budget(), recorded_increments=shared.recorded)
 
 
 def reduce(result: NavigationResult) -> dict[str, np.ndarray]:
@@ -310,6 +336,12 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     return out
 
 
+def _imu_name(case: Case, shared: Setup) -> str | None:
+    if shared.model is not None:
+        return shared.model.name
+    return f"recording {Path(case['imu'].strip()).name} (static)" if shared.recorded is not None else None
+
+
 def run_case(case: Case, fidelity: str | None = None) -> NavigateResult:
     """One case in full: its outputs (as :func:`evaluate` gives them) and its error histories."""
     shared = setup(case)
@@ -317,7 +349,7 @@ def run_case(case: Case, fidelity: str | None = None) -> NavigateResult:
     name = case["trajectory"].strip()
     return NavigateResult(
         trajectory=name, mode=shared.mode, vertical_channel=shared.vertical_channel,
-        imu=None if shared.model is None else shared.model.name, duration_s=shared.duration,
+        imu=_imu_name(case, shared), duration_s=shared.duration,
         imu_rate_hz=shared.imu_rate, output_step_s=shared.output_step,
         errors={key: float(values[0]) for key, values in reduce(result).items()}, navigation=result)
 
@@ -325,5 +357,7 @@ def run_case(case: Case, fidelity: str | None = None) -> NavigateResult:
 def member_bytes(case: Case) -> int:
     """Memory one Monte Carlo member holds while evaluated (sizes the chunks)."""
     shared = setup(case)
+    if shared.recorded is not None:
+        _refuse_monte_carlo()
     noisy = shared.model if shared.model is not None and imu_noise.has_noise(shared.model) else None
     return bytes_per_member(shared, noisy)

@@ -147,6 +147,23 @@ def _initial_states(generator: TruthGenerator, errors: InitialErrors, members: i
     return states
 
 
+def _recorded(increments, n_samples: int, mode: str) -> np.ndarray | None:
+    """The first ``n_samples`` rows of recorded increments, checked (None: the ideal IMU of the truth)."""
+    if increments is None:
+        return None
+    if mode != "strapdown":
+        raise InvalidParameter("mode", "recorded increments are body-axis (strapdown) samples; the platform "
+                                       "mechanization senses in its own axes")
+    array = np.asarray(increments, dtype=float)
+    if array.ndim != 2 or array.shape[1] != 6 or array.shape[0] < n_samples:
+        raise InvalidParameter("recorded_increments", f"shape {array.shape} must be (n, 6) with n >= {n_samples} "
+                                                      "(the IMU intervals of the duration)")
+    array = np.ascontiguousarray(array[:n_samples])
+    if not np.all(np.isfinite(array)):
+        raise InvalidParameter("recorded_increments", "must be finite")
+    return array
+
+
 def _baro_parameters(generator: TruthGenerator, time_constant: float, baro_error: float) -> np.ndarray:
     """k1, k2, k3 of the critically damped third-order loop (all poles at -1/tau) and the baro error."""
     if not (np.isfinite(baro_error) and abs(baro_error) <= 1e4):
@@ -194,7 +211,7 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
              centripetal_compensation: bool = True, earth_rate_latitude: str = "computed",
              azimuth_reference: bool = False, baro_error: float = 0.0,
              baro_time_constant: float = 100.0, max_memory: int = DEFAULT_MAX_MEMORY,
-             record_interval_means: bool = False) -> NavigationResult:
+             record_interval_means: bool = False, recorded_increments=None) -> NavigationResult:
     """Simulate the nonlinear INS along a trajectory and return its errors at the output step.
 
     Parameters
@@ -239,6 +256,12 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
         Refuse runs that would hold more than this many bytes.
     record_interval_means : bool
         Also keep the truth's means over each output interval (for the linear model).
+    recorded_increments : array_like, shape (n, 6), optional
+        Measured (dtheta, dv) of each IMU interval, body axes x forward, y right,
+        z down, rad and m/s (a recording, :mod:`schuler.navigate.recording`): the
+        computer integrates these instead of the truth's ideal increments (the
+        sensor errors and noise given still add to them). Strapdown only; at
+        least as many rows as the duration has IMU intervals (the first are used).
 
     Returns
     -------
@@ -258,6 +281,7 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
     initial_errors = initial_errors or InitialErrors()
     sensor_errors = sensor_errors or SensorErrors()
     generator = TruthGenerator(trajectory, duration, imu_rate, earth_rate)
+    recorded = _recorded(recorded_increments, generator.n_samples, mode)
     every = output_interval(output_step, imu_rate)
     batch, ids = _members(initial_errors, sensor_errors, member_ids)
     n_members = ids.size
@@ -300,6 +324,8 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
             gyro_noise = accel_noise = empty_noise
         vertical = np.ascontiguousarray(np.stack([part.positions[:, 2], part.velocities[:, 2]], axis=1))
         sensed = part.nav_increments if platform else part.increments
+        if recorded is not None:
+            sensed = recorded[part.start:part.start + n]
         entered_rate = _entered_earth_rate(part, previous_latitude, generator.earth_rate) if entered else no_rate
         previous_latitude = part.positions[-1, 0]
         kernel(generator.dt, part.start, sensed, vertical, states, gyro, accel, gyro_noise, accel_noise,
