@@ -38,6 +38,13 @@ QUICK = {
 }
 """Options that keep each system's base case short; the fuzzed option comes after them."""
 
+QUICK_ACTIONS = {
+    ("align", "compare"): ["--imu", "tactical", "--duration", "60"],
+    ("north", "compare"): ["--monte-carlo", "4"],
+    ("calibrate", "compare"): ["--monte-carlo", "2"],
+}
+"""The same for system actions whose defaults take long (Monte Carlo members of simulated records)."""
+
 CARELESS = st.one_of(
     st.sampled_from(["nan", "NaN", "inf", "-inf", "-1", "0", "1e308", "-1e308", "1e9", "1e-300", "", " ",
                      "abc", "1,5", "12 parsecs", "5 kg", "0.01 Hz", "95 percent", "1e4 g", "-0", "0x10",
@@ -97,6 +104,7 @@ def run_careless(run_cli, system: str, command: str, option: str, value: str, wo
     args = [system, command]
     if command == "run":
         args += QUICK[system]
+    args += QUICK_ACTIONS.get((system, command), [])
     if command in ("identify", "info", "allan"):
         record = workdir / "record.csv"
         record.write_bytes(b"\x00\x01binary\xff\xfe")

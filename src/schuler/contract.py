@@ -275,6 +275,10 @@ class Action:
         Positional file arguments.
     output_file : str
         Help of a required ``-o/--output FILE`` option; empty: no such option.
+    write_files : callable, optional
+        ``write_files(result, out_dir) -> [paths]`` for an action whose results are
+        not the system's own types (a comparison built by another package); None:
+        the system's ``write_files``.
     """
 
     name: str
@@ -283,6 +287,7 @@ class Action:
     parameters: ParameterSet
     arguments: tuple[Argument, ...] = ()
     output_file: str = ""
+    write_files: Callable[[Result, Path], list[Path]] | None = None
 
 
 @dataclass(frozen=True)

@@ -139,7 +139,8 @@ def _action_command(system: System, action: Action) -> click.Command:
         case = action.parameters.parse(raw, labels="option")
         with options_named(action.parameters):
             result = action.function(**files_in, **case)
-        files = system.write_files(result, out_dir) if out_dir is not None else []
+        writer = action.write_files or system.write_files
+        files = writer(result, out_dir) if out_dir is not None else []
         written = getattr(result, "files", None) or []
         emit(result, as_json, inputs={**{k: str(v) for k, v in files_in.items()}, **case},
              parameters=action.parameters, files=[*written, *files])

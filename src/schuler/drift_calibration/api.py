@@ -16,6 +16,7 @@ Examples
 
 from __future__ import annotations
 
+from schuler.alignment.commands import calibrate_compare_action
 from schuler.contract import System
 from schuler.drift_calibration.evaluation import (
     OUTPUTS,
@@ -44,6 +45,7 @@ SYSTEM = System(
     reproduce_parameters=REPRODUCE_PARAMETERS,
     write_files=write_files,
     report=report,
+    actions=(calibrate_compare_action(PARAMETERS, evaluate),),
     random_terms=True,
     member_bytes=member_bytes,
     guide="calibrate",

@@ -18,6 +18,7 @@ Examples
 
 from __future__ import annotations
 
+from schuler.alignment.commands import north_compare_action
 from schuler.contract import System
 from schuler.ground_gyrocompass.actions import ACTIONS
 from schuler.ground_gyrocompass.evaluation import (
@@ -46,7 +47,7 @@ SYSTEM = System(
     write_files=write_files,
     report=report,
     fidelities=FIDELITIES,
-    actions=ACTIONS,
+    actions=(*ACTIONS, north_compare_action(PARAMETERS, evaluate)),
     random_terms=True,
     member_bytes=member_bytes,
     guide="north",

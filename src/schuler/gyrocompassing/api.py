@@ -16,6 +16,7 @@ Examples
 
 from __future__ import annotations
 
+from schuler.alignment.commands import ALIGN_COMPARE
 from schuler.contract import System
 from schuler.gyrocompassing.evaluation import FIDELITIES, OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case
 from schuler.gyrocompassing.reproduction import report, reproduce
@@ -34,6 +35,7 @@ SYSTEM = System(
     write_files=write_files,
     report=report,
     fidelities=FIDELITIES,
+    actions=(ALIGN_COMPARE,),
     random_terms=True,
     member_bytes=member_bytes,
     guide="align",

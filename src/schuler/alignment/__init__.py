@@ -1,0 +1,1 @@
+"""Alignment, north finding and calibration beyond the seeds."""

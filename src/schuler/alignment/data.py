@@ -1,0 +1,203 @@
+"""What the alignment methods read: a batch of static records as increments, and what each method returns.
+
+:class:`StaticBatch` holds m records of n samples each (``(m, n, 3)`` angle
+increments, rad, and velocity increments, m/s, body x forward / y right / z
+down) taken at one site; one :class:`~schuler.imu.record.ImuRecord` is a batch of
+one. :class:`MethodEstimate` is one method's answer for every record of a
+batch: final roll, pitch, heading (rad, aerospace, NED), the method's own
+1-sigma where it has one, and the histories on a common time grid.
+
+Examples
+--------
+>>> import numpy as np
+>>> batch = StaticBatch(np.zeros((2, 100, 3)), np.zeros((2, 100, 3)), sample_interval_s=0.01,
+...                     latitude_rad=0.6)
+>>> batch.members, batch.samples, batch.duration_s
+(2, 100, 1.0)
+>>> batch.history_indices(0.25)
+array([ 25,  50,  75, 100])
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from schuler.alignment.attitude import wrap_angle
+from schuler.core.earth import normal_gravity
+from schuler.exceptions import InvalidParameter
+from schuler.imu.record import ImuRecord
+
+BYTES_PER_SAMPLE = 6 * 8
+"""Bytes of one six-axis sample of one record in a batch (float64)."""
+
+
+@dataclass
+class StaticBatch:
+    """m static records at one site, as increments over each sample interval.
+
+    Parameters
+    ----------
+    gyro_increment : ndarray (m, n, 3)
+        Angle increments, rad, body axes.
+    accel_increment : ndarray (m, n, 3)
+        Velocity increments (specific force integrated over dt), m/s, body axes.
+    sample_interval_s : float
+        dt, s.
+    latitude_rad : float
+        Site latitude L, rad.
+    gravity_m_s2 : float, optional
+        g at the site (default: WGS-84 normal gravity at L).
+    """
+
+    gyro_increment: np.ndarray
+    accel_increment: np.ndarray
+    sample_interval_s: float
+    latitude_rad: float
+    gravity_m_s2: float | None = None
+
+    def __post_init__(self):
+        self.gyro_increment = np.asarray(self.gyro_increment, dtype=float)
+        self.accel_increment = np.asarray(self.accel_increment, dtype=float)
+        if self.gyro_increment.ndim != 3 or self.gyro_increment.shape[2] != 3:
+            raise InvalidParameter("gyro_increment", f"shape {self.gyro_increment.shape} must be (members, samples, 3)")
+        if self.accel_increment.shape != self.gyro_increment.shape:
+            raise InvalidParameter("accel_increment", f"shape {self.accel_increment.shape} must equal the gyro's "
+                                   f"{self.gyro_increment.shape}")
+        if self.samples < 2:
+            raise InvalidParameter("duration", f"an alignment needs at least 2 samples, got {self.samples}")
+        dt = float(self.sample_interval_s)
+        if not (math.isfinite(dt) and dt > 0):
+            raise InvalidParameter("sample_interval_s", f"must be finite and > 0, got {self.sample_interval_s!r}")
+        self.sample_interval_s = dt
+        if not (math.isfinite(self.latitude_rad) and abs(self.latitude_rad) <= math.pi / 2):
+            raise InvalidParameter("latitude", f"{self.latitude_rad!r} rad must be within [-pi/2, pi/2]")
+        if self.gravity_m_s2 is not None and not (math.isfinite(self.gravity_m_s2) and self.gravity_m_s2 > 0):
+            raise InvalidParameter("gravity", f"must be finite and > 0 m/s^2, got {self.gravity_m_s2!r}")
+        for name in ("gyro_increment", "accel_increment"):
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise InvalidParameter(name, "holds NaN or infinite samples")
+
+    @classmethod
+    def from_record(cls, record: ImuRecord, *, latitude_rad: float | None = None, start_s: float = 0.0,
+                    duration_s: float | None = None) -> StaticBatch:
+        """The window [start, start + duration) of a record as a batch of one.
+
+        Raises
+        ------
+        InvalidParameter
+            No latitude (neither in the record nor given), or a window outside the record.
+        """
+        latitude = record.latitude_rad if latitude_rad is None else latitude_rad
+        if latitude is None:
+            raise InvalidParameter("latitude", f"{record.source or 'the record'} states no site latitude; give one")
+        first, stop = window_indices(record.samples, record.sample_interval_s, start_s, duration_s)
+        return cls(record.gyro_increment_rad[None, first:stop], record.accel_increment_m_s[None, first:stop],
+                   record.sample_interval_s, float(latitude), record.gravity_m_s2)
+
+    @property
+    def gravity(self) -> float:
+        """g at the site, m/s^2 (the one given, or WGS-84 normal gravity at the latitude)."""
+        return float(normal_gravity(self.latitude_rad)) if self.gravity_m_s2 is None else float(self.gravity_m_s2)
+
+    @property
+    def members(self) -> int:
+        return int(self.gyro_increment.shape[0])
+
+    @property
+    def samples(self) -> int:
+        return int(self.gyro_increment.shape[1])
+
+    @property
+    def duration_s(self) -> float:
+        return round(self.samples * self.sample_interval_s, 12)
+
+    def head(self, duration_s: float) -> StaticBatch:
+        """The first ``duration_s`` seconds (at least 2 samples, at most all), as a batch (views, no copy)."""
+        samples = max(2, min(self.samples, int(round(duration_s / self.sample_interval_s))))
+        return StaticBatch(self.gyro_increment[:, :samples], self.accel_increment[:, :samples],
+                           self.sample_interval_s, self.latitude_rad, self.gravity_m_s2)
+
+    def history_indices(self, step_s: float) -> np.ndarray:
+        """Sample counts (1-based ends) at which histories are reported: every ``step_s``, and the last sample."""
+        stride = max(1, int(round(step_s / self.sample_interval_s)))
+        ends = np.arange(stride, self.samples + 1, stride)
+        if ends.size == 0 or ends[-1] != self.samples:
+            ends = np.append(ends, self.samples)
+        return ends
+
+    def mean_rates(self, stop: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Mean angular rate (rad/s) and specific force (m/s^2) over samples [0, stop), each (m, 3)."""
+        stop = self.samples if stop is None else int(stop)
+        span = stop * self.sample_interval_s
+        return self.gyro_increment[:, :stop].sum(axis=1) / span, self.accel_increment[:, :stop].sum(axis=1) / span
+
+
+def window_indices(samples: int, dt: float, start_s: float, duration_s: float | None) -> tuple[int, int]:
+    """Sample range [first, stop) of the window [start, start + duration) of a record of ``samples`` samples."""
+    total = samples * dt
+    if not (math.isfinite(start_s) and 0 <= start_s < total):
+        raise InvalidParameter("start", f"{start_s:g} s must be within the record's [0, {total:g}) s")
+    first = int(round(start_s / dt))
+    if duration_s is None:
+        return first, samples
+    if not (math.isfinite(duration_s) and duration_s > 0):
+        raise InvalidParameter("duration", f"must be finite and > 0 s, got {duration_s!r}")
+    stop = first + int(round(duration_s / dt))
+    if stop > samples:
+        raise InvalidParameter("duration", f"{start_s:g} s + {duration_s:g} s runs past the record's end "
+                               f"({total:g} s)")
+    if stop - first < 2:
+        raise InvalidParameter("duration", f"{duration_s:g} s holds fewer than 2 samples")
+    return first, stop
+
+
+@dataclass
+class MethodEstimate:
+    """One method's attitude for every record of a batch.
+
+    Attributes
+    ----------
+    method : str
+        ``coarse``, ``inertial_frame``, ``kalman`` or ``gyrocompass``.
+    roll_rad, pitch_rad, heading_rad : ndarray (m,)
+        Final attitude, aerospace angles (heading in (-pi, pi]).
+    sigma_rad : ndarray (m, 3) or None
+        The method's own 1-sigma of roll, pitch, heading (None: the method states none).
+    time_s : ndarray (K,)
+        Times of the histories, s from the window's start.
+    roll_history_rad, pitch_history_rad, heading_history_rad : ndarray (m, K)
+        The attitude the method would give if stopped at each time.
+    sigma_history_rad : ndarray (m, K, 3) or None
+        Its 1-sigma over time, where it has one.
+    """
+
+    method: str
+    roll_rad: np.ndarray
+    pitch_rad: np.ndarray
+    heading_rad: np.ndarray
+    sigma_rad: np.ndarray | None
+    time_s: np.ndarray
+    roll_history_rad: np.ndarray
+    pitch_history_rad: np.ndarray
+    heading_history_rad: np.ndarray
+    sigma_history_rad: np.ndarray | None = None
+
+
+def convergence_time(time_s, history, final, band) -> np.ndarray:
+    """The first time after which ``history`` stays within ``band`` of ``final`` (per record), s.
+
+    Parameters
+    ----------
+    time_s : ndarray (K,)
+    history : ndarray (m, K)
+        Angles, rad (differences are wrapped).
+    final : ndarray (m,)
+    band : float or ndarray (m,)
+        Half-width, rad.
+    """
+    outside = np.abs(wrap_angle(np.asarray(history) - np.asarray(final)[:, None])) > np.asarray(band).reshape(-1, 1)
+    last = np.where(outside.any(axis=1), outside.shape[1] - 1 - np.argmax(outside[:, ::-1], axis=1), -1)
+    return np.where(last + 1 < time_s.size, time_s[np.minimum(last + 1, time_s.size - 1)], time_s[-1])

@@ -1,0 +1,198 @@
+"""North finders, multi-position calibration and the three ``compare`` commands.
+
+Round trips on simulated records: what goes in (azimuth, biases, scale factors, misalignments) comes out
+within the predicted 1-sigma; the commands' JSON carries the documented keys, the figures the documented size.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from schuler.alignment.attitude import wrap_angle
+from schuler.alignment.calibration_comparison import compare_calibration
+from schuler.alignment.commands import align_compare
+from schuler.alignment.multi_static import MultiStaticPlan, calibrate_multi_static, identifiable_truth
+from schuler.alignment.north import AXES, NORTH_METHODS, find_north, north_sigma, schedule, turntable_rates
+from schuler.alignment.north_comparison import compare_north
+from schuler.alignment.six_position import SixPositionPlan, calibrate_six_position
+from schuler.exceptions import InvalidParameter
+from schuler.imu.simulate import ImuSimulator
+from schuler.imu.spec import preset
+
+LATITUDE = math.radians(45.0)
+METHOD_NAMES = ("coarse", "inertial_frame", "kalman", "gyrocompass")
+
+
+@pytest.mark.parametrize("method", NORTH_METHODS)
+@pytest.mark.parametrize("axes", AXES)
+@pytest.mark.parametrize("heading_deg", [30.0, 100.0, -150.0])
+def test_north_finders_recover_the_azimuth_of_noise_free_rates(method, axes, heading_deg):
+    """Exact Earth rates plus a bias per gyro in, the azimuth out to rounding (1e-9 rad)."""
+    heading = math.radians(heading_deg)
+    start, end = schedule(method, samples=400, sample_interval_s=0.5)
+    rates = turntable_rates(LATITUDE, heading, start, end, 0.5)[:, :len(axes)]
+    rates = rates + np.array([3e-6, -2e-6])[:len(axes)]   # a bias per gyro, rad/s
+    estimate = find_north(rates[None], start, end, LATITUDE, method, axes)
+    truth = abs(heading) if estimate.ambiguous else heading
+    assert float(wrap_angle(estimate.heading_rad[0] - truth)) == pytest.approx(0.0, abs=1e-9)
+    assert estimate.bias_rad_s[0] == pytest.approx(np.array([3e-6, -2e-6])[:len(axes)], abs=1e-14)
+
+
+def test_north_sigma_closed_forms():
+    """N / (Omega cos L sqrt(T)) with two gyros; sqrt(2) of it with one turned; / |sin psi| at two positions."""
+    n, duration = 1e-5, 400.0
+    base = n / (7.292115e-5 * math.cos(LATITUDE) * math.sqrt(duration))
+    assert north_sigma("carousel", "xy", n, LATITUDE, duration) == pytest.approx(base, rel=1e-6)
+    assert north_sigma("four_position", "x", n, LATITUDE, duration) == pytest.approx(math.sqrt(2) * base, rel=1e-6)
+    assert north_sigma("two_position", "x", n, LATITUDE, duration, math.radians(30)) == pytest.approx(2 * base,
+                                                                                                      rel=1e-6)
+    with pytest.raises(InvalidParameter, match="method"):
+        north_sigma("three_position", "x", n, LATITUDE, duration)
+
+
+def test_north_comparison_puts_system_5_on_the_same_time_axis():
+    """compare_north with a stand-in for system 5: its curve sits beside the three methods, per duration.
+
+    (The Monte Carlo spreads against the closed forms are tests/test_alignment_monte_carlo.py's, at 1,000
+    members; the grade's flicker makes the simulator slow, so few members here.)
+    """
+    calls = []
+
+    def ground_gyrocompass(durations, noise, latitude):
+        calls.append((np.asarray(durations).copy(), noise, latitude))
+        return noise / np.sqrt(np.asarray(durations))
+
+    result = compare_north("tactical", latitude_rad=LATITUDE, heading_rad=math.radians(30), duration_s=120.0,
+                           sample_interval_s=0.5, members=4, seed=3, ground_gyrocompass=ground_gyrocompass)
+    assert set(result.methods) == set(NORTH_METHODS)
+    assert len(result.versus_time["ground_gyrocompass"]) == len(result.versus_time["duration_s"])
+    assert result.ground_gyrocompass["sigma_rad"] == pytest.approx(calls[-1][1] / math.sqrt(120.0))
+    for method, row in result.methods.items():
+        # one record's error within 4.5 of its fit's 1-sigma, and that 1-sigma within a factor 2 of the closed form
+        assert abs(row["error_rad"]) < 4.5 * row["sigma_rad"], method
+        assert 0.5 < row["sigma_rad"] / row["analytic_sigma_rad"] < 2.0, method
+    grades = result.versus_grade
+    assert grades["navigation"]["carousel"] < grades["tactical"]["carousel"]
+
+
+def test_six_position_calibration_is_exact_without_noise():
+    """Noise-free six positions with a rate test: biases, scale factors and misalignments to rounding."""
+    plan = SixPositionPlan(latitude_rad=LATITUDE, dwell_s=10.0, turn_s=20.0, sample_interval_s=0.1)
+    gyro_true, accel_true = plan.truth()
+    rng = np.random.default_rng(5)
+    gyro_matrix = np.eye(3) + rng.normal(0, 1e-3, (3, 3))
+    accel_matrix = np.eye(3) + rng.normal(0, 1e-3, (3, 3))
+    gyro_bias, accel_bias = rng.normal(0, 1e-5, 3), rng.normal(0, 1e-2, 3)
+    fit = calibrate_six_position(gyro_true @ gyro_matrix.T + gyro_bias, accel_true @ accel_matrix.T + accel_bias,
+                                 plan)
+    assert fit.gyro_bias == pytest.approx(gyro_bias, abs=1e-12)
+    assert fit.accel_bias == pytest.approx(accel_bias, abs=1e-10)
+    assert fit.gyro_matrix == pytest.approx(gyro_matrix, abs=1e-9)
+    assert fit.accel_matrix == pytest.approx(accel_matrix, abs=1e-10)
+
+
+def test_multi_static_calibration_is_exact_without_noise():
+    """Noise-free hand-held record with sensor errors: what the method can identify, to 1e-6."""
+    plan = MultiStaticPlan(positions=15, sample_interval_s=0.02, latitude_rad=LATITUDE)
+    gyro_true, accel_true = plan.truth(seed=4)
+    rng = np.random.default_rng(6)
+    accel_matrix = np.eye(3) + rng.normal(0, 2e-3, (3, 3))
+    gyro_matrix = np.eye(3) + rng.normal(0, 2e-3, (3, 3))
+    accel_bias = rng.normal(0, 0.05, 3)
+    fit = calibrate_multi_static(gyro_true @ gyro_matrix.T, accel_true @ accel_matrix.T + accel_bias,
+                                 plan.sample_interval_s, initial_s=plan.initial_s, gravity_m_s2=plan.gravity)
+    truth = identifiable_truth(accel_matrix, accel_bias, gyro_matrix)
+    assert fit.accel_bias == pytest.approx(truth["accel_bias"], abs=1e-6)
+    assert fit.accel_scale == pytest.approx(truth["accel_scale"], abs=1e-6)
+    assert fit.accel_non_orthogonality == pytest.approx(truth["accel_non_orthogonality"], abs=1e-6)
+    # the gyro fit leaves out the Earth rate during the turns (module notes): 1e-4 of the matrix
+    assert fit.gyro_matrix == pytest.approx(truth["gyro_matrix"], abs=1e-4)
+
+
+def _z(entries: dict) -> np.ndarray:
+    return np.concatenate([np.asarray(v["z"]) for v in entries.values() if isinstance(v, dict)])
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_calibration_round_trip_within_the_predicted_accuracy(seed):
+    """Known errors of one industrial IMU in, estimates out: z = (estimate - true) / predicted 1-sigma.
+
+    Six positions: the rms of its 24 z is 1 within the spread of a chi distribution of 24 degrees of freedom
+    (0.6-1.4 is beyond 2.5 standard deviations); no |z| above 4.5. Multi-static: it states less than it makes
+    (rms z 1.0-1.6 over seeds 0-2 and two grades; accelerometer biases 1.5-1.9, see multi_static's notes):
+    no |z| above 5 and rms z below 2.
+    """
+    result = compare_calibration("industrial", latitude_rad=LATITUDE, seed=seed)
+    six, multi = _z(result.six_position), _z(result.multi_static)
+    assert 0.6 < np.sqrt(np.mean(six**2)) < 1.4
+    assert np.abs(six).max() < 4.5
+    assert np.sqrt(np.mean(multi**2)) < 2.0
+    assert np.abs(multi).max() < 5.0
+    assert result.multi_static["static_intervals"] >= 37   # every orientation and the initial period found
+
+
+def test_imu_simulator_and_six_position_agree_on_the_truth():
+    """The calibration's truth is the simulator's: its drawn K and b (measured - true) are what six positions find.
+
+    Navigation grade over 60 s dwells: 1-sigma from white noise only, checked per entry at 4.5 sigma.
+    """
+    model = preset("navigation")
+    plan = SixPositionPlan(latitude_rad=LATITUDE, dwell_s=60.0, turn_s=36.0, sample_interval_s=0.05)
+    gyro_true, accel_true = plan.truth()
+    simulator = ImuSimulator(model, plan.sample_interval_s, true_gyro_rad_s=gyro_true, true_accel_m_s2=accel_true,
+                             seed=8)
+    gyro, accel = simulator.window([0], 0, gyro_true.shape[0])
+    constants = simulator.constants([0])
+    fit = calibrate_six_position(gyro[0], accel[0], plan, model.gyro.random_walk, model.accel.random_walk)
+    slow = np.hypot(model.accel.bias_instability, 1e-30)   # the slow terms the fit does not model, m/s^2
+    assert np.all(np.abs(fit.accel_bias - constants["accel_bias"][0]) < 4.5 * np.hypot(fit.accel_bias_sigma, slow))
+
+
+def test_align_compare_refuses_no_data():
+    with pytest.raises(InvalidParameter, match="record"):
+        align_compare(imu=None)
+
+
+def test_align_compare_json_and_figure(run_cli, tmp_path):
+    """``schuler align compare --imu GRADE --json --out DIR``: the documented keys, one figure <= 7 in wide."""
+    out = run_cli("align", "compare", "--imu", "navigation", "--duration", "120", "--imu-rate", "20", "--json",
+                  "--out", tmp_path)
+    assert out.code == 0, out.stderr
+    methods = out.json()["methods"]
+    assert set(methods) == set(METHOD_NAMES)
+    for name, row in methods.items():
+        for key in ("roll_rad", "pitch_rad", "heading_rad", "limit_heading_rad", "convergence_time_s"):
+            assert math.isfinite(row[key]), (name, key)
+        assert (row["heading_sigma_rad"] is None) == (name != "kalman")
+        # a simulated record's truth is known: every heading within 4 of its 1-sigma limits
+        assert abs(row["heading_error_rad"]) < 4 * row["limit_heading_rad"], name
+    assert (tmp_path / "align_compare_heading.png").exists() and (tmp_path / "align_compare_heading.svg").exists()
+    from matplotlib.image import imread
+
+    height, width = imread(tmp_path / "align_compare_heading.png").shape[:2]
+    assert width <= 700 and height <= 700
+
+
+def test_north_and_calibrate_compare_commands(run_cli, tmp_path):
+    """``north compare`` has system 5 on its curve; ``calibrate compare`` has system 3's pulse method beside."""
+    out = run_cli("north", "compare", "--duration", "60", "--imu-rate", "2", "--monte-carlo", "3", "--json",
+                  "--out", tmp_path)
+    assert out.code == 0, out.stderr
+    north = out.json()
+    assert set(north["methods"]) == set(NORTH_METHODS)
+    assert north["ground_gyrocompass"]["sigma_rad"] > 0
+    assert len(north["versus_time"]["ground_gyrocompass"]) == len(north["versus_time"]["duration_s"])
+    assert (tmp_path / "north_compare_accuracy.png").exists()
+    out = run_cli("calibrate", "compare", "--positions", "12", "--dwell", "10", "--imu-rate", "20",
+                  "--monte-carlo", "4", "--json", "--out", tmp_path)
+    assert out.code == 0, out.stderr
+    calibration = out.json()
+    assert calibration["pulse"]["drift_sigma_rad_s"] > 0
+    assert {"gyro_bias", "accel_bias", "gyro_scale", "accel_scale"} <= set(calibration["six_position"])
+    assert {"accel_non_orthogonality", "gyro_matrix"} <= set(calibration["multi_static"])
+    written = json.dumps(calibration)
+    assert "NaN" not in written
