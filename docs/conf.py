@@ -18,12 +18,16 @@ with ``-W --keep-going``: every warning fails the build.
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
+# the gallery runs the INS's parallel numba loops in this process before `-j auto` forks the readers:
+# GNU OpenMP cannot survive a fork, numba's fork-safe layers can
+os.environ.setdefault("NUMBA_THREADING_LAYER", "forksafe")
 
 DOCS = Path(__file__).resolve().parent
 sys.path.insert(0, str(DOCS / "_ext"))
@@ -33,7 +37,7 @@ from sphinx_gallery.sorting import ExplicitOrder  # noqa: E402
 import schuler  # noqa: E402
 
 GALLERY = DOCS.parent / "examples" / "gallery"
-SYSTEM_ORDER = ("errors", "vertical", "calibrate", "align", "north", "engine", "imu")
+SYSTEM_ORDER = ("errors", "vertical", "calibrate", "align", "north", "navigate", "mission", "engine", "imu")
 """Gallery sections in the guide's order; a new system's folder is built after them ("*")."""
 
 project = "schuler"
