@@ -1,10 +1,11 @@
-# Quick start: `make demo` builds the report of every system; `make test` runs the guards and the suite.
+# Quick start: `make demo` builds the report of every system; `make test` runs the guards and the suite;
+# `make docs` builds the documentation into docs/_build/html.
 PYTHON ?= $(shell command -v python3.11 || command -v python3)
 VENV := .venv
 BIN := $(VENV)/bin
 OUT ?= results
 
-.PHONY: demo test test-slow lint bench clean
+.PHONY: demo test test-slow lint bench docs clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -18,6 +19,10 @@ $(VENV)/.installed-test: $(BIN)/python pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(VENV)/.installed $@
 
+$(VENV)/.installed-docs: $(BIN)/python pyproject.toml
+	$(BIN)/python -m pip install --quiet -e '.[docs]'
+	touch $(VENV)/.installed $@
+
 demo: $(VENV)/.installed
 	$(BIN)/schuler report --out $(OUT)
 	@echo "Open $(OUT)/index.html in a browser."
@@ -28,7 +33,7 @@ PSINS_IMU ?= $(abspath $(wildcard ../shared/data/psins/lasergyro.imu))
 # the guards: lint, types, and the layers of the import contract (pyproject.toml)
 lint: $(VENV)/.installed-test
 	@echo "== ruff: lint"
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks docs/_ext docs/conf.py examples
 	@echo "== mypy: types"
 	$(BIN)/mypy
 	@echo "== import-linter: layers cli > study > systems > boundary > core"
@@ -47,8 +52,13 @@ test-slow: $(VENV)/.installed-test
 	@echo "== pytest: the tests marked slow"
 	$(PYTEST) -m slow
 
+# the site: user guide, gallery (its examples run), API reference; every warning is an error
+docs: $(VENV)/.installed-docs
+	OPENBLAS_NUM_THREADS=1 $(BIN)/python -m sphinx -W --keep-going -j auto -b html docs docs/_build/html
+	@echo "Open docs/_build/html/index.html in a browser."
+
 bench: $(VENV)/.installed-test
 	for b in benchmarks/bench_*.py; do OPENBLAS_NUM_THREADS=1 $(BIN)/python $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache
+	rm -rf $(VENV) $(OUT) .pytest_cache docs/_build docs/api docs/gallery docs/sg_execution_times.rst

@@ -23,7 +23,13 @@ __version__ = "0.2.0"
 
 
 def get_system(name: str):
-    """The system registered under ``name`` (``errors``, ``vertical``, ``calibrate``, ``align``, ``north``)."""
+    """The system registered under ``name`` (``errors``, ``vertical``, ``calibrate``, ``align``, ``north``).
+
+    Parameters
+    ----------
+    name : str
+        Command name of the system.
+    """
     from schuler.registry import get_system as lookup
 
     return lookup(name)

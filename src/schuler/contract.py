@@ -114,7 +114,17 @@ class Cases:
 
     @classmethod
     def from_case(cls, case: Case, n: int = 1, **kwargs) -> Cases:
-        """``n`` copies of one case (a Monte Carlo's members, or a single evaluation)."""
+        """``n`` copies of one case (a Monte Carlo's members, or a single evaluation).
+
+        Parameters
+        ----------
+        case : Case
+            A validated case (SI values).
+        n : int
+            Number of copies (members).
+        **kwargs
+            ``members``, ``random`` and ``fidelity``, as in :class:`Cases`.
+        """
         values = {}
         for name, value in case.items():
             if value is None:
@@ -139,7 +149,13 @@ class Cases:
         return tuple(self._values)
 
     def float(self, name: str) -> np.ndarray:
-        """A numeric parameter as a float array (NaN where not set)."""
+        """A numeric parameter as a float array (NaN where not set).
+
+        Parameters
+        ----------
+        name : str
+            Parameter name; its values are SI (the parameter's SI unit).
+        """
         array = self._values[name]
         if array.dtype == object:
             # numpy's stubs leave out None, which object arrays compare elementwise
@@ -148,12 +164,26 @@ class Cases:
         return array.astype(float)
 
     def value_or(self, name: str, fallback) -> np.ndarray:
-        """A numeric parameter with its "not set" entries replaced by ``fallback`` (scalar or array)."""
+        """A numeric parameter with its "not set" entries replaced by ``fallback`` (scalar or array).
+
+        Parameters
+        ----------
+        name : str
+            Parameter name.
+        fallback : float or ndarray
+            Value of the cases that do not set it, in the parameter's SI unit.
+        """
         values = self.float(name)
         return np.where(np.isnan(values), fallback, values)
 
     def is_set(self, name: str) -> np.ndarray:
-        """Which cases set the parameter (bool array)."""
+        """Which cases set the parameter (bool array).
+
+        Parameters
+        ----------
+        name : str
+            Parameter name.
+        """
         array = self._values[name]
         if array.dtype == object:
             # numpy's stubs leave out None, which object arrays compare elementwise
@@ -163,7 +193,13 @@ class Cases:
         return np.ones(self.n, dtype=bool)
 
     def take(self, index) -> Cases:
-        """The cases at ``index`` (an index array or boolean mask), keeping their member numbers."""
+        """The cases at ``index`` (an index array or boolean mask), keeping their member numbers.
+
+        Parameters
+        ----------
+        index : ndarray of int or bool
+            Indices (or a mask of length ``len(self)``) of the cases kept.
+        """
         return Cases({k: v[index] for k, v in self._values.items()}, members=self.members[index],
                      random=self.random, fidelity=self.fidelity)
 
@@ -172,6 +208,12 @@ class Cases:
 
         For parameters that change the shape of a computation (a duration, an
         output step, a model choice), so each group is evaluated at once.
+
+        Parameters
+        ----------
+        *names : str
+            Parameters whose distinct values define the groups.
+
         """
         if not names or self.n == 0:
             yield np.arange(self.n), self
@@ -185,7 +227,13 @@ class Cases:
             yield index, self.take(index)
 
     def case(self, i: int) -> Case:
-        """Case ``i`` as a :class:`Case` (NaN and None become "not set")."""
+        """Case ``i`` as a :class:`Case` (NaN and None become "not set").
+
+        Parameters
+        ----------
+        i : int
+            Index of the case in the batch.
+        """
         values = {}
         for name, array in self._values.items():
             value = array[i]
@@ -304,11 +352,23 @@ class System:
     guide: str = ""
 
     def case(self, **si_values) -> Case:
-        """A validated case from SI values; unknown names raise :class:`InvalidParameter` with a suggestion."""
+        """A validated case from SI values; unknown names raise :class:`InvalidParameter` with a suggestion.
+
+        Parameters
+        ----------
+        **si_values
+            Parameters by name, in SI (each parameter's SI unit: rad, rad/s, m, s ...).
+        """
         return self.parameters.case(si_values)
 
     def check_fidelity(self, fidelity: str | None) -> str | None:
-        """The fidelity to use (the default when None); refuses one the system does not offer."""
+        """The fidelity to use (the default when None); refuses one the system does not offer.
+
+        Parameters
+        ----------
+        fidelity : str or None
+            One of :attr:`fidelities`, or None for the default.
+        """
         if fidelity is None:
             return self.fidelities[0] if self.fidelities else None
         if fidelity not in self.fidelities:
@@ -361,7 +421,23 @@ class System:
     def monte_carlo(self, case: Case, members: int, streams: RandomStreams, fidelity: str | None = None, *,
                     draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None,
                     progress: Callable[[int, int], None] | None = None) -> MonteCarloSummary:
-        """Statistics of every output over ``members`` random members of ``case`` (see :func:`monte_carlo`)."""
+        """Statistics of every output over ``members`` random members of ``case`` (see :func:`monte_carlo`).
+
+        Parameters
+        ----------
+        case : Case
+            The nominal case (SI values).
+        members : int
+            Number of random members.
+        streams : RandomStreams
+            Where the members' random terms come from.
+        fidelity : str, optional
+            One of :attr:`fidelities`.
+        draw : callable, optional
+            ``draw(member_numbers) -> {parameter: values}``, SI values per member.
+        progress : callable, optional
+            ``progress(done, total)`` after each chunk, in members.
+        """
         return monte_carlo(self.evaluate, self.outputs, case, members, streams, fidelity,
                            chunk=self._chunk_size(case), draw=draw, progress=progress)
 
@@ -374,7 +450,19 @@ class System:
 
     def evaluate_values(self, values: Mapping[str, Any], *, members=None, random: RandomStreams | None = None,
                         fidelity: str | None = None) -> dict[str, np.ndarray]:
-        """``evaluate`` on parameter arrays in SI (unset parameters take their defaults)."""
+        """``evaluate`` on parameter arrays in SI (unset parameters take their defaults).
+
+        Parameters
+        ----------
+        values : mapping of str to array_like
+            Parameter arrays (or scalars, broadcast) in SI, each of the same length.
+        members : array_like of int, optional
+            Global member numbers (the addresses of the random draws; default 0 .. n-1).
+        random : RandomStreams, optional
+            Where random terms come from; None evaluates the nominal case.
+        fidelity : str, optional
+            One of :attr:`fidelities`.
+        """
         self.parameters.refuse_unknown(values)
         lengths = {np.size(v) for v in values.values() if np.ndim(v) > 0}
         if len(lengths) > 1:
@@ -388,6 +476,13 @@ class System:
         return self.evaluate(Cases(arrays, members=members, random=random, fidelity=self.check_fidelity(fidelity)))
 
     def output(self, name: str) -> Output:
+        """The declared :class:`Output` called ``name`` (KeyError if there is none).
+
+        Parameters
+        ----------
+        name : str
+            Output key (``azimuth_error_rad``).
+        """
         for output in self.outputs:
             if output.name == name:
                 return output
@@ -403,6 +498,28 @@ def monte_carlo(evaluate: Callable[[Cases], dict[str, np.ndarray]], outputs: tup
     Member ``i`` draws its random terms from ``streams`` at address ``i``, so the
     statistics do not depend on ``chunk``. ``draw(member_numbers) -> {parameter:
     values}`` optionally replaces parameters per member (a scenario's distributions).
+
+    Parameters
+    ----------
+    evaluate : callable
+        A system's ``evaluate(cases) -> {output: array}`` (SI).
+    outputs : tuple of Output
+        The outputs to summarise.
+    case : Case
+        The nominal case (SI values).
+    members : int
+        Number of random members.
+    streams : RandomStreams
+        Where the members' random terms come from.
+    fidelity : str, optional
+        Passed to ``evaluate`` through :attr:`Cases.fidelity`.
+    chunk : int
+        Members evaluated at once (a count; it does not change the result).
+    draw : callable, optional
+        ``draw(member_numbers) -> {parameter: values}``, SI values per member.
+    progress : callable, optional
+        ``progress(done, total)`` after each chunk, in members.
+
     """
     statistics = {output.name: StreamingStatistics((1,), reservoir_size=MONTE_CARLO_SAMPLES) for output in outputs}
     samples: dict[str, list[np.ndarray]] = {output.name: [] for output in outputs}

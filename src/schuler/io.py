@@ -54,6 +54,13 @@ def _naming(tmp: Path | None, shown):
 def atomic_path(path):
     """Yield a path to write; on success it becomes ``path`` (see the module notes).
 
+    Parameters
+    ----------
+    path : str or Path
+        The file to write.
+
+    Examples
+    --------
     >>> import tempfile, pathlib
     >>> target = pathlib.Path(tempfile.mkdtemp()) / "a.txt"
     >>> with atomic_path(target) as tmp:
@@ -90,7 +97,13 @@ def atomic_path(path):
 
 
 def remove_stale_parts(folder) -> list[Path]:
-    """Delete temporary files (``.*.part``) an interrupted run left in ``folder`` and its subfolders."""
+    """Delete temporary files (``.*.part``) an interrupted run left in ``folder`` and its subfolders.
+
+    Parameters
+    ----------
+    folder : str or Path
+        Output folder.
+    """
     removed = []
     for part in Path(folder).rglob(f".*{PART_SUFFIX}"):
         if part.is_file():
@@ -100,14 +113,30 @@ def remove_stale_parts(folder) -> list[Path]:
 
 
 def write_text(path, text: str) -> Path:
-    """Write text atomically; returns the path."""
+    """Write text atomically; returns the path.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    text : str
+        Its content.
+    """
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return Path(path)
 
 
 def write_json(path, data) -> Path:
-    """Write JSON atomically (``data`` must already be JSON-safe)."""
+    """Write JSON atomically (``data`` must already be JSON-safe).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    data : dict or list
+        JSON-safe data (:func:`schuler.results.json_safe`).
+    """
     return write_text(path, json.dumps(data, indent=2) + "\n")
 
 
@@ -116,7 +145,15 @@ MIN_FONT_KEY = "schuler-min-font-px"
 
 
 def smallest_font_px(fig, dpi: float) -> float:
-    """The smallest font size among the figure's visible texts, in pixels at ``dpi``."""
+    """The smallest font size among the figure's visible texts, in pixels at ``dpi``.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    dpi : float
+        Resolution, dpi (dots per inch).
+    """
     from matplotlib.text import Text
 
     sizes = [t.get_fontsize() for t in fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
@@ -128,6 +165,16 @@ def save_figure(fig, path, **kwargs) -> Path:
 
     A PNG records its smallest font size in pixels (:data:`MIN_FONT_KEY`), so a
     page showing it can check that its text stays legible at the displayed size.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or Path
+        The file (``.png``, ``.svg`` ...).
+    **kwargs
+        Passed to ``Figure.savefig``.
+
     """
     path = Path(path)
     fmt = path.suffix.lstrip(".") or "png"
@@ -141,7 +188,19 @@ def save_figure(fig, path, **kwargs) -> Path:
 
 
 def save_figure_formats(fig, stem, formats=("png", "svg"), **kwargs) -> list[Path]:
-    """Save a figure as ``stem.png``, ``stem.svg`` ... atomically; close it; return the paths."""
+    """Save a figure as ``stem.png``, ``stem.svg`` ... atomically; close it; return the paths.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure (closed afterwards).
+    stem : str or Path
+        Path without suffix.
+    formats : tuple of str
+        Suffixes to write.
+    **kwargs
+        Passed to ``Figure.savefig``.
+    """
     import matplotlib.pyplot as plt
 
     stem = Path(stem)
@@ -151,7 +210,15 @@ def save_figure_formats(fig, stem, formats=("png", "svg"), **kwargs) -> list[Pat
 
 
 def write_dataframe_csv(frame, path) -> Path:
-    """Write a pandas DataFrame as CSV atomically."""
+    """Write a pandas DataFrame as CSV atomically.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The table (units in its column names).
+    path : str or Path
+        The file.
+    """
     with atomic_path(path) as tmp:
         frame.to_csv(tmp, index=False)
     return Path(path)

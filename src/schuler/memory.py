@@ -35,7 +35,13 @@ class MemoryBudgetExceeded(SchulerError):
 
 
 def parse_bytes(text: str) -> int:
-    """``"8 GiB"`` -> 8589934592; ``"500 MB"`` -> 500000000; ``"1e9"`` -> 1000000000."""
+    """``"8 GiB"`` -> 8589934592; ``"500 MB"`` -> 500000000; ``"1e9"`` -> 1000000000.
+
+    Parameters
+    ----------
+    text : str
+        A size with a unit (bytes, kB, MB, GB, KiB, MiB, GiB) or a bare number of bytes.
+    """
     match = re.fullmatch(r"\s*([0-9.eE+]+)\s*([KkMmGgTt]?i?[Bb]?)\s*", str(text))
     if not match:
         raise SchulerError(f"{ENVIRONMENT}: cannot read {text!r} as a size such as '8 GiB'")
@@ -73,7 +79,13 @@ def budget() -> int:
 
 
 def format_bytes(n: float) -> str:
-    """``1536`` -> ``'1.5 KiB'``."""
+    """``1536`` -> ``'1.5 KiB'``.
+
+    Parameters
+    ----------
+    n : float
+        A size, bytes.
+    """
     for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
         if abs(n) < 1024:
             return f"{n:.3g} {unit}"
@@ -101,5 +113,13 @@ def require(nbytes: float, what: str, change: str) -> None:
 
 
 def chunk_members(member_bytes: int, largest: int = 2_000) -> int:
-    """Members to evaluate at once so that a chunk uses at most a quarter of the budget."""
+    """Members to evaluate at once so that a chunk uses at most a quarter of the budget.
+
+    Parameters
+    ----------
+    member_bytes : int
+        Memory one member needs while evaluated, bytes.
+    largest : int
+        Most members per chunk (a count).
+    """
     return int(max(1, min(largest, budget() // (4 * max(int(member_bytes), 1)))))

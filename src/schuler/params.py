@@ -102,6 +102,14 @@ class Parameter:
 
         Returns the value as the kind's Python type (float, int, str or bool);
         None is returned as is (the parameter's "not set" rule applies).
+
+        Parameters
+        ----------
+        value : float, int, str, bool or None
+            The value in SI (the parameter's SI unit: :attr:`si_unit`).
+        label : str, optional
+            Name used in error messages (default: the parameter's name).
+
         """
         label = label or self.name
         if value is None:
@@ -143,6 +151,14 @@ class Parameter:
         """Convert a user value to its SI value (float), choice (str), int or bool.
 
         ``label`` is the name used in error messages (defaults to ``name``).
+
+        Parameters
+        ----------
+        value : str, float, int or bool
+            As written: a bare number in the display unit (:attr:`unit`) or a string with a unit ("0.01 deg/h").
+        label : str, optional
+            Name used in error messages (default: the parameter's name).
+
         """
         label = label or self.name
         if self.kind == "choice":
@@ -307,7 +323,15 @@ class ParameterSet:
         return tuple(self._by_name)
 
     def refuse_unknown(self, names: Iterable[str], label=lambda name: name) -> None:
-        """Raise :class:`InvalidParameter` for the first name that is not a parameter, suggesting the closest."""
+        """Raise :class:`InvalidParameter` for the first name that is not a parameter, suggesting the closest.
+
+        Parameters
+        ----------
+        names : iterable of str
+            The names given.
+        label : callable
+            ``label(name) -> str``: how an error message names a parameter (a key or a CLI option).
+        """
         for name in names:
             if name in self.renamed and name not in self._by_name:
                 raise InvalidParameter(label(name), f"renamed to {label(self.renamed[name])!r} (see CHANGELOG.md)")
@@ -330,7 +354,15 @@ class ParameterSet:
         return {p.name: None if p.default is None else p.parse(p.default) for p in self.parameters}
 
     def case(self, values: Mapping[str, Any] | None = None, /, **si_values) -> Case:
-        """A validated :class:`Case` from SI values (Python API); missing or None values take the default."""
+        """A validated :class:`Case` from SI values (Python API); missing or None values take the default.
+
+        Parameters
+        ----------
+        values : mapping of str to value, optional
+            Parameters by name, in SI (each parameter's SI unit).
+        **si_values
+            More parameters by name, in SI.
+        """
         given = {**(values or {}), **si_values}
         self.refuse_unknown(given)
         given = {name: value for name, value in given.items() if value is not None}
@@ -344,6 +376,14 @@ class ParameterSet:
         """A validated :class:`Case` from values as users write them (display units or unit strings).
 
         ``labels="option"`` names problems by CLI option (``--drift-east``).
+
+        Parameters
+        ----------
+        written : mapping of str to value
+            Values as written: bare numbers in each parameter's display unit, or strings with units.
+        labels : {"name", "option"}
+            How errors name a parameter.
+
         """
         label = (lambda name: self._by_name[name].option if name in self._by_name else "--" + name.replace("_", "-")) \
             if labels == "option" else (lambda name: name)

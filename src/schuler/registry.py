@@ -29,6 +29,13 @@ SYSTEM_MODULES: dict[str, str] = {
 def get_system(name: str) -> System:
     """The :class:`~schuler.contract.System` registered under ``name``.
 
+    Parameters
+    ----------
+    name : str
+        Command name of the system (a key of :data:`SYSTEM_MODULES`).
+
+    Examples
+    --------
     >>> get_system("align").name
     'align'
     >>> get_system("allign")

@@ -41,9 +41,23 @@ class Tolerance:
     absolute: float = 0.0
 
     def allows(self, printed: float, computed: float) -> bool:
+        """Whether ``computed`` agrees with ``printed``.
+
+        Parameters
+        ----------
+        printed, computed : float
+            The printed and the computed value, in the row's unit.
+        """
         return abs(computed - printed) <= max(self.relative * abs(printed), self.absolute)
 
     def describe(self, unit: str = "") -> str:
+        """The tolerance in words for a verdict: ``within 0.5 %``.
+
+        Parameters
+        ----------
+        unit : str
+            Unit of the absolute tolerance.
+        """
         parts = []
         if self.relative:
             parts.append(f"{self.relative * 100:g} %")
@@ -93,6 +107,13 @@ _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)")
 def printed_value(text: str) -> float:
     """The number in a printed value: ``"3,650"`` -> 3650, ``"1.62 x 10^6"`` -> 1.62e6, ``"0.34 %"`` -> 0.34.
 
+    Parameters
+    ----------
+    text : str
+        The value exactly as printed (any unit: only the number is read).
+
+    Examples
+    --------
     >>> printed_value("1.62 x 10^6"), printed_value("3,650"), printed_value("5.6e-3"), printed_value("-12.5 arcmin")
     (1620000.0, 3650.0, 0.0056, -12.5)
     """
@@ -125,7 +146,7 @@ def compare(quantity: str, computed: float, unit: str, *, printed: str | None = 
     where : str
         Where it is printed.
     value : float, optional
-        The printed number, where :func:`printed_value` cannot read it from the text.
+        The printed number in ``unit``, where :func:`printed_value` cannot read it from the text.
     tolerance : Tolerance
     erratum : str
         Why the printed value is wrong (used when the values disagree).

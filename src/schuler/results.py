@@ -21,6 +21,13 @@ def json_safe(value: Any) -> Any:
     Non-finite floats become None (JSON has no NaN); floats keep 15 significant
     digits, so rounding noise (29.999999999999993) does not reach the user.
 
+    Parameters
+    ----------
+    value : object
+        Numbers (any unit: they are written as they are), arrays, mappings, sequences, results.
+
+    Examples
+    --------
     >>> json_safe({"a": np.array([1.0, np.nan]), "b": (np.int64(2),), "c": 29.999999999999993})
     {'a': [1.0, None], 'b': [2], 'c': 30.0}
     """
@@ -103,7 +110,13 @@ class Footnotes:
         self._numbers: dict[str, int] = {}
 
     def reference(self, *notes: str) -> str:
-        """The ``[n]`` marks for the given notes (empty notes are skipped)."""
+        """The ``[n]`` marks for the given notes (empty notes are skipped).
+
+        Parameters
+        ----------
+        *notes : str
+            The notes to mark.
+        """
         numbers = sorted({self._numbers.setdefault(note, len(self._numbers) + 1) for note in notes if note})
         return " ".join(f"[{n}]" for n in numbers)
 
@@ -142,6 +155,21 @@ class MonteCarloSummary(Result):
 
     @classmethod
     def from_statistics(cls, members, seed, outputs, statistics, samples) -> MonteCarloSummary:
+        """The summary of streamed statistics: count, mean, std, min, max, rms and percentiles per output.
+
+        Parameters
+        ----------
+        members : int
+            Number of members.
+        seed : int
+            Seed of the random streams.
+        outputs : sequence of Output
+            The outputs summarised (SI units; display units for tables).
+        statistics : dict of str to StreamingStatistics
+            Per output, over the members (SI).
+        samples : dict of str to ndarray
+            Per output, the members' values kept for histograms (SI).
+        """
         table = {}
         for output in outputs:
             stats = statistics[output.name]
@@ -185,6 +213,15 @@ _SI_SUFFIXES = ("_rad_s2", "_rad_s", "_m_s2", "_m_s", "_rad", "_s", "_m")
 def display_label(name: str, unit: str = "") -> str:
     """A column label in a display unit: ``azimuth_error_rad`` in arcmin -> ``azimuth_error (arcmin)``.
 
+    Parameters
+    ----------
+    name : str
+        Key with an SI unit suffix (``_rad``, ``_s``, ``_m_s`` ...).
+    unit : str
+        Display unit (empty: keep the key).
+
+    Examples
+    --------
     >>> display_label("azimuth_error_rad", "arcmin"), display_label("settling_time_s")
     ('azimuth_error (arcmin)', 'settling_time_s')
     """

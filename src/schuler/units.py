@@ -190,6 +190,15 @@ def parse_quantity(value, unit: str, *, name: str) -> float:
 def to_unit(value_si, unit: str):
     """Express an SI value (float or array) in ``unit`` (e.g. rad -> "arcmin").
 
+    Parameters
+    ----------
+    value_si : float or ndarray
+        Value in the SI unit of ``unit``'s dimension.
+    unit : str
+        Target unit ("deg/h", "arcmin", "ft" ...).
+
+    Examples
+    --------
     >>> round(to_unit(4.84813681109536e-08, "deg/h"), 12)
     0.01
     """
@@ -199,7 +208,15 @@ def to_unit(value_si, unit: str):
 
 
 def from_unit(value, unit: str):
-    """Express a value given in ``unit`` in SI (the inverse of :func:`to_unit`)."""
+    """Express a value given in ``unit`` in SI (the inverse of :func:`to_unit`).
+
+    Parameters
+    ----------
+    value : float or ndarray
+        Value in ``unit``.
+    unit : str
+        Its unit ("deg/h", "arcmin", "ft" ...).
+    """
     target = _display_unit(unit)
     return value * ureg.Quantity(1.0, target).to_base_units().magnitude
 
@@ -207,6 +224,17 @@ def from_unit(value, unit: str):
 def format_quantity(value_si: float, unit: str, digits: int = 4) -> str:
     """Format an SI value in ``unit`` for people: ``"3.556 arcmin"``.
 
+    Parameters
+    ----------
+    value_si : float
+        Value in the SI unit of ``unit``'s dimension.
+    unit : str
+        Display unit.
+    digits : int
+        Number of significant digits.
+
+    Examples
+    --------
     >>> format_quantity(1e-3, "arcmin")
     '3.438 arcmin'
     """

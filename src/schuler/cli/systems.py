@@ -37,7 +37,8 @@ def system_group(system: System) -> click.Group:
     """The click group ``schuler NAME`` with ``run``, ``reproduce`` and the system's actions."""
     group = click.Group(
         name=system.name,
-        help=f"{system.title}.\n\nSource: {system.reference}." + (f"\n\nGuide: {system.guide}" if system.guide else ""),
+        help=f"{system.title}.\n\nSource: {system.reference.rstrip('.')}."
+        + (f"\n\nGuide: docs/_build/html/guide/{system.guide}.html (make docs)" if system.guide else ""),
         short_help=system.title + ".",
         context_settings=_CONTEXT,
     )

@@ -76,6 +76,15 @@ def schuler_frequency(gravity: float, radius: float) -> float:
 def schuler_period(gravity: float, radius: float) -> float:
     """Schuler period T = 2 pi sqrt(R / g), s.
 
+    Parameters
+    ----------
+    gravity : float
+        g, m/s^2.
+    radius : float
+        R, m.
+
+    Examples
+    --------
     >>> round(schuler_period(9.81, 6.4e6))
     5075
     """
@@ -90,6 +99,8 @@ def normal_gravity(latitude):
     latitude : float or array_like
         Geodetic latitude, rad.
 
+    Examples
+    --------
     >>> round(float(normal_gravity(0.0)), 7), round(float(normal_gravity(np.pi / 2)), 7)
     (9.7803253, 9.8321849)
     """

@@ -250,6 +250,17 @@ def _grid_counts(durations, steps, names: tuple[str, str], max_points: float) ->
 def grid_points(duration: float, step: float, *, names: tuple[str, str] = ("duration", "step")) -> float:
     """Number of points :func:`time_grid` would return (a float: huge requests can be sized, then refused).
 
+    Parameters
+    ----------
+    duration : float
+        Length of the grid, s.
+    step : float
+        Output step, s.
+    names : tuple of str
+        The parameter names an error message uses for ``duration`` and ``step``.
+
+    Examples
+    --------
     >>> grid_points(2.0, 0.5), grid_points(1.0, 0.3), grid_points(1e9, 1e-3)
     (5.0, 5.0, 1000000000001.0)
     """

@@ -323,7 +323,7 @@ def simulate_reduce(system: StateSpace, time, initial_state=None, inputs=None, i
     Parameters
     ----------
     system, time, initial_state, inputs, input_series
-        As in :func:`simulate`.
+        As in :func:`simulate` (time in s, states and inputs in SI).
     reducer : callable
         Called as ``reducer(chunk, members)`` for consecutive chunks, where
         ``chunk`` is a batched :class:`Response` (k, T, .) of the members
@@ -333,7 +333,7 @@ def simulate_reduce(system: StateSpace, time, initial_state=None, inputs=None, i
         Only these outputs, and no states, are computed and passed on (default:
         all states and outputs).
     chunk_size : int, optional
-        Members per chunk (default: about :data:`CHUNK_BYTES` of history).
+        Number of members per chunk (default: about :data:`CHUNK_BYTES` of history).
 
     Returns
     -------
@@ -395,12 +395,35 @@ class StatisticsResponse:
         return array[..., self.output_names.index(name)]
 
     def mean(self, name: str) -> np.ndarray:
+        """Mean over members of an output at every time, in the output's SI unit.
+
+        Parameters
+        ----------
+        name : str
+            Output name.
+        """
         return self._channel(self.statistics.mean, name)
 
     def std(self, name: str) -> np.ndarray:
+        """Standard deviation over members of an output at every time, in its SI unit.
+
+        Parameters
+        ----------
+        name : str
+            Output name.
+        """
         return self._channel(self.statistics.std, name)
 
     def percentile(self, q, name: str) -> np.ndarray:
+        """Percentiles over members (from the reservoir) of an output at every time, in its SI unit.
+
+        Parameters
+        ----------
+        q : float or array_like
+            Percentile(s), percent (0 to 100).
+        name : str
+            Output name.
+        """
         return self._channel(self.statistics.percentile(q), name)
 
 
@@ -425,11 +448,11 @@ def simulate_statistics(
     Parameters
     ----------
     system, time, initial_state, inputs, input_series
-        As in :func:`simulate`; the members are the batch's.
+        As in :func:`simulate` (time in s, states and inputs in SI); the members are the batch's.
     chunk_size : int, optional
-        Members per chunk.
+        Number of members per chunk.
     reservoir_size : int, optional
-        Members kept, uniformly at random, for percentiles (default: as many
+        Number of members kept, uniformly at random, for percentiles (default: as many
         as fit in :data:`RESERVOIR_BYTES`, at most 2,048). Percentiles are exact
         while the members do not outnumber it.
     seed : int

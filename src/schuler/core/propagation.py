@@ -111,6 +111,13 @@ def zoh_discretize(A: np.ndarray, B: np.ndarray, dt) -> tuple[np.ndarray, np.nda
 def uniform_step(t: np.ndarray) -> float | None:
     """The grid's step if all steps agree to rounding (linspace and arange grids), else None.
 
+    Parameters
+    ----------
+    t : ndarray, shape (T,)
+        Time points, s.
+
+    Examples
+    --------
     >>> uniform_step(np.linspace(0.0, 1.0, 11)), uniform_step(np.array([0.0, 1.0, 3.0]))
     (0.1, None)
     """
@@ -157,6 +164,13 @@ class Grid:
 
     @classmethod
     def of(cls, t: np.ndarray) -> Grid:
+        """The grid of the time points ``t``.
+
+        Parameters
+        ----------
+        t : ndarray, shape (T,)
+            Strictly increasing time points, s.
+        """
         steps = t.size - 1
         step = uniform_step(t)
         if step is not None:
@@ -172,6 +186,11 @@ class Grid:
 
 def balance(M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Balance a batch of matrices (N, q, q) by one exact diagonal similarity.
+
+    Parameters
+    ----------
+    M : ndarray, shape (N, q, q)
+        The matrices (SI, 1/s for a continuous model).
 
     Returns
     -------
@@ -300,6 +319,18 @@ def propagate_constant_input(M: np.ndarray, R: np.ndarray, grid: Grid, n_moving:
     Exponentials at block and point times (:class:`ConstantInputPropagator`),
     unless a batch of models would need more than :data:`POINT_EXPONENTIALS`
     point exponentials on a non-uniform grid: then exact steps.
+
+    Parameters
+    ----------
+    M : ndarray, shape (q, q) or (N, q, q)
+        The augmented matrix [[A, B], [0, 0]], 1/s.
+    R : ndarray, shape (r, q) or (N, r, q)
+        Rows of z wanted at each time (outputs in SI).
+    grid : Grid
+        The time points, s.
+    n_moving : int
+        Number of leading entries of z that evolve (the states); the rest are the held inputs.
+
     """
     if M.shape[0] * (grid.times.size - grid.n_uniform) <= POINT_EXPONENTIALS:
         return ConstantInputPropagator(M, R, grid, n_moving)

@@ -86,7 +86,17 @@ class RandomStreams:
         return f"RandomStreams(seed={self.seed})"
 
     def uniform(self, stream: str, members, size: int | None = None) -> np.ndarray:
-        """Uniform numbers in (0, 1): shape (n,) or (n, size) for ``members`` of length n."""
+        """Uniform numbers in (0, 1): shape (n,) or (n, size) for ``members`` of length n.
+
+        Parameters
+        ----------
+        stream : str
+            Name of the stream (one per random term).
+        members : array_like of int
+            Member numbers: the addresses of the draws.
+        size : int, optional
+            Number of draws per member (None: one, shape (n,)).
+        """
         members = np.asarray(members, dtype=np.int64)
         if members.size and members.min() < 0:
             raise InvalidParameter("member", "member numbers must be >= 0")
@@ -98,11 +108,31 @@ class RandomStreams:
         return u[:, 0] if size is None else u
 
     def normal(self, stream: str, members, size: int | None = None) -> np.ndarray:
-        """Standard normal numbers (inverse CDF of :meth:`uniform`), shape (n,) or (n, size)."""
+        """Standard normal numbers (inverse CDF of :meth:`uniform`), shape (n,) or (n, size).
+
+        Parameters
+        ----------
+        stream : str
+            Name of the stream (one per random term).
+        members : array_like of int
+            Member numbers: the addresses of the draws.
+        size : int, optional
+            Number of draws per member (None: one, shape (n,)).
+        """
         return ndtri(self.uniform(stream, members, size))
 
     def normal_series(self, stream: str, members, start: int, stop: int) -> np.ndarray:
-        """Standard normal samples ``start .. stop-1`` of each member: shape (n, stop - start)."""
+        """Standard normal samples ``start .. stop-1`` of each member: shape (n, stop - start).
+
+        Parameters
+        ----------
+        stream : str
+            Name of the stream (one per random term).
+        members : array_like of int
+            Member numbers: the addresses of the draws.
+        start, stop : int
+            Index range of the samples (sample k of a member is the same however the series is cut).
+        """
         members = np.asarray(members, dtype=np.int64).reshape(-1)
         start, stop = int(start), int(stop)
         if start < 0 or stop < start:

@@ -42,6 +42,13 @@ class Response:
         raise KeyError(f"no channel {name!r}; outputs are {self.output_names}, states {self.state_names}")
 
     def unit(self, name: str) -> str:
+        """SI unit of a state or output channel.
+
+        Parameters
+        ----------
+        name : str
+            Channel name.
+        """
         if name in self.output_names:
             return self.output_units[self.output_names.index(name)]
         return self.state_units[self.state_names.index(name)]
@@ -61,7 +68,15 @@ class Response:
         return frame
 
     def plot(self, channels=None, ax=None):
-        """Plot outputs against time (all members of a batch, thinly). Returns the Figure."""
+        """Plot outputs against time (all members of a batch, thinly). Returns the Figure.
+
+        Parameters
+        ----------
+        channels : sequence of str, optional
+            Output names to draw (default: all outputs).
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into (default: a new figure); time in s, outputs in their SI units.
+        """
         import matplotlib.pyplot as plt
 
         channels = list(channels or self.output_names)

@@ -114,11 +114,23 @@ class StateSpace:
         return np.linalg.eigvals(self.A)
 
     def discretize(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        """Exact zero-order-hold matrices (Ad, Bd) for the step ``dt`` (s)."""
+        """Exact zero-order-hold matrices (Ad, Bd) for the step ``dt`` (s).
+
+        Parameters
+        ----------
+        dt : float
+            Step, s.
+        """
         return zoh_discretize(self.A, self.B, np.asarray(dt, dtype=float))
 
     def subset(self, start: int, stop: int) -> StateSpace:
-        """Models start:stop of a batch (the model itself when not batched)."""
+        """Models start:stop of a batch (the model itself when not batched).
+
+        Parameters
+        ----------
+        start, stop : int
+            Index range of the models in the batch.
+        """
         if self.batch_size is None:
             return self
         def cut(M: np.ndarray) -> np.ndarray:

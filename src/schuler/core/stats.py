@@ -61,7 +61,13 @@ class StreamingStatistics:
         self._kept = 0
 
     def update(self, samples: np.ndarray) -> None:
-        """Add a chunk of members, shape ``(k, *shape)``."""
+        """Add a chunk of members, shape ``(k, *shape)``.
+
+        Parameters
+        ----------
+        samples : ndarray
+            One sample per member, shape ``(k, *shape)``, in the unit of the statistic.
+        """
         samples = np.asarray(samples, dtype=float)
         if samples.shape[1:] != self.shape:
             raise ValueError(f"samples of shape {samples.shape[1:]} do not match {self.shape}")
@@ -129,7 +135,13 @@ class StreamingStatistics:
         return self.count <= self._reservoir_size
 
     def percentile(self, q) -> np.ndarray:
-        """Percentile(s) ``q`` (0..100) over members, from the reservoir."""
+        """Percentile(s) ``q`` (0..100) over members, from the reservoir.
+
+        Parameters
+        ----------
+        q : float or array_like
+            Percentile(s), percent (0 to 100).
+        """
         if self.count == 0:
             raise ValueError("no samples yet")
         if self._reservoir_size == 0:

@@ -98,7 +98,15 @@ class ProcedureErrors:
 
     @classmethod
     def zero(cls, members: int, channels: int, positions: int, cycles: int) -> ProcedureErrors:
-        """No errors: the error-free procedure."""
+        """No errors: the error-free procedure.
+
+        Parameters
+        ----------
+        members : int
+            Number of procedures (Monte Carlo members).
+        channels, positions, cycles : int
+            Number of gyro channels measured, of platform positions and of cycles per position.
+        """
         return draw_errors({}, None, np.zeros(members, dtype=np.int64), channels=channels, positions=positions,
                            cycles=cycles, samples=0)
 

@@ -113,7 +113,13 @@ class ErrorBudget:
             raise InvalidParameter("sway_frequency", "must be > 0")
 
     def scaled(self, factor: float) -> ErrorBudget:
-        """Every random item times ``factor`` (the deterministic loop values kept)."""
+        """Every random item times ``factor`` (the deterministic loop values kept).
+
+        Parameters
+        ----------
+        factor : float
+            Scale of every random item, plain number.
+        """
         keep = {"loop_time_constant", "sway_frequency"}
         return dataclasses.replace(self, **{f.name: getattr(self, f.name) * factor
                                            for f in dataclasses.fields(self) if f.name not in keep})

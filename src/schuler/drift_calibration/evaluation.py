@@ -174,7 +174,13 @@ _INSTRUMENT = ("mode", "positions", "cycles", "pulse_shape", "pulse_duration", "
 
 
 def stabilizer_of(case) -> Stabilizer:
-    """The instrument of a case: H = 0.1 N m s, i = 10 mA and K_M from the pulse rate (K_M / H) i."""
+    """The instrument of a case: H = 0.1 N m s, i = 10 mA and K_M from the pulse rate (K_M / H) i.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     return Stabilizer(
         k1=case["sensor_gain"], torquer_gain=case["pulse_rate"] * ANGULAR_MOMENTUM / PULSE_CURRENT,
         angular_momentum=ANGULAR_MOMENTUM, pulse_current=PULSE_CURRENT, tau=case["pulse_duration"],
@@ -183,7 +189,13 @@ def stabilizer_of(case) -> Stabilizer:
 
 
 def member_bytes(case) -> int:
-    """Memory one procedure needs while simulated, bytes: every cycle's grid of inputs, states and noise."""
+    """Memory one procedure needs while simulated, bytes: every cycle's grid of inputs, states and noise.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     channels = 1 if case["mode"] == "single-axis" else 2
     cycles = channels * int(case["positions"]) * int(case["cycles"])
     grid = cycle_grid(SHAPES[case["pulse_shape"]](), NOISE_STEPS).size
@@ -192,7 +204,15 @@ def member_bytes(case) -> int:
 
 
 def check_observable(latitude: np.ndarray, max_latitude: np.ndarray) -> None:
-    """Raise :class:`NotObservable` beyond the latitude limit; warn when the accuracy degrades."""
+    """Raise :class:`NotObservable` beyond the latitude limit; warn when the accuracy degrades.
+
+    Parameters
+    ----------
+    latitude : ndarray
+        Latitude of each case, rad.
+    max_latitude : ndarray
+        The azimuth limit of each case (``--max-latitude``), rad.
+    """
     phi = np.abs(np.asarray(latitude, dtype=float))
     if phi.size == 0:
         return
@@ -214,6 +234,11 @@ def check_observable(latitude: np.ndarray, max_latitude: np.ndarray) -> None:
 
 def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
 
     Examples
     --------
@@ -284,6 +309,13 @@ def run_case(case: Case, fidelity: str | None = None) -> CalibrationResult:
     """One procedure in full: the outputs of :func:`evaluate`, the true values and one cycle's histories.
 
     ``fidelity`` is accepted for the contract; the system has one way of evaluating.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    fidelity : str, optional
+        One of the system's fidelities (default: the first).
 
     Examples
     --------

@@ -68,8 +68,15 @@ def _rotation_x(angle: float) -> np.ndarray:
 def initial_attitude(azimuth: float, pitch: float = 0.0, roll: float = 0.0) -> np.ndarray:
     """C (platform -> ENU) of a platform whose Y axis points at ``azimuth`` (clockwise from north), rad.
 
-    ``pitch`` turns about the platform Y axis, ``roll`` about X (small tilts, rad).
+    Parameters
+    ----------
+    azimuth : float
+        Azimuth of the platform Y axis, clockwise from north, rad.
+    pitch, roll : float
+        Turns about the platform Y axis and X axis (small tilts), rad.
 
+    Examples
+    --------
     >>> np.round(initial_attitude(np.pi / 2) @ [0.0, 1.0, 0.0], 12) + 0.0   # Y axis east
     array([1., 0., 0.])
     """

@@ -13,7 +13,12 @@ from schuler.units import to_unit
 def plot_cycle(history, title: str = "One measurement cycle"):
     """Platform angle (arcsec), sensor signal (V) and integrator output (V s) against time; returns the figure.
 
-    ``history`` is a :class:`~schuler.drift_calibration.results.CycleHistory`.
+    Parameters
+    ----------
+    history : CycleHistory
+        The cycle's time histories (:class:`~schuler.drift_calibration.results.CycleHistory`, SI).
+    title : str
+        Figure title.
     """
     import matplotlib.pyplot as plt
 
@@ -38,8 +43,15 @@ def plot_cycle(history, title: str = "One measurement cycle"):
 def plot_histograms(samples: dict, title: str = "Monte Carlo errors"):
     """Histograms of the drift errors (deg/h) and the azimuth errors (arcmin) of Monte Carlo members.
 
-    ``samples`` maps ``drift_x_error_rad_s``, ``drift_y_error_rad_s`` (NaN when
-    not measured) and ``azimuth_error_rad`` to arrays; returns the figure.
+    Returns the figure.
+
+    Parameters
+    ----------
+    samples : dict
+        ``drift_x_error_rad_s``, ``drift_y_error_rad_s`` (rad/s, NaN when not
+        measured) and ``azimuth_error_rad`` (rad), each an array over members.
+    title : str
+        Figure title.
     """
     import matplotlib.pyplot as plt
 
@@ -61,7 +73,19 @@ def plot_histograms(samples: dict, title: str = "Monte Carlo errors"):
 
 
 def plot_trade_offs(positions, azimuth_by_positions, cycle_times, azimuth_by_cycle):
-    """RMS azimuth error (rad in, arcmin shown) against the number of positions and against the cycle time (s)."""
+    """RMS azimuth error (rad in, arcmin shown) against the number of positions and against the cycle time (s).
+
+    Parameters
+    ----------
+    positions : array_like
+        Number of platform positions of each point.
+    azimuth_by_positions : array_like
+        RMS azimuth error at each number of positions, rad.
+    cycle_times : array_like
+        Cycle time 2 tau of each point, s.
+    azimuth_by_cycle : array_like
+        RMS azimuth error at each cycle time, rad.
+    """
     import matplotlib.pyplot as plt
 
     positions = np.asarray(positions, dtype=float)

@@ -65,6 +65,8 @@ def apparent_drift(latitude, azimuth, earth_rate: float = EARTH_RATE):
     earth_rate : float
         Omega, rad/s.
 
+    Examples
+    --------
     >>> [round(float(w) / EARTH_RATE, 12) for w in apparent_drift(0.0, np.pi / 2)]
     [1.0, -0.0, -0.0]
     """
@@ -85,6 +87,8 @@ def rate_from_reading(reading, k1: float, tau: float):
     tau : float
         Pulse duration, s.
 
+    Examples
+    --------
     >>> float(rate_from_reading(-57.3 * 25 * 1e-5, 57.3, 5.0))
     1e-05
     """
@@ -96,6 +100,17 @@ def separate_drift(reading_1, reading_2, k1: float, tau: float):
 
     omega_d = -(Delta U1 + Delta U2) / (2 K1 tau^2),  omega_X0 = -(Delta U1 - Delta U2) / (2 K1 tau^2).
 
+    Parameters
+    ----------
+    reading_1, reading_2 : float or ndarray
+        Integrator outputs Delta U at A0 and at A0 + 180 deg, V s.
+    k1 : float
+        Command-sensor gain K1, V/rad.
+    tau : float
+        Pulse duration, s.
+
+    Examples
+    --------
     >>> [float(w) for w in separate_drift(-25.0 * 3.0, -25.0 * (-1.0), 1.0, 5.0)]
     [1.0, 2.0]
     """
@@ -109,6 +124,13 @@ def azimuth_from_channels(omega_x0, omega_y0):
 
     The latitude drops out: only the direction of the horizontal Earth rate counts.
 
+    Parameters
+    ----------
+    omega_x0, omega_y0 : float or ndarray
+        Apparent drifts of the X and Y channels, rad/s.
+
+    Examples
+    --------
     >>> round(float(np.degrees(azimuth_from_channels(-1.0, 0.0))), 9)
     270.0
     """
@@ -118,6 +140,15 @@ def azimuth_from_channels(omega_x0, omega_y0):
 def azimuth_from_single_channel(omega_x0, latitude, earth_rate: float = EARTH_RATE):
     """A0 = asin(omega_X0 / (Omega cos phi)) and its twin 180 deg - A0, rad in [0, 2 pi).
 
+    Parameters
+    ----------
+    omega_x0 : float or ndarray
+        Apparent drift of the X channel, rad/s.
+    latitude : float or ndarray
+        phi, rad.
+    earth_rate : float
+        Omega, rad/s.
+
     Returns
     -------
     principal, alternative : ndarray
@@ -125,6 +156,8 @@ def azimuth_from_single_channel(omega_x0, latitude, earth_rate: float = EARTH_RA
     saturated : ndarray of bool
         Where |omega_X0| exceeded Omega cos phi (errors near A0 = 90 deg) and was clipped.
 
+    Examples
+    --------
     >>> a, b, _ = azimuth_from_single_channel(0.5 * EARTH_RATE, 0.0)
     >>> round(float(np.degrees(a)), 9), round(float(np.degrees(b)), 9)
     (30.0, 150.0)
@@ -141,6 +174,18 @@ def azimuth_sensitivity(azimuth, latitude, mode: str = "three-axis", earth_rate:
     Three-axis: 1 / (Omega cos phi) whatever A0. Single-axis: 1 / (Omega cos phi |cos A0|),
     infinite at A0 = 90 deg.
 
+    Parameters
+    ----------
+    azimuth : float or ndarray
+        A0, rad.
+    latitude : float or ndarray
+        phi, rad.
+    mode : {"three-axis", "single-axis"}
+    earth_rate : float
+        Omega, rad/s.
+
+    Examples
+    --------
     >>> s3 = azimuth_sensitivity(np.radians(80), np.radians(70), "three-axis")
     >>> s1 = azimuth_sensitivity(np.radians(80), np.radians(70), "single-axis")
     >>> round(float(s1 / s3), 3)   # 1 / cos 80 deg
@@ -154,7 +199,13 @@ def azimuth_sensitivity(azimuth, latitude, mode: str = "three-axis", earth_rate:
 
 
 def turn_angles(positions: int) -> np.ndarray:
-    """Equally spaced turns 2 pi k / N about the vertical (azimuth increasing), rad."""
+    """Equally spaced turns 2 pi k / N about the vertical (azimuth increasing), rad.
+
+    Parameters
+    ----------
+    positions : int
+        Number of positions N.
+    """
     return 2.0 * np.pi * np.arange(positions) / positions
 
 
@@ -165,6 +216,13 @@ def position_design(positions: int, mode: str) -> np.ndarray:
     s = Omega cos phi cos A0; at turn theta the X channel reads
     omega_dX + c cos theta + s sin theta and the Y channel omega_dY + c sin theta - s cos theta.
     Rows: X readings of every position, then (three-axis) the Y readings.
+
+    Parameters
+    ----------
+    positions : int
+        Number of positions N.
+    mode : {"three-axis", "single-axis"}
+
     """
     theta = turn_angles(positions)
     ones, zeros = np.ones(positions), np.zeros(positions)
@@ -183,13 +241,16 @@ def fit_positions(rates_x, rates_y=None, mode: str = "three-axis"):
     rates_x : ndarray, shape (M, N)
         omega_dX + omega_X0 measured at each position (rad/s), M members.
     rates_y : ndarray, shape (M, N), optional
-        The Y channel (three-axis mode).
+        The Y channel (three-axis mode), rad/s.
+    mode : {"three-axis", "single-axis"}
 
     Returns
     -------
     dict of ndarray (M,)
         ``drift_x``, ``drift_y`` (NaN in single-axis mode), ``c``, ``s`` (rad/s).
 
+    Examples
+    --------
     >>> th = turn_angles(4)
     >>> fit = fit_positions((1.0 + 2.0 * np.cos(th) + 3.0 * np.sin(th))[None, :], mode="single-axis")
     >>> [round(float(fit[k][0]), 12) for k in ("drift_x", "c", "s")]
@@ -208,7 +269,13 @@ def fit_positions(rates_x, rates_y=None, mode: str = "three-axis"):
 
 
 def wrap_angle(angle):
-    """Angle difference brought into (-pi, pi], rad."""
+    """Angle difference brought into (-pi, pi], rad.
+
+    Parameters
+    ----------
+    angle : float or ndarray
+        Angle, rad.
+    """
     return -np.mod(-np.asarray(angle) + np.pi, 2.0 * np.pi) + np.pi
 
 
@@ -308,8 +375,8 @@ def run_procedure(
     -------
     ProcedureOutcome
 
-    Example
-    -------
+    Examples
+    --------
     >>> from schuler.drift_calibration.pulses import rectangular
     >>> stab = Stabilizer(57.3, 0.02, 0.1, 1e-3, 5.0, rectangular())
     >>> out = run_procedure(stab, np.radians(70), np.radians(80), np.radians(0.1) / 3600)
@@ -391,11 +458,28 @@ def _recover(rates, mode, positions, azimuth, assumed_latitude, earth_rate, read
 
 
 def cycle_time(tau: float) -> float:
-    """One measurement cycle, two pulses of duration tau, s (the source's cycles: 8-15 s)."""
+    """One measurement cycle, two pulses of duration tau, s (the source's cycles: 8-15 s).
+
+    Parameters
+    ----------
+    tau : float
+        Pulse duration, s.
+    """
     return 2.0 * tau
 
 
 def procedure_time(tau: float, mode: str, positions: int, cycles: int) -> float:
-    """Measuring time of the whole procedure (turns not counted), s."""
+    """Measuring time of the whole procedure (turns not counted), s.
+
+    Parameters
+    ----------
+    tau : float
+        Pulse duration, s.
+    mode : {"three-axis", "single-axis"}
+    positions : int
+        Number of platform positions.
+    cycles : int
+        Number of measurement cycles per position.
+    """
     return cycle_time(tau) * positions * cycles * (1 if mode == "single-axis" else 2)
 

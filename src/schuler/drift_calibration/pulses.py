@@ -115,7 +115,13 @@ class PulseShape:
         return self.area() - 2.0 * self.first_moment()
 
     def is_symmetric(self, tolerance: float = 1e-12) -> bool:
-        """Whether shape(u) == shape(1 - u) at every knot (both sides) and mid-segment."""
+        """Whether shape(u) == shape(1 - u) at every knot (both sides) and mid-segment.
+
+        Parameters
+        ----------
+        tolerance : float
+            Largest difference allowed, in units of the pulse amplitude (dimensionless).
+        """
         probes = np.concatenate([self.knots, 0.5 * (self.knots[:-1] + self.knots[1:])])
         inside = np.clip(probes, 1e-300, 1.0 - 1e-16)
         scale = max(np.max(np.abs(self.start_values)), np.max(np.abs(self.end_values)))
@@ -130,6 +136,12 @@ class PulseShape:
 
         A tilt leaves the area unchanged and adds ``-tilt / 3`` to
         :meth:`symmetry_bracket`: the error-budget model of pulse asymmetry.
+
+        Parameters
+        ----------
+        tilt : float
+            Slope of the ramp, relative to the amplitude (dimensionless).
+
         """
         knots = self.knots
         return PulseShape(
@@ -164,10 +176,14 @@ def from_samples(times, values, name: str = "user-defined") -> PulseShape:
     Parameters
     ----------
     times : array_like
-        Normalised sample times, strictly increasing from 0 to 1.
+        Normalised sample times (dimensionless, time / tau), strictly increasing from 0 to 1.
     values : array_like
         Shape values at those times (dimensionless, relative to the amplitude).
+    name : str
+        Label of the shape.
 
+    Examples
+    --------
     >>> p = from_samples([0, 0.2, 1], [1, 1, 0])
     >>> round(p.area(), 12), p.is_symmetric()
     (0.6, False)
@@ -182,6 +198,18 @@ def from_samples(times, values, name: str = "user-defined") -> PulseShape:
 def from_function(function, samples: int = 201, name: str = "user-defined") -> PulseShape:
     """A user-defined shape from a callable on [0, 1], linearly interpolated at ``samples`` points.
 
+    Parameters
+    ----------
+    function : callable
+        ``function(u)`` for the normalised time u = t / tau in [0, 1] (dimensionless), returning the shape
+        relative to the amplitude.
+    samples : int
+        Number of interpolation points.
+    name : str
+        Label of the shape.
+
+    Examples
+    --------
     >>> p = from_function(lambda u: np.sin(np.pi * u), samples=101)
     >>> p.is_symmetric()
     True

@@ -59,7 +59,15 @@ REPRODUCE_PARAMETERS = ParameterSet((
 
 
 def source_case(budget: ErrorBudget = TYPICAL, **si_values):
-    """The source's modelling case with an error budget: 70 deg, 80 deg, 5 s rectangular pulses, 2 ms loop."""
+    """The source's modelling case with an error budget: 70 deg, 80 deg, 5 s rectangular pulses, 2 ms loop.
+
+    Parameters
+    ----------
+    budget : ErrorBudget
+        The error budget (SI) whose terms the case takes.
+    **si_values
+        Parameters of ``schuler calibrate run`` overriding the source's, SI.
+    """
     values = {name: getattr(budget, term) for name, term in evaluation.BUDGET_TERMS.items()}
     values.update(latitude=SOURCE_LATITUDE, azimuth=SOURCE_AZIMUTH, drift_x=REFERENCE_DRIFT,
                   loop_time_constant=budget.loop_time_constant, sway_frequency=budget.sway_frequency)
@@ -166,6 +174,17 @@ def reproduce(monte_carlo: int = 2000, seed: int = 0) -> Reproduction:
 def error_versus_positions(positions=(2, 3, 4, 6, 8), members: int = 1000, seed: int = 0):
     """RMS azimuth error (rad) of the source's case, typical budget, three-axis, against the number of positions.
 
+    Parameters
+    ----------
+    positions : sequence of int
+        Number of platform positions of each point.
+    members : int
+        Monte Carlo members per point.
+    seed : int
+        Seed of the random streams.
+
+    Examples
+    --------
     >>> n, rms = error_versus_positions((2, 4), members=100)
     >>> bool(rms[1] < rms[0])
     True
@@ -176,7 +195,17 @@ def error_versus_positions(positions=(2, 3, 4, 6, 8), members: int = 1000, seed:
 
 
 def error_versus_cycle_time(pulse_durations=(1.0, 2.0, 4.0, 5.0, 7.5, 10.0), members: int = 1000, seed: int = 0):
-    """Cycle time 2 tau (s) and RMS azimuth error (rad) of the source's case, typical budget, three-axis."""
+    """Cycle time 2 tau (s) and RMS azimuth error (rad) of the source's case, typical budget, three-axis.
+
+    Parameters
+    ----------
+    pulse_durations : sequence of float
+        Pulse duration tau of each point, s.
+    members : int
+        Monte Carlo members per point.
+    seed : int
+        Seed of the random streams.
+    """
     rms = [_monte_carlo(source_case(pulse_duration=tau), members, seed).statistics["azimuth_error_rad"]["rms"]
            for tau in pulse_durations]
     return 2.0 * np.asarray(pulse_durations), np.array(rms)
@@ -187,6 +216,12 @@ def report(figures_dir: Path) -> ReportSection:
 
     The run's Monte Carlo has 1000 members, the trade-offs 200 per point and
     the reproduction 500 per budget; ``--monte-carlo`` scales them up.
+
+    Parameters
+    ----------
+    figures_dir : Path
+        The report's figure folder.
+
     """
     from schuler.drift_calibration.plots import plot_trade_offs
     from schuler.io import save_figure_formats

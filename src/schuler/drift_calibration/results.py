@@ -125,7 +125,15 @@ def _shown(value, unit: str, digits: int, fixed: bool = True) -> str:
 
 
 def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """Figures (PNG and SVG) and CSV data of a run, its Monte Carlo, or the reproduction."""
+    """Figures (PNG and SVG) and CSV data of a run, its Monte Carlo, or the reproduction.
+
+    Parameters
+    ----------
+    result : Result
+        What ``run``, ``reproduce`` or an action returned.
+    out_dir : Path
+        Folder for the figures (PNG, SVG) and data files (CSV); created if missing.
+    """
     import pandas as pd
 
     from schuler.drift_calibration import plots

@@ -233,6 +233,15 @@ def _short_step(model: StateSpace, state: np.ndarray, inputs: np.ndarray, length
 def cycle_grid(shape: PulseShape, steps: int = NOISE_STEPS) -> np.ndarray:
     """Normalised time grid of one phase when noise is on: the pulse knots and ``steps`` equal steps.
 
+    Parameters
+    ----------
+    shape : PulseShape
+        The pulse shape (its knots on the normalised time 0..1).
+    steps : int
+        Number of equal steps.
+
+    Examples
+    --------
     >>> from schuler.drift_calibration.pulses import triangular
     >>> cycle_grid(triangular(), 4)
     array([0.  , 0.25, 0.5 , 0.75, 1.  ])
@@ -431,6 +440,15 @@ def loop_lag_error_rectangular(stabilizer: Stabilizer, rate):
     The pulse part is the same in both runs of the procedure: it biases omega_d
     and cancels in omega_X0; the w part scales both by 1 - (T_s/tau)^2 (1 - E)^2.
 
+    Parameters
+    ----------
+    stabilizer : Stabilizer
+        The instrument (SI).
+    rate : float or ndarray
+        w, the drift rate about the measured axis, rad/s.
+
+    Examples
+    --------
     >>> from schuler.drift_calibration.pulses import rectangular
     >>> stab = Stabilizer(1.0, 0.02, 0.1, 1e-3, 5.0, rectangular(), loop_time_constant=0.0)
     >>> float(loop_lag_error_rectangular(stab, 1e-5))
@@ -450,6 +468,15 @@ def leak_error_initial_angle(stabilizer: Stabilizer, initial_angle):
     int_0^{2 tau} s(t) U0 exp(-(2 tau - t)/T_L) dt = -U0 T_L (1 - exp(-tau/T_L))^2;
     an ideal integrator (T_L = inf) cancels U0 exactly.
 
+    Parameters
+    ----------
+    stabilizer : Stabilizer
+        The instrument (SI).
+    initial_angle : float or ndarray
+        alpha0, the platform angle at the start of the cycle, rad.
+
+    Examples
+    --------
     >>> from schuler.drift_calibration.pulses import rectangular
     >>> stab = Stabilizer(1.0, 0.02, 0.1, 0.0, 5.0, rectangular(), integrator_leak_time=100.0)
     >>> round(float(leak_error_initial_angle(stab, 1e-3) / (-1e-3 * 25 / 100)), 2)   # ~ -U0 tau^2 / T_L

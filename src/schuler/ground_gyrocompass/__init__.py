@@ -4,24 +4,26 @@ Source: :data:`schuler.references.FEDOROV_2020`; equation numbers are the articl
 
 Modules:
 
-* :mod:`.motion` -- eqs. (1)-(9): the Bessel-function solution for any initial
+* :mod:`~schuler.ground_gyrocompass.motion` -- eqs. (1)-(9): the Bessel-function solution for any initial
   angle and rate, a constant harmful torque, derivatives, and the numerical simulator;
-* :mod:`.problem` -- the identification problem: unknown sets (2-5), record checks,
+* :mod:`~schuler.ground_gyrocompass.problem` -- the identification problem: unknown sets (2-5), record checks,
   the model's columns, the Jacobian and the covariance, shared by both methods;
-* :mod:`.varpro` -- north (and lambda, B, the torque) by variable-projection least
+* :mod:`~schuler.ground_gyrocompass.varpro` -- north (and lambda, B, the torque) by variable-projection least
   squares from a regression start, one record or many;
-* :mod:`.grid` -- the source's three-stage grid search (vectorised, and one ODE
+* :mod:`~schuler.ground_gyrocompass.grid` -- the source's three-stage grid search (vectorised, and one ODE
   integration per cell as the source did);
-* :mod:`.estimate` -- :func:`identify`, the dispatcher over both methods, and the
+* :mod:`~schuler.ground_gyrocompass.estimate` -- :func:`identify`, the dispatcher over both methods, and the
   :class:`NorthEstimate` users see;
-* :mod:`.observations` -- noise, quantisation, CSV records;
-* :mod:`.monte_carlo` -- accuracy against observation time, predicted and simulated
+* :mod:`~schuler.ground_gyrocompass.observations` -- noise, quantisation, CSV records;
+* :mod:`~schuler.ground_gyrocompass.monte_carlo` -- accuracy against observation time, predicted and simulated
   with the estimator users run;
-* :mod:`.reproduction` -- the source's Tables 1-3 against the toolkit;
-* :mod:`.evaluation`, :mod:`.results`, :mod:`.actions`, :mod:`.report`, :mod:`.api` --
+* :mod:`~schuler.ground_gyrocompass.reproduction` -- the source's Tables 1-3 against the toolkit;
+* :mod:`~schuler.ground_gyrocompass.evaluation`, :mod:`~schuler.ground_gyrocompass.results`,
+  :mod:`~schuler.ground_gyrocompass.actions`, :mod:`~schuler.ground_gyrocompass.report`,
+  :mod:`~schuler.ground_gyrocompass.api` --
   the system on the contract: parameters, ``evaluate`` and ``run_case``, result
   types and files, ``identify`` and ``simulate``, the report, and ``SYSTEM``;
-* :mod:`.plots` -- figures.
+* :mod:`~schuler.ground_gyrocompass.plots` -- figures.
 """
 
 from schuler.ground_gyrocompass.estimate import NorthEstimate, identify

@@ -135,7 +135,24 @@ def _std(std_arcsec, factor, unit, fmt):
 
 
 def make_estimate(fit: Fit, time, observed, unknowns, reading, method, inertia, omega_h) -> NorthEstimate:
-    """Turn a :class:`Fit` into the user-facing :class:`NorthEstimate`."""
+    """Turn a :class:`Fit` into the user-facing :class:`NorthEstimate`.
+
+    Parameters
+    ----------
+    fit : Fit
+        The least-squares or grid result (SI).
+    time : ndarray
+        Sample times, s.
+    observed : ndarray
+        Observed coordinate, rad.
+    unknowns : {2, 3, 4, 5}
+    reading : {"relative", "absolute"}
+    method : {"lsq", "grid"}
+    inertia : float
+        J, kg m^2.
+    omega_h : float
+        Omega_h, rad/s.
+    """
     values = fit.values
     errors = {}
     correlation: dict[str, list[str] | np.ndarray | None] = {"parameters": list(fit.names), "matrix": None}

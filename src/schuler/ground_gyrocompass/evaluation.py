@@ -165,7 +165,13 @@ def fit_bytes(samples: int, method: str, unknowns: int) -> int:
 
 
 def member_bytes(case: Case) -> int:
-    """Memory one Monte Carlo member holds while its record is made (the fits run one at a time)."""
+    """Memory one Monte Carlo member holds while its record is made (the fits run one at a time).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     return int(sample_count(case["duration"], case["output_step"]) * RECORD_BYTES_PER_SAMPLE)
 
 
@@ -413,6 +419,13 @@ def run_case(case: Case, fidelity: str | None = None) -> NorthRun:
 
     Raises :class:`~schuler.exceptions.IdentificationError` when the record does not
     determine the unknowns (where :func:`evaluate` gives NaN).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    fidelity : str, optional
+        One of the system's fidelities (default: the first).
 
     Examples
     --------

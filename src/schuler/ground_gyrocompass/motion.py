@@ -14,7 +14,7 @@ moment of inertia (zero in the source; the abstract names it as identifiable).
 The substitution z = (2 / lambda) sqrt(B exp(-lambda t)) (eq. (5)) turns the
 homogeneous equation into Bessel's equation of order zero (eq. (6)), so the motion
 is a combination of J0(z) and Y0(z) (eq. (7)); with the initial angle and angular
-rate at t = 0 it is eq. (9) written in time:
+rate at t = 0 it is eq. (9) written in time::
 
     alpha(t) = alpha0 u1(t) + alpha0_dot u2(t) + m u3(t),
 
@@ -58,7 +58,15 @@ SOURCE_STEP = 1.0  # every 1 s
 
 
 def check_decay_rate(decay_rate, name: str = "lambda") -> None:
-    """Raise InvalidParameter unless every decay rate lambda is finite and > 0."""
+    """Raise InvalidParameter unless every decay rate lambda is finite and > 0.
+
+    Parameters
+    ----------
+    decay_rate : float or ndarray
+        lambda, 1/s.
+    name : str
+        Name used in the error message.
+    """
     if isinstance(decay_rate, float) and 0.0 < decay_rate < math.inf:
         return  # a valid scalar, without numpy's per-call cost (checked once per fit)
     values = np.asarray(decay_rate, dtype=float)
@@ -67,7 +75,17 @@ def check_decay_rate(decay_rate, name: str = "lambda") -> None:
 
 
 def check_positive(value, name: str, unit: str) -> None:
-    """Raise InvalidParameter unless every value is finite and > 0."""
+    """Raise InvalidParameter unless every value is finite and > 0.
+
+    Parameters
+    ----------
+    value : float or ndarray
+        The values, in ``unit``.
+    name : str
+        Name used in the error message.
+    unit : str
+        Their unit, for the message.
+    """
     if isinstance(value, float) and 0.0 < value < math.inf:
         return  # a valid scalar, without numpy's per-call cost
     values = np.asarray(value, dtype=float)
@@ -105,6 +123,16 @@ def bessel_argument(time, decay_rate, coefficient):
     """z(t) = (2 / lambda) sqrt(B exp(-lambda t)) (Fedorov et al. (2020), eq. (5)) and z0 = z(0).
 
     Broadcasts ``time`` against ``decay_rate`` and ``coefficient``.
+
+    Parameters
+    ----------
+    time : float or ndarray
+        Time since release, s.
+    decay_rate : float or ndarray
+        lambda, 1/s.
+    coefficient : float or ndarray
+        B = H_m Omega_h / J, 1/s^2.
+
     """
     z0 = 2.0 / decay_rate * np.sqrt(coefficient)
     return z0 * np.exp(-0.5 * decay_rate * time), z0
@@ -123,6 +151,15 @@ at 1e7, measured on records of 200 to 2,000 s).
 def check_closed_form_reach(decay_rate, coefficient) -> None:
     """Raise InvalidParameter where lambda is so small that z0 exceeds :data:`MAX_BESSEL_ARGUMENT`.
 
+    Parameters
+    ----------
+    decay_rate : float or ndarray
+        lambda, the decay rate of the rotor's angular momentum during run-down, 1/s.
+    coefficient : float or ndarray
+        B = H_m Omega_h / J, 1/s^2.
+
+    Examples
+    --------
     >>> check_closed_form_reach(1e-9, 0.0135849)
     Traceback (most recent call last):
     ...
@@ -148,7 +185,9 @@ def check_closed_form_reach(decay_rate, coefficient) -> None:
 class Basis:
     """Fundamental solutions of eq. (4) and their derivatives w.r.t. lambda and B.
 
-    Attributes (arrays broadcast from ``time`` and the parameters)
+    The arrays broadcast from ``time`` and the parameters.
+
+    Attributes
     ----------
     angle : ndarray, shape (3, ...)
         u1 (alpha0 = 1 rad), u2 (alpha0_dot = 1 rad/s), u3 (m = 1 rad/s^2); rad per unit.
@@ -326,6 +365,21 @@ def simulate(time, alpha0, alpha0_dot, decay_rate, coefficient, specific_torque=
 
     Same parameters as :func:`closed_form`; ``time`` must be increasing from >= 0.
     The state is (alpha, alpha_dot), started at t = 0.
+
+    Parameters
+    ----------
+    time : ndarray
+        Time since release, s (increasing from >= 0).
+    alpha0 : float
+        Initial angle of the rotor axis from north, rad.
+    alpha0_dot : float
+        Initial azimuth rate, rad/s.
+    decay_rate : float
+        lambda, 1/s.
+    coefficient : float
+        B = H_m Omega_h / J, 1/s^2.
+    specific_torque : float
+        m = M / J, rad/s^2.
 
     Notes
     -----

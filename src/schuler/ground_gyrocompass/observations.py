@@ -58,7 +58,17 @@ def observe(angle, alpha0, noise=0.0, quantisation=0.0, reading="relative", offs
 
 
 def write_record(path, time, observed) -> Path:
-    """Write a record as CSV with columns ``t_s``, ``alpha_rad`` (atomically)."""
+    """Write a record as CSV with columns ``t_s``, ``alpha_rad`` (atomically).
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file.
+    time : ndarray
+        Sample times, s.
+    observed : ndarray
+        Observed coordinate, rad.
+    """
     import pandas as pd
 
     from schuler.io import write_dataframe_csv
@@ -72,6 +82,11 @@ def read_record(path):
 
     The file must be UTF-8 text; a byte-order mark (spreadsheets' "CSV UTF-8") is
     accepted.
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file (columns ``t_s``, ``alpha_rad``).
 
     Raises
     ------

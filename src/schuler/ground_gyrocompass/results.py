@@ -287,7 +287,15 @@ class ReproductionFigures:
 
 
 def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """Figures (PNG and SVG) and CSV data of a run, an identification, a record or the reproduction."""
+    """Figures (PNG and SVG) and CSV data of a run, an identification, a record or the reproduction.
+
+    Parameters
+    ----------
+    result : Result
+        What ``run``, ``reproduce`` or an action returned.
+    out_dir : Path
+        Folder for the figures (PNG, SVG) and data files (CSV); created if missing.
+    """
     out_dir = Path(out_dir)
     if isinstance(result, Reproduction):
         return _reproduction_files(result.data, out_dir)

@@ -166,6 +166,13 @@ OUTPUTS = (
 def parse_speed_profile(text: str, label: str = "speed_profile") -> SpeedProfile:
     """Read 'TIME: SPEED, TIME: SPEED, ...' (bare times in s, speeds in m/s; units allowed).
 
+    Parameters
+    ----------
+    text : str
+        The profile, e.g. ``"0: 0, 1 h: 36 km/h"``.
+    label : str
+        Parameter name used in error messages.
+
     Examples
     --------
     >>> p = parse_speed_profile("0: 0, 1 h: 36 km/h")
@@ -191,7 +198,13 @@ def _speed(case) -> SpeedProfile:
 
 
 def build_model(case) -> GyroVertical:
-    """The :class:`~schuler.gyro_vertical.model.GyroVertical` of a validated case (SI values)."""
+    """The :class:`~schuler.gyro_vertical.model.GyroVertical` of a validated case (SI values).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     earth = PRESETS[case["earth"]]
     profile = case["speed_profile"]
     try:
@@ -210,19 +223,41 @@ def build_model(case) -> GyroVertical:
 
 
 def output_points(duration: float, output_step: float) -> int:
-    """Samples of the output grid 0, step, 2 step, ... up to ``duration`` (the last within half a step)."""
+    """Samples of the output grid 0, step, 2 step, ... up to ``duration`` (the last within half a step).
+
+    Parameters
+    ----------
+    duration : float
+        Simulated time, s.
+    output_step : float
+        Spacing of the output grid, s.
+    """
     return math.floor(duration / output_step + 0.5) + 1
 
 
 def time_grid(duration: float, output_step: float) -> np.ndarray:
-    """The output times of a case, s (refuses a step longer than the duration)."""
+    """The output times of a case, s (refuses a step longer than the duration).
+
+    Parameters
+    ----------
+    duration : float
+        Simulated time, s.
+    output_step : float
+        Spacing of the output grid, s.
+    """
     if output_step > duration:
         raise InvalidParameter("output_step", f"{output_step:g} s is longer than the duration {duration:g} s")
     return np.arange(output_points(duration, output_step)) * output_step
 
 
 def member_bytes(case: Case) -> int:
-    """Memory one case holds while simulated, bytes (see :data:`POINT_BYTES`)."""
+    """Memory one case holds while simulated, bytes (see :data:`POINT_BYTES`).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     return int(POINT_BYTES * output_points(case["duration"], case["output_step"]) + CASE_BYTES)
 
 
@@ -233,6 +268,11 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     at once; the simulation (or, with ``fidelity="closed"``, the quasi-steady
     error (29) along the path) runs case by case on each case's own duration and
     output step. The model has no random terms: ``cases.random`` is not used.
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
 
     Examples
     --------
@@ -332,6 +372,13 @@ def _start_closed_forms(cases: Cases, each: list[Case]) -> dict[str, np.ndarray]
 
 def run_case(case: Case, fidelity: str | None = None) -> VerticalResult:
     """One case in full: the outputs of :func:`evaluate` for the one-case batch, and its histories.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    fidelity : str, optional
+        One of the system's fidelities (default: the first).
 
     Examples
     --------

@@ -159,15 +159,36 @@ class AccelerationInput:
 
     @classmethod
     def constant(cls, W_x: float = 0.0, W_y: float = 0.0) -> AccelerationInput:
+        """Constant accelerations.
+
+        Parameters
+        ----------
+        W_x, W_y : float
+            Accelerations on the x and y accelerometers, m/s^2.
+        """
         return cls(np.zeros(1), np.array([W_x], dtype=float), np.array([W_y], dtype=float))
 
     @classmethod
     def ramp(cls, W_x_final: float, W_y_final: float, duration: float) -> AccelerationInput:
-        """From zero to the final values over ``duration`` (s), then held."""
+        """From zero to the final values over ``duration`` (s), then held.
+
+        Parameters
+        ----------
+        W_x_final, W_y_final : float
+            Accelerations reached at the end of the ramp, m/s^2.
+        duration : float
+            Length of the ramp, s.
+        """
         return cls(np.array([0.0, duration]), np.array([0.0, W_x_final]), np.array([0.0, W_y_final]))
 
     def piece(self, index: int):
-        """Start (s), values (m/s^2) and slopes (m/s^3) of piece ``index``."""
+        """Start (s), values (m/s^2) and slopes (m/s^3) of piece ``index``.
+
+        Parameters
+        ----------
+        index : int
+            Index of the piece (of the knot it starts at).
+        """
         start = self.times[index]
         if index + 1 < self.times.size:
             span = self.times[index + 1] - start

@@ -140,8 +140,9 @@ def forcing(kinematics: Kinematics, radius, schuler_tuning=1.0, earth_rate_compe
     radius : float or ndarray
         R, m.
     schuler_tuning : float or ndarray
-        kappa.
+        kappa = k R / H, dimensionless (1: the Schuler condition (11)).
     earth_rate_compensation, transport_coriolis_compensation : bool or ndarray of bool
+        Apply the torques (8); subtract W* (21) from the accelerometer signals.
     accelerometer_bias : pair of float or ndarray
         (b_x, b_y), m/s^2.
     gyro_drift : pair of float or ndarray
@@ -268,7 +269,13 @@ class GyroVertical:
         return self.trajectory.radius
 
     def forcing(self, kinematics: Kinematics):
-        """Error-model inputs (f_x, f_y, e_x, e_y) along a trajectory (see :func:`forcing`)."""
+        """Error-model inputs (f_x, f_y, e_x, e_y) along a trajectory (see :func:`forcing`).
+
+        Parameters
+        ----------
+        kinematics : Kinematics
+            The trajectory's kinematics at the times wanted (SI).
+        """
         return forcing(kinematics, self.radius, self.schuler_tuning, self.earth_rate_compensation,
                        self.transport_coriolis_compensation, self.accelerometer_bias, self.gyro_drift)
 
@@ -286,6 +293,16 @@ class GyroVertical:
         """Right-hand side of the full equations for the state (alpha, beta, V_x, V_y).
 
         Uses (5), (2'), (6) with (11) scaled by kappa, (8) and (19); see the module notes.
+
+        Parameters
+        ----------
+        t : float
+            Time, s.
+        state : ndarray, shape (4,)
+            (alpha, beta) in rad and (V_x, V_y) in m/s.
+        kinematics : Kinematics
+            The trajectory's kinematics at ``t`` (SI).
+
         """
         k, R, g = kinematics, self.radius, self.gravity
         alpha, beta, V_x, V_y = state

@@ -41,7 +41,15 @@ def _finish(fig, axes, title: str, xlabel: str = "time [h]"):
 
 
 def plot_tilts(analysis, title: str = "Gyro vertical: tilts"):
-    """alpha and beta (arcmin) against time, with the forced motion (26)."""
+    """alpha and beta (arcmin) against time, with the forced motion (26).
+
+    Parameters
+    ----------
+    analysis : Analysis
+        A simulated run with its quasi-steady solution (SI).
+    title : str
+        Figure title.
+    """
     r, q = analysis.response, analysis.quasi_steady
     hours = r.time / HOUR
     fig, axes = _figure(2)
@@ -53,7 +61,17 @@ def plot_tilts(analysis, title: str = "Gyro vertical: tilts"):
 
 
 def plot_velocity_errors(analysis, compensated=None, title: str = "Gyro vertical: velocity errors"):
-    """Delta v_x and Delta v_y (m/s) against time, with (29), its slowly-varying form and the compensated run."""
+    """Delta v_x and Delta v_y (m/s) against time, with (29), its slowly-varying form and the compensated run.
+
+    Parameters
+    ----------
+    analysis : Analysis
+        A simulated run with its quasi-steady solution (SI).
+    compensated : Analysis, optional
+        The same run with the errors compensated, drawn beside it.
+    title : str
+        Figure title.
+    """
     r, q = analysis.response, analysis.quasi_steady
     hours = r.time / HOUR
     fig, axes = _figure(2)
@@ -71,7 +89,15 @@ def plot_velocity_errors(analysis, compensated=None, title: str = "Gyro vertical
 
 
 def plot_quasi_steady(quasi, title: str = "Gyro vertical: quasi-steady velocity errors (29)"):
-    """Forced tilts (26) (arcmin) and the quasi-steady errors (29) (m/s) of a closed-form run."""
+    """Forced tilts (26) (arcmin) and the quasi-steady errors (29) (m/s) of a closed-form run.
+
+    Parameters
+    ----------
+    quasi : QuasiSteady
+        The closed-form run (SI).
+    title : str
+        Figure title.
+    """
     hours = quasi.time / HOUR
     fig, axes = _figure(2)
     axes[0].plot(hours, quasi.alpha_r / ARCMIN, color="C0", lw=1.2, label="alpha_r")
@@ -86,7 +112,15 @@ def plot_quasi_steady(quasi, title: str = "Gyro vertical: quasi-steady velocity 
 
 
 def plot_monte_carlo(samples_x, samples_y, title: str = "Monte Carlo: systematic velocity errors"):
-    """Histograms of the members' mean velocity errors Delta v_x and Delta v_y (m/s), each on its own axis."""
+    """Histograms of the members' mean velocity errors Delta v_x and Delta v_y (m/s), each on its own axis.
+
+    Parameters
+    ----------
+    samples_x, samples_y : array_like
+        Each member's mean velocity error, m/s.
+    title : str
+        Figure title.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -109,7 +143,15 @@ def plot_monte_carlo(samples_x, samples_y, title: str = "Monte Carlo: systematic
 
 
 def plot_spectrum(analysis, title: str = "Spectrum of the velocity-error oscillation"):
-    """Amplitude of u = Delta v_x - i Delta v_y minus (29) against signed frequency (cycles/h)."""
+    """Amplitude of u = Delta v_x - i Delta v_y minus (29) against signed frequency (cycles/h).
+
+    Parameters
+    ----------
+    analysis : Analysis
+        A simulated run with its spectrum (SI).
+    title : str
+        Figure title.
+    """
     fig, axes = _figure(1, height=3.6)
     axis = axes[0]
     spectrum = analysis.spectrum

@@ -117,6 +117,11 @@ def mode_frequencies(system) -> np.ndarray:
     Returns the distinct positive imaginary parts, fastest first, shape (n_modes,)
     or (N, n_modes) for a batch.
 
+    Parameters
+    ----------
+    system : StateSpace
+        A model or a batch of models (1/s).
+
     Examples
     --------
     >>> from schuler.gyro_vertical.model import error_state_space
@@ -263,12 +268,23 @@ class Spectrum:
     amplitude: np.ndarray
 
     def peak(self, sign: int) -> float:
-        """Frequency (Hz) of the strongest line on the positive (+1) or negative (-1) side."""
+        """Frequency (Hz) of the strongest line on the positive (+1) or negative (-1) side.
+
+        Parameters
+        ----------
+        sign : {1, -1}
+        """
         side = self.frequency * sign > 0
         return float(self.frequency[side][np.argmax(self.amplitude[side])])
 
     def amplitude_at(self, frequency: float) -> float:
-        """Amplitude (m/s) of the bin nearest ``frequency`` (Hz)."""
+        """Amplitude (m/s) of the bin nearest ``frequency`` (Hz).
+
+        Parameters
+        ----------
+        frequency : float
+            Frequency, Hz.
+        """
         return float(self.amplitude[np.argmin(np.abs(self.frequency - frequency))])
 
 
@@ -410,6 +426,16 @@ def analyse(vertical: GyroVertical, time, method: str = "auto") -> Analysis:
     The spectrum's strongest line on each side of zero frequency seeds
     :func:`fit_modes` (with records under six Schuler periods the model's
     eigenfrequencies seed it instead, the FFT being too coarse).
+
+    Parameters
+    ----------
+    vertical : GyroVertical
+        The instrument on its trajectory.
+    time : ndarray
+        Times, s.
+    method : str
+        Simulation method: ``"auto"``, ``"exact"`` or a ``solve_ivp`` method.
+
     """
     response = vertical.simulate(time, method=method)
     t = response.time

@@ -217,7 +217,13 @@ CAPTIONS = {
 
 
 def report(figures_dir: Path) -> ReportSection:
-    """The reproduction, its figures (worked example, spectrum, friction) and the commands (a few seconds)."""
+    """The reproduction, its figures (worked example, spectrum, friction) and the commands (a few seconds).
+
+    Parameters
+    ----------
+    figures_dir : Path
+        The report's figure folder.
+    """
     reproduction = reproduce()
     files = write_files(reproduction, Path(figures_dir))
     figures = [FigureRef(path.name, CAPTIONS[path.stem]) for path in files if path.suffix == ".png"]

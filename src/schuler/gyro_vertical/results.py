@@ -178,7 +178,15 @@ class FrictionResult(Result):
 
 
 def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """Figures (PNG and SVG) and CSV data of a run, of the friction action or of the reproduction."""
+    """Figures (PNG and SVG) and CSV data of a run, of the friction action or of the reproduction.
+
+    Parameters
+    ----------
+    result : Result
+        What ``run``, ``reproduce`` or an action returned.
+    out_dir : Path
+        Folder for the figures (PNG, SVG) and data files (CSV); created if missing.
+    """
     out_dir = Path(out_dir)
     if isinstance(result, Reproduction):
         data = result.data

@@ -44,7 +44,15 @@ from schuler.exceptions import InvalidParameter
 
 
 def check_finite(name: str, value) -> float:
-    """``value`` as a float; InvalidParameter naming ``name`` unless it is finite."""
+    """``value`` as a float; InvalidParameter naming ``name`` unless it is finite.
+
+    Parameters
+    ----------
+    name : str
+        Name used in the error message.
+    value : float
+        The value (any unit).
+    """
     value = float(value)
     if not math.isfinite(value):
         raise InvalidParameter(name, f"must be a finite number, got {value}")
@@ -96,28 +104,58 @@ class SpeedProfile:
 
     @classmethod
     def constant(cls, speed: float) -> SpeedProfile:
-        """A constant speed, m/s."""
+        """A constant speed, m/s.
+
+        Parameters
+        ----------
+        speed : float
+            Speed, m/s.
+        """
         return cls(np.zeros(1), np.array([speed], dtype=float))
 
     def _piece(self, t):
         return np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, self.times.size - 1)
 
     def piece(self, index: int) -> tuple[float, float, float, float]:
-        """Start time (s), distance (m), speed (m/s) and acceleration (m/s^2) of piece ``index``."""
+        """Start time (s), distance (m), speed (m/s) and acceleration (m/s^2) of piece ``index``.
+
+        Parameters
+        ----------
+        index : int
+            Index of the piece.
+        """
         return (float(self.times[index]), float(self._distances[index]), float(self.speeds[index]),
                 float(self._slopes[index]))
 
     def speed(self, t):
-        """Speed at time ``t`` (s), m/s."""
+        """Speed at time ``t`` (s), m/s.
+
+        Parameters
+        ----------
+        t : float or ndarray
+            Time, s.
+        """
         k = self._piece(t)
         return self.speeds[k] + self._slopes[k] * (np.asarray(t) - self.times[k])
 
     def acceleration(self, t):
-        """Along-path acceleration at ``t`` (s), m/s^2 (right-continuous at knots)."""
+        """Along-path acceleration at ``t`` (s), m/s^2 (right-continuous at knots).
+
+        Parameters
+        ----------
+        t : float or ndarray
+            Time, s.
+        """
         return self._slopes[self._piece(t)]
 
     def distance(self, t):
-        """Distance travelled at ``t`` (s), m."""
+        """Distance travelled at ``t`` (s), m.
+
+        Parameters
+        ----------
+        t : float or ndarray
+            Time, s.
+        """
         k = self._piece(t)
         dt = np.asarray(t) - self.times[k]
         return self._distances[k] + self.speeds[k] * dt + 0.5 * self._slopes[k] * dt**2
@@ -217,7 +255,21 @@ class GreatCircleTrajectory:
     @classmethod
     def from_source(cls, latitude: float, speed: float, radius: float = 6.4e6, rate: float = 7.3e-5,
                     **kwargs) -> GreatCircleTrajectory:
-        """The worked example's geometry (theta = 0, v along +y0) with the source's constants."""
+        """The worked example's geometry (theta = 0, v along +y0) with the source's constants.
+
+        Parameters
+        ----------
+        latitude : float
+            Start latitude, rad.
+        speed : float
+            Constant speed, m/s.
+        radius : float
+            R, m (the source's 6.4e6 m).
+        rate : float
+            Omega, rad/s (the source's 7.3e-5 1/s).
+        **kwargs
+            Further fields (``frozen``).
+        """
         return cls(latitude, 0.0, math.pi / 2, SpeedProfile.constant(speed), radius, rate, **kwargs)
 
     @property
@@ -234,7 +286,13 @@ class GreatCircleTrajectory:
         return kr, kt * cg - pole * sg, pole * cg + kt * sg
 
     def kinematics(self, t) -> Kinematics:
-        """Latitude, Earth-rate components, velocity and acceleration at times ``t`` (s)."""
+        """Latitude, Earth-rate components, velocity and acceleration at times ``t`` (s).
+
+        Parameters
+        ----------
+        t : float or ndarray
+            Time, s.
+        """
         t = np.asarray(t, dtype=float)
         if self.frozen:
             t0 = np.zeros_like(t)
@@ -261,6 +319,12 @@ class GreatCircleTrajectory:
         For the ODE solver's right-hand side, called once per stage: plain floats,
         no arrays. The piece is the one starting at ``speed.times[index]`` (for a
         frozen path, the start values throughout).
+
+        Parameters
+        ----------
+        index : int
+            Index of the speed profile's piece.
+
         """
         start, s0, v0, accel = self.speed.piece(index)
         if self.frozen:

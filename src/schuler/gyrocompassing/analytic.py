@@ -31,7 +31,7 @@ def gains_from_design(time_constant, damping, latitude, earth_rate=EARTH_RATE):
     time_constant : float or ndarray
         T, s (> 0).
     damping : float or ndarray
-        zeta (> 0).
+        zeta, dimensionless (> 0).
     latitude : float or ndarray
         phi, rad.
     earth_rate : float
@@ -60,6 +60,15 @@ def gains_from_design(time_constant, damping, latitude, earth_rate=EARTH_RATE):
 
 def design_from_gains(c_gamma, c_a, latitude, earth_rate=EARTH_RATE):
     """Time constant T = 1 / sqrt(U_eta c_a) and damping zeta = c_gamma / (2 sqrt(U_eta c_a)).
+
+    Parameters
+    ----------
+    c_gamma, c_a : float or ndarray
+        Gains, 1/s.
+    latitude : float or ndarray
+        phi, rad.
+    earth_rate : float
+        U, rad/s.
 
     Returns
     -------
@@ -175,7 +184,18 @@ def full_steady_state(latitude, c_gamma, c_a, drift_east=0.0, drift_north=0.0, d
 
     Parameters
     ----------
-    As :func:`steady_state`, plus drift_north (dw_deta, rad/s) and eps_alpha (rad).
+    latitude : float or ndarray
+        phi, rad.
+    c_gamma, c_a : float or ndarray
+        Gains, 1/s.
+    drift_east, drift_north, drift_up : float or ndarray
+        Residual drifts dw_dxi, dw_deta, dw_dz, rad/s.
+    latitude_error : float or ndarray
+        dphi, rad.
+    eps_beta, eps_alpha : float or ndarray
+        Accelerometer errors about the east and north axes over g, rad.
+    earth_rate : float
+        U, rad/s.
 
     Returns
     -------
@@ -206,6 +226,19 @@ def azimuth_error_sigma(latitude, c_gamma, c_a, sigma_drift_east=0.0, sigma_drif
 
     sigma_delta^2 = (sigma_xi / U_eta)^2 + (c_gamma sigma_z / (c_a U_eta))^2 + (c_gamma sigma_phi / c_a)^2.
     Accelerometer errors do not enter the simplified model's azimuth error.
+
+    Parameters
+    ----------
+    latitude : float or ndarray
+        phi, rad.
+    c_gamma, c_a : float or ndarray
+        Gains, 1/s.
+    sigma_drift_east, sigma_drift_up : float or ndarray
+        1-sigma of the residual drifts dw_dxi and dw_dz, rad/s.
+    sigma_latitude_error : float or ndarray
+        1-sigma of dphi, rad.
+    earth_rate : float
+        U, rad/s.
 
     Examples
     --------
@@ -246,6 +279,15 @@ def settling_time(c_gamma, c_a, latitude, earth_rate=EARTH_RATE) -> np.ndarray:
     slow root p = -h + sqrt(h^2 - omega0^2) decays with time constant
     1 / (h - sqrt(h^2 - omega0^2)). Both forms meet at h = omega0.
 
+    Parameters
+    ----------
+    c_gamma, c_a : float or ndarray
+        Gains, 1/s.
+    latitude : float or ndarray
+        phi, rad.
+    earth_rate : float
+        U, rad/s.
+
     Examples
     --------
     >>> round(float(settling_time(2 * 0.8 / 30, 1 / (900 * 7.292115e-5), 0.0)), 2)
@@ -262,14 +304,22 @@ def settling_time(c_gamma, c_a, latitude, earth_rate=EARTH_RATE) -> np.ndarray:
 def transient(time, delta0, delta_rate0, delta_y, c_gamma, c_a, latitude, earth_rate=EARTH_RATE) -> np.ndarray:
     """Solution of (1.20) delta'' + c_gamma delta' + c_a U_eta delta = const, tending to delta_y.
 
-    Oscillatory (omega0 > h), (1.22):
+    Oscillatory (omega0 > h), (1.22)::
+
         delta = e^(-h t) [(delta0 - delta_y) cos(w t) + (delta'0 + h (delta0 - delta_y)) / w sin(w t)] + delta_y,
         w = sqrt(omega0^2 - h^2).
-    Aperiodic (h > omega0), (1.24): delta = C1 e^(p1 t) + C2 e^(p2 t) + delta_y,
+
+    Aperiodic (h > omega0), (1.24)::
+
+        delta = C1 e^(p1 t) + C2 e^(p2 t) + delta_y,
         p1,2 = -h +- sqrt(h^2 - omega0^2), C2 = (delta'0 - (delta0 - delta_y) p1) / (p2 - p1),
         C1 = delta0 - delta_y - C2 (printed with "delta_2" for delta_y).
-    Critical (h = omega0): delta = (C1 + C2 t) e^(-h t) + delta_y, C1 = delta0 - delta_y,
+
+    Critical (h = omega0)::
+
+        delta = (C1 + C2 t) e^(-h t) + delta_y, C1 = delta0 - delta_y,
         C2 = delta'0 + h (delta0 - delta_y) (printed with delta'0 in place of delta0).
+
     The same form holds for beta with its own initial values and beta_y (1.25).
 
     Parameters

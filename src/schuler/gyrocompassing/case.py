@@ -171,25 +171,50 @@ class AlignmentCase:
         return columns if self.size is None else np.broadcast_to(columns, (self.size, 6)).copy()
 
     def model(self, name: str) -> StateSpace:
-        """The state-space model ``name`` (one of :data:`models.MODELS`) of this case (batched for N cases)."""
+        """The state-space model ``name`` (one of :data:`models.MODELS`) of this case (batched for N cases).
+
+        Parameters
+        ----------
+        name : str
+            One of :data:`models.MODELS`.
+        """
         c_gamma, c_a = self.gains()
         return models.build_model(name, self.latitude, self.azimuth, c_gamma, c_a,
                                   earth_rate=self.earth_rate, gravity=self.gravity)
 
     def initial_state(self, name: str) -> np.ndarray:
-        """Initial state of the model ``name``: (delta0, beta0, alpha0) in its coordinates, rad."""
+        """Initial state of the model ``name``: (delta0, beta0, alpha0) in its coordinates, rad.
+
+        Parameters
+        ----------
+        name : str
+            One of :data:`models.MODELS`.
+        """
         return models.initial_state(name, self.initial_azimuth_error, self.initial_beta, self.initial_alpha,
                                     self.azimuth)
 
 
 def check_model(model: str) -> None:
-    """Raise InvalidParameter unless ``model`` is one of :data:`models.MODELS`."""
+    """Raise InvalidParameter unless ``model`` is one of :data:`models.MODELS`.
+
+    Parameters
+    ----------
+    model : str
+        The model name to check.
+    """
     if model not in models.MODELS:
         raise InvalidParameter("model", f"{model!r} is not one of {', '.join(models.MODELS)}")
 
 
 def analytic_results(case: AlignmentCase, model: str = "full") -> dict[str, np.ndarray]:
     """Closed-form results of (many) cases at once, pure numpy.
+
+    Parameters
+    ----------
+    case : AlignmentCase
+        One case or N cases (SI arrays).
+    model : str
+        One of :data:`models.MODELS`.
 
     Returns
     -------
@@ -239,6 +264,15 @@ def analytic_results(case: AlignmentCase, model: str = "full") -> dict[str, np.n
 def time_grid(duration: float, time_step: float) -> np.ndarray:
     """Output times 0, dt, ..., duration (the last step shortened to end exactly at duration), s.
 
+    Parameters
+    ----------
+    duration : float
+        Simulated time, s.
+    time_step : float
+        Output step dt, s.
+
+    Examples
+    --------
     >>> time_grid(2.5, 1.0)
     array([0. , 1. , 2. , 2.5])
     """
@@ -256,6 +290,13 @@ def time_grid(duration: float, time_step: float) -> np.ndarray:
 def automatic_duration(settling_time) -> float:
     """2 h, or 3 analytic settling times when longer, at most 48 h (s).
 
+    Parameters
+    ----------
+    settling_time : float or ndarray
+        Analytic settling times of the cases, s (the longest counts).
+
+    Examples
+    --------
     >>> automatic_duration(187.5), automatic_duration(1e4), automatic_duration(1e9)
     (7200.0, 30000.0, 172800.0)
     """
@@ -266,6 +307,13 @@ def automatic_duration(settling_time) -> float:
 def sweep_grid(axes: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The Cartesian product of parameter axes as flat arrays of equal length (first axis slowest).
 
+    Parameters
+    ----------
+    axes : dict of ndarray
+        Values of each swept parameter, in its own unit (SI for the system's parameters).
+
+    Examples
+    --------
     >>> g = sweep_grid({"a": np.array([1.0, 2.0]), "b": np.array([10.0, 20.0, 30.0])})
     >>> g["a"].tolist(), g["b"].tolist()
     ([1.0, 1.0, 1.0, 2.0, 2.0, 2.0], [10.0, 20.0, 30.0, 10.0, 20.0, 30.0])

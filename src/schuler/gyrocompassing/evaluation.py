@@ -125,7 +125,13 @@ _CASE_FIELDS = ("latitude", "azimuth", "drift_east", "drift_north", "drift_x", "
 
 
 def alignment_case(cases: Cases) -> AlignmentCase:
-    """The :class:`~schuler.gyrocompassing.AlignmentCase` of a batch, random terms drawn for members."""
+    """The :class:`~schuler.gyrocompassing.AlignmentCase` of a batch, random terms drawn for members.
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values; random terms from ``cases.random``).
+    """
     arrays = {name: cases.float(name) for name in _CASE_FIELDS}
     arrays["accel_error_x"] = cases.float("accel_bias_x")
     arrays["accel_error_y"] = cases.float("accel_bias_y")
@@ -146,6 +152,12 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
 
     Cases are grouped by model, duration and output step (each group is one
     batched simulation on the engine), so swept durations and steps hold per case.
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
+
     """
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
@@ -210,6 +222,13 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
 def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
     """One case in full: the outputs of :func:`evaluate` and the histories of the model and of (1.19).
 
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    fidelity : str, optional
+        One of the system's fidelities (default: the first).
+
     Examples
     --------
     >>> r = run_case(PARAMETERS.case(drift_east=np.radians(0.01) / 3600, model="simplified"))
@@ -257,7 +276,13 @@ def _regime(c_gamma: float, c_a: float, latitude: float) -> str:
 
 
 def member_bytes(case: Case) -> int:
-    """Memory one member holds while simulated: its history of 3 states and 3 outputs, 8 bytes each."""
+    """Memory one member holds while simulated: its history of 3 states and 3 outputs, 8 bytes each.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     duration = case["duration"] or MAX_DURATION
     return int(6 * 8 * (duration / case["output_step"] + 2))
 

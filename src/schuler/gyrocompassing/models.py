@@ -302,6 +302,23 @@ BUILDERS = {"full": full_mu_nu_model, "full-ab": full_alpha_beta_model, "simplif
 def build_model(model: str, latitude, azimuth, c_gamma, c_a, **constants) -> StateSpace:
     """Build the model named ``model`` (one of :data:`MODELS`); other arguments as :func:`full_mu_nu_model`.
 
+    Parameters
+    ----------
+    model : str
+        One of :data:`MODELS`.
+    latitude : float or ndarray
+        Latitude phi, rad.
+    azimuth : float or ndarray
+        Azimuth A, rad.
+    c_gamma : float or ndarray
+        Level correction gain c_Gamma, 1/s.
+    c_a : float or ndarray
+        Azimuth correction gain c_a, 1/s.
+    **constants
+        ``earth_rate`` (rad/s) and ``gravity`` (m/s^2).
+
+    Examples
+    --------
     >>> build_model("simplified", 0.8, 0.5, 0.05, 20.0).n_states
     2
     """
@@ -315,6 +332,17 @@ def initial_state(model: str, delta0, beta0=0.0, alpha0=0.0, azimuth=0.0) -> np.
     mu = beta sin A + alpha cos A, nu = beta cos A - alpha sin A. The simplified
     model has no alpha. Scalars give shape (n,), arrays of length N give (N, n).
 
+    Parameters
+    ----------
+    model : str
+        One of :data:`MODELS`.
+    delta0, beta0, alpha0 : float or ndarray
+        Initial azimuth error and level errors, rad.
+    azimuth : float or ndarray
+        Azimuth A, rad.
+
+    Examples
+    --------
     >>> initial_state("full", 0.01, 0.0, 0.0)
     array([0.  , 0.  , 0.01])
     """
@@ -335,6 +363,17 @@ def platform_drifts(azimuth, drift_x=0.0, drift_y=0.0, drift_east=0.0, drift_nor
     Inverts (1.14): dw_dx = dw_dxi cos A - dw_deta sin A, dw_dy = dw_dxi sin A + dw_deta cos A,
     added to the platform-axis parts.
 
+    Parameters
+    ----------
+    azimuth : float or ndarray
+        Azimuth A, rad.
+    drift_x, drift_y : float or ndarray
+        Drifts about the platform axes x, y, rad/s.
+    drift_east, drift_north : float or ndarray
+        Drifts about east and north, rad/s.
+
+    Examples
+    --------
     >>> x, y = platform_drifts(np.pi / 2, drift_east=1.0)
     >>> round(float(x), 12), round(float(y), 12)
     (0.0, 1.0)

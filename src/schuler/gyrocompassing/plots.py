@@ -27,10 +27,17 @@ def _figure(rows: int = 1, height: float = 3.2):
 def time_history(runs: dict, title: str = "Gyrocompassing: azimuth and level errors", settling_times: float = 4.0):
     """delta and beta against time for one or more runs, Fig. 1.4 style.
 
-    ``runs`` maps a label to a :class:`~schuler.gyrocompassing.simulation.CaseRun`.
-
     The time axis spans ``settling_times`` analytic settling times (or the whole
     run if shorter), so that the transient is visible.
+
+    Parameters
+    ----------
+    runs : dict
+        Label -> :class:`~schuler.gyrocompassing.simulation.CaseRun` (SI).
+    title : str
+        Figure title.
+    settling_times : float
+        Span of the time axis in analytic settling times, plain number.
     """
     fig, (ax_delta, ax_beta) = _figure(2)
     for label, run in runs.items():
@@ -52,7 +59,15 @@ def time_history(runs: dict, title: str = "Gyrocompassing: azimuth and level err
 
 
 def phase_trajectory(runs: dict, title: str = "Phase trajectory in the (delta, beta) plane (task 5)"):
-    """The platform's path in the (delta, beta) plane for one or more runs (label -> CaseRun)."""
+    """The platform's path in the (delta, beta) plane for one or more runs (label -> CaseRun).
+
+    Parameters
+    ----------
+    runs : dict
+        Label -> :class:`~schuler.gyrocompassing.simulation.CaseRun` (SI).
+    title : str
+        Figure title.
+    """
     fig, (axis,) = _figure(1, 4.5)
     for label, run in runs.items():
         delta, beta = to_unit(run.delta, "arcmin"), to_unit(run.beta, "arcsec")
@@ -111,7 +126,17 @@ def sweep_curves(x, x_label: str, columns: dict, groups=None):
 
 
 def monte_carlo_histogram(samples_arcmin, sigma_analytic_arcmin: float, mean_arcmin: float, model: str):
-    """Histogram of the Monte Carlo azimuth errors with the analytic normal density beside it."""
+    """Histogram of the Monte Carlo azimuth errors with the analytic normal density beside it.
+
+    Parameters
+    ----------
+    samples_arcmin : array_like
+        Each member's azimuth error, arcmin.
+    sigma_analytic_arcmin, mean_arcmin : float
+        Standard deviation and mean of the analytic normal density, arcmin.
+    model : str
+        Name of the model simulated (for the legend).
+    """
     fig, (axis,) = _figure(1, 4.0)
     samples = np.asarray(samples_arcmin)
     axis.hist(samples, bins=min(60, max(10, samples.size // 25)), density=True, alpha=0.6,
@@ -131,7 +156,15 @@ def monte_carlo_histogram(samples_arcmin, sigma_analytic_arcmin: float, mean_arc
 
 
 def printed_versus_corrected(time, delta_printed, delta_corrected):
-    """delta over time for the printed (1.17) third line and the corrected one, at A = 0."""
+    """delta over time for the printed (1.17) third line and the corrected one, at A = 0.
+
+    Parameters
+    ----------
+    time : array_like
+        Time, s.
+    delta_printed, delta_corrected : array_like
+        Azimuth error of each model, rad.
+    """
     fig, (axis,) = _figure(1, 3.6)
     hours = np.asarray(time) / 3600.0
     axis.plot(hours, to_unit(delta_printed, "deg"), label="(1.17) as printed: diverges")
@@ -146,7 +179,17 @@ def printed_versus_corrected(time, delta_printed, delta_corrected):
 
 
 def write_figures(figures: dict, outdir, formats=("png", "svg")) -> list[Path]:
-    """Save figures (stem -> Figure) into ``outdir`` in ``formats``; returns the paths."""
+    """Save figures (stem -> Figure) into ``outdir`` in ``formats``; returns the paths.
+
+    Parameters
+    ----------
+    figures : dict
+        File stem -> matplotlib Figure.
+    outdir : str or Path
+        Folder to write into.
+    formats : tuple of str
+        File formats (suffixes).
+    """
     paths = []
     for stem, fig in figures.items():
         paths += save_figure_formats(fig, Path(outdir) / stem, formats)

@@ -144,6 +144,11 @@ def report(outdir: Path) -> ReportSection:
 
     The Monte Carlo uses 400 members and the latitude sweep 9 simulated cases;
     ``schuler align run --monte-carlo 10000`` and ``schuler sweep`` scale them up.
+
+    Parameters
+    ----------
+    outdir : Path
+        The report's figure folder.
     """
     outdir = Path(outdir)
     reproduction = reproduce()

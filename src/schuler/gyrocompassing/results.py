@@ -100,7 +100,15 @@ def _clean(value: float, digits: int) -> str:
 
 
 def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """Figures (PNG and SVG) and CSV of a run, a Monte Carlo or the reproduction."""
+    """Figures (PNG and SVG) and CSV of a run, a Monte Carlo or the reproduction.
+
+    Parameters
+    ----------
+    result : Result
+        What ``run``, ``reproduce`` or an action returned.
+    out_dir : Path
+        Folder for the figures (PNG, SVG) and data files (CSV); created if missing.
+    """
     import pandas as pd
 
     from schuler.gyrocompassing import plots

@@ -189,6 +189,15 @@ class CaseRun:
 def constraint_violations(max_abs_delta: float, max_abs_beta: float, max_abs_delta_rate: float) -> list[str]:
     """Readable list of the task-1 constraints a run broke (empty when all hold).
 
+    Parameters
+    ----------
+    max_abs_delta, max_abs_beta : float
+        Largest azimuth error and level error of the run, rad.
+    max_abs_delta_rate : float
+        Largest azimuth error rate, rad/s.
+
+    Examples
+    --------
     >>> constraint_violations(0.5, 0.0, 0.0)
     ['|delta| reached 0.5 rad (limit 0.4 rad)']
     """

@@ -43,6 +43,17 @@ DEFAULT_MAX_FRACTION = 0.125
 def allan_lags(samples: int, per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION) -> np.ndarray:
     """Lags m (in samples), ``per_octave`` per octave from 1 up to ``max_fraction`` x samples.
 
+    Parameters
+    ----------
+    samples : int
+        Number of samples in the record.
+    per_octave : int
+        Number of lags per octave.
+    max_fraction : float
+        Largest lag as a fraction of the record (dimensionless).
+
+    Examples
+    --------
     >>> allan_lags(100, per_octave=1).tolist()
     [1, 2, 4, 8]
     """
@@ -97,7 +108,15 @@ class AllanCurve:
 
 
 def noise_types(tau, avar) -> np.ndarray:
-    """alpha per tau from the local log-log slope of the Allan variance over about +/- one octave, non-increasing."""
+    """alpha per tau from the local log-log slope of the Allan variance over about +/- one octave, non-increasing.
+
+    Parameters
+    ----------
+    tau : ndarray
+        Averaging times, s.
+    avar : ndarray
+        Allan variance at ``tau``, in the channel's rate unit squared.
+    """
     log_tau, log_avar = np.log(np.asarray(tau, float)), np.log(np.maximum(np.asarray(avar, float), 1e-300))
     alpha = np.zeros(log_tau.size, dtype=int)
     for i in range(log_tau.size):
@@ -113,7 +132,21 @@ def noise_types(tau, avar) -> np.ndarray:
 
 
 def confidence(adev, alpha, lags, phase_points: int, confidence_level: float = 0.6826894921370859):
-    """Greenhall edf and the chi-square interval of each deviation: (edf, lower, upper)."""
+    """Greenhall edf and the chi-square interval of each deviation: (edf, lower, upper).
+
+    Parameters
+    ----------
+    adev : ndarray
+        Allan deviation, in the channel's rate unit (rad/s or m/s^2).
+    alpha : ndarray
+        Power-law noise type at each lag (dimensionless exponent).
+    lags : ndarray of int
+        Lags m, in samples.
+    phase_points : int
+        Number of integrated (phase) samples.
+    confidence_level : float
+        Probability covered by the interval (dimensionless, 0.683: 1 sigma).
+    """
     import allantools
 
     edf = np.array([allantools.edf_greenhall(alpha=int(a), d=2, m=int(m), N=int(phase_points), overlapping=True,
@@ -170,7 +203,13 @@ class AllanAccumulator:
         self._counts = np.zeros((self.channels, self.lags.size), dtype=np.int64)
 
     def update(self, chunk) -> None:
-        """Add rate samples, shape (L, channels) (or (L,) for one channel)."""
+        """Add rate samples, shape (L, channels) (or (L,) for one channel).
+
+        Parameters
+        ----------
+        chunk : ndarray, shape (L, channels) or (L,)
+            Rate samples, rad/s or m/s^2.
+        """
         chunk = np.asarray(chunk, dtype=float)
         if chunk.ndim == 1:
             chunk = chunk[:, None]
@@ -194,7 +233,15 @@ class AllanAccumulator:
         self.samples += chunk.shape[0]
 
     def curves(self, with_confidence: bool = True, max_lag: int | None = None) -> list[AllanCurve]:
-        """One :class:`AllanCurve` per channel, over the lags (up to ``max_lag``) with a second difference."""
+        """One :class:`AllanCurve` per channel, over the lags (up to ``max_lag``) with a second difference.
+
+        Parameters
+        ----------
+        with_confidence : bool
+            Compute the edf and the confidence interval.
+        max_lag : int, optional
+            Largest lag, in samples.
+        """
         valid = self._counts[0] > 0
         offsets = [0.0] * self.channels if self._offsets is None else [float(v) for v in self._offsets]
         if max_lag is not None:

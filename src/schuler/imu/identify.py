@@ -68,13 +68,27 @@ SLOPES = {"Q": -1.0, "N": -0.5, "B": 0.0, "K": 0.5, "R": 1.0}
 
 
 def term_basis(tau) -> np.ndarray:
-    """Columns of sigma^2(tau) per unit squared coefficient: (3/tau^2, 1/tau, 2 ln2/pi, tau/3, tau^2/2)."""
+    """Columns of sigma^2(tau) per unit squared coefficient: (3/tau^2, 1/tau, 2 ln2/pi, tau/3, tau^2/2).
+
+    Parameters
+    ----------
+    tau : ndarray
+        Averaging times, s.
+    """
     tau = np.asarray(tau, dtype=float)
     return np.column_stack([3.0 / tau**2, 1.0 / tau, np.full(tau.size, FLICKER_FLOOR**2), tau / 3.0, tau**2 / 2.0])
 
 
 def term_allan_deviations(values: dict[str, float], tau) -> dict[str, np.ndarray]:
-    """Each term's own Allan deviation at ``tau`` (the slope lines of the plot)."""
+    """Each term's own Allan deviation at ``tau`` (the slope lines of the plot).
+
+    Parameters
+    ----------
+    values : dict of str to float
+        The terms Q, N, B, K, R in SI (rad, rad/sqrt(s), rad/s ... for a gyro).
+    tau : ndarray
+        Averaging times, s.
+    """
     basis = term_basis(tau)
     return {term: np.sqrt(basis[:, i]) * values[term] for i, term in enumerate(TERMS)}
 
@@ -111,7 +125,13 @@ class NoiseTerms:
     model_floor: float = 0.0
 
     def model_adev(self, tau) -> np.ndarray:
-        """The fitted model's Allan deviation at ``tau``."""
+        """The fitted model's Allan deviation at ``tau``.
+
+        Parameters
+        ----------
+        tau : float or ndarray
+            Averaging times, s.
+        """
         return np.sqrt(term_basis(tau) @ np.array([self.values[t] ** 2 for t in TERMS]))
 
 

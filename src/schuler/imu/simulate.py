@@ -186,7 +186,13 @@ class ImuSimulator:
         return {p.stream: p.step for processes in self._processes.values() for p in processes}
 
     def constants(self, members) -> dict[str, np.ndarray]:
-        """Each member's constant errors: ``gyro_bias`` (m, 3), ``gyro_matrix`` (m, 3, 3) = I + S + M, ``gyro_g`` ..."""
+        """Each member's constant errors: ``gyro_bias`` (m, 3), ``gyro_matrix`` (m, 3, 3) = I + S + M, ``gyro_g`` ...
+
+        Parameters
+        ----------
+        members : ndarray of int
+            Member numbers (the addresses of their draws).
+        """
         members = np.asarray(members, dtype=np.int64).reshape(-1)
         out = {}
         for sensor, errors in self._sensors.items():
@@ -248,7 +254,13 @@ class ImuSimulator:
         return parts[0] if len(parts) == 1 else np.concatenate(parts)
 
     def forget(self, members) -> None:
-        """Drop the carried state of ``members`` (their next window replays from sample 0)."""
+        """Drop the carried state of ``members`` (their next window replays from sample 0).
+
+        Parameters
+        ----------
+        members : ndarray of int
+            Member numbers.
+        """
         for member in np.asarray(members, dtype=np.int64).reshape(-1):
             self._states.pop(int(member), None)
 
@@ -307,6 +319,14 @@ class ImuSimulator:
         """Rates of ``members`` over samples ``start .. stop-1``: gyro (m, L, 3) rad/s, accel (m, L, 3) m/s^2.
 
         Sample k is the mean over (k dt, (k + 1) dt]. With quantisation, rate = whole quanta / dt.
+
+        Parameters
+        ----------
+        members : ndarray of int
+            Member numbers.
+        start, stop : int
+            Sample index range.
+
         """
         members = np.asarray(members, dtype=np.int64).reshape(-1)
         start, stop = int(start), int(stop)
@@ -343,7 +363,21 @@ def _sample_count(duration_s: float, dt: float) -> int:
 
 
 def iter_simulation(simulator: ImuSimulator, members, samples: int, window: int = WINDOW, member_chunk: int = 8):
-    """Yield ``(members, start, gyro, accel)`` windows covering ``samples`` samples of ``members``, bounded memory."""
+    """Yield ``(members, start, gyro, accel)`` windows covering ``samples`` samples of ``members``, bounded memory.
+
+    Parameters
+    ----------
+    simulator : ImuSimulator
+        The simulator (error model, dt, seed).
+    members : ndarray of int
+        Member numbers.
+    samples : int
+        Number of samples per member.
+    window : int
+        Number of samples per window.
+    member_chunk : int
+        Number of members simulated at once.
+    """
     members = np.asarray(members, dtype=np.int64).reshape(-1)
     for first in range(0, members.size, member_chunk):
         group = members[first:first + member_chunk]
@@ -360,6 +394,28 @@ def simulate_members(model: ErrorModel, *, samples: int, sample_interval_s: floa
     """All samples of several members in memory: gyro and accel rates, each (members, samples, 3).
 
     ``members`` is a count (members 0 .. n-1) or a sequence of member numbers.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        Sensor errors (SI).
+    samples : int
+        Number of samples per member.
+    sample_interval_s : float
+        dt, s.
+    members : int or sequence of int
+        A count (members 0 .. n-1) or the member numbers.
+    seed : int
+        Seed of the random streams.
+    true_gyro_rad_s : tuple of float
+        True angular rate in body axes, rad/s.
+    true_accel_m_s2 : tuple of float
+        True specific force in body axes, m/s^2.
+    workers : int
+        Number of threads.
+    max_memory_bytes : int
+        Largest result allocated, bytes (larger requests are refused).
+
     """
     ids = np.arange(members) if np.ndim(members) == 0 else np.asarray(members, dtype=np.int64)
     _check_size(ids.size, int(samples), max_memory_bytes)
@@ -388,6 +444,8 @@ def simulate_record(model: ErrorModel, *, duration_s: float, sample_interval_s: 
     latitude_rad, heading_rad : float
         Site latitude and heading of the x axis, rad.
     kind : {"rate", "increment"}
+    max_memory_bytes : int
+        Largest record allocated, bytes (larger requests are refused).
     """
     dt = float(sample_interval_s)
     samples = _sample_count(duration_s, dt)
@@ -404,7 +462,23 @@ def simulate_record(model: ErrorModel, *, duration_s: float, sample_interval_s: 
 def write_simulation(path, model: ErrorModel, *, duration_s: float, sample_interval_s: float, seed: int = 0,
                      member: int = 0, latitude_rad: float = math.radians(45.0), heading_rad: float = 0.0,
                      workers: int = 1):
-    """Simulate one member at rest straight into a native (Parquet) file, window by window; returns the path."""
+    """Simulate one member at rest straight into a native (Parquet) file, window by window; returns the path.
+
+    Parameters
+    ----------
+    path : str or Path
+        The Parquet file.
+    model : ErrorModel
+        Sensor errors (SI).
+    duration_s, sample_interval_s : float
+        Length and dt, s.
+    seed, member : int
+        Address of the random numbers.
+    latitude_rad, heading_rad : float
+        Site latitude and heading of the x axis, rad.
+    workers : int
+        Number of threads.
+    """
     from schuler.imu.native import ParquetRecordWriter
 
     dt = float(sample_interval_s)

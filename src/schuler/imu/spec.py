@@ -86,7 +86,14 @@ def _parse_values(value, unit: str, name: str, shape: tuple[int, ...]) -> np.nda
 
 
 def sensor_errors_from_spec(table: dict, sensor: str) -> SensorErrors:
-    """A :class:`SensorErrors` from a spec-file table (``sensor`` is "gyro" or "accel", used in messages)."""
+    """A :class:`SensorErrors` from a spec-file table (``sensor`` is "gyro" or "accel", used in messages).
+
+    Parameters
+    ----------
+    table : dict
+        The ``[gyro]`` or ``[accel]`` table: figures as strings with their units ("0.125 deg/sqrt(h)").
+    sensor : {"gyro", "accel"}
+    """
     units = GYRO_UNITS if sensor == "gyro" else ACCEL_UNITS
     if not isinstance(table, dict):
         raise InvalidParameter(sensor, "must be a table of figures")
@@ -117,7 +124,15 @@ def sensor_errors_from_spec(table: dict, sensor: str) -> SensorErrors:
 
 
 def error_model_from_spec(spec: dict, name: str = "custom") -> ErrorModel:
-    """An :class:`ErrorModel` from a parsed spec (a dict as TOML gives it)."""
+    """An :class:`ErrorModel` from a parsed spec (a dict as TOML gives it).
+
+    Parameters
+    ----------
+    spec : dict
+        The parsed spec file (figures as strings with their units).
+    name : str
+        Name of the model.
+    """
     for key in spec:
         if key not in _TOP_LEVEL:
             raise _unknown(key, _TOP_LEVEL, "")
@@ -130,6 +145,11 @@ def error_model_from_spec(spec: dict, name: str = "custom") -> ErrorModel:
 
 def load_spec_file(path) -> ErrorModel:
     """Read a TOML spec file (format in the module notes).
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML spec file.
 
     Raises
     ------
@@ -216,6 +236,12 @@ GRADES = tuple(PRESET_SPECS)
 def preset(grade: str) -> ErrorModel:
     """The :class:`ErrorModel` of a grade: navigation, tactical, industrial or consumer.
 
+    Parameters
+    ----------
+    grade : {"navigation", "tactical", "industrial", "consumer"}
+
+    Examples
+    --------
     >>> float(preset("tactical").gyro.random_walk[0])   # 0.125 deg/sqrt(h) in rad/sqrt(s)
     3.6361026e-05
     """

@@ -56,7 +56,7 @@ def sample_count(duration: float, imu_rate: float) -> int:
 
 @dataclass
 class TruthChunk:
-    """One block of truth and ideal IMU: intervals ``start .. start + n - 1`` (global indices).
+    """One block of truth and ideal IMU: intervals ``start`` to ``start + n - 1`` (global indices).
 
     Attributes
     ----------

@@ -42,6 +42,8 @@ def thrust_gravity(thrust_factor, gravity):
     gravity : float or ndarray
         g0, m/s^2 (> 0).
 
+    Examples
+    --------
     >>> float(thrust_gravity(9, 9.80665))
     88.25985
     """
@@ -74,6 +76,15 @@ def flight_gravity(gravity, speed, path_radius):
 def orbital_speed(gravity, path_radius):
     """V_c = sqrt(g r), m/s: the speed at which g_eff vanishes.
 
+    Parameters
+    ----------
+    gravity : float or ndarray
+        g, m/s^2 (> 0).
+    path_radius : float or ndarray
+        r, radius of the flight path about the Earth's centre, m (> 0).
+
+    Examples
+    --------
     >>> round(float(orbital_speed(9.80665, 6.371e6)))
     7904
     """
@@ -91,6 +102,8 @@ def effective_schuler_period(radius, effective_gravity):
         g_eff, m/s^2. At or above the orbital speed g_eff <= 0: the loop has no
         restoring acceleration and the period is returned as ``inf``.
 
+    Examples
+    --------
     >>> float(effective_schuler_period(6.4e6, 0.0))
     inf
     """

@@ -134,6 +134,12 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     Closed forms are vectorised over the batch; the simulated fidelity runs one
     exact simulation per distinct (source, R, g, V for the azimuth source,
     duration, output step), for a unit magnitude, scaled per case.
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
+
     """
     n = len(cases)
     batch = _batch(cases)
@@ -175,12 +181,25 @@ def _simulate_groups(batch: dict[str, np.ndarray], points: np.ndarray, out: dict
 
 
 def member_bytes(case: Case) -> int:
-    """Memory one Monte Carlo member holds while evaluated: a few floats per output (grids are per group)."""
+    """Memory one Monte Carlo member holds while evaluated: a few floats per output (grids are per group).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
     return 64 * len(OUTPUTS) + 256
 
 
 def run_case(case: Case, fidelity: str | None = None) -> ErrorRunResult:
     """One case in full: the outputs of :func:`evaluate` and the error histories for figures and CSV.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    fidelity : str, optional
+        One of the system's fidelities (default: the first).
 
     Examples
     --------

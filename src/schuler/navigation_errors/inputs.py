@@ -192,6 +192,17 @@ def earth_constants(earth: str = "default", radius: float | None = None, gravity
     A preset that states its Schuler period (Bollay's 5060 s) uses the loop's
     effective gravity omega_s^2 R unless the radius or the gravity is given.
 
+    Parameters
+    ----------
+    earth : str
+        Preset name.
+    radius : float, optional
+        R overriding the preset's, m.
+    gravity : float, optional
+        g0 overriding the preset's, m/s^2.
+
+    Examples
+    --------
     >>> [round(x, 4) for x in earth_constants("bollay")]
     [6373002.24, 9.8266]
     """
@@ -212,7 +223,17 @@ def earth_constants(earth: str = "default", radius: float | None = None, gravity
 
 
 def earth_constant_arrays(earth: np.ndarray, radius: np.ndarray, gravity: np.ndarray):
-    """:func:`earth_constants` for arrays of cases (NaN radius or gravity: not set), m and m/s^2."""
+    """:func:`earth_constants` for arrays of cases (NaN radius or gravity: not set), m and m/s^2.
+
+    Parameters
+    ----------
+    earth : ndarray
+        Preset name of each case (None: the default).
+    radius : ndarray
+        R of each case, m (NaN: the preset's).
+    gravity : ndarray
+        g0 of each case, m/s^2 (NaN: the preset's).
+    """
     # numpy's stubs leave out None, which object arrays compare elementwise
     earth = np.where(np.equal(earth, None), "default", earth)  # type: ignore[call-overload]
     R, g = radius.astype(float).copy(), gravity.astype(float).copy()
@@ -228,6 +249,17 @@ def earth_constant_arrays(earth: np.ndarray, radius: np.ndarray, gravity: np.nda
 def check_vertical_growth(duration: float, radius: float, gravity: float) -> None:
     """Refuse a run whose pure-inertial vertical error would grow beyond exp(:data:`MAX_GROWTH_EXPONENT`).
 
+    Parameters
+    ----------
+    duration : float
+        Simulated time, s.
+    radius : float
+        R, m.
+    gravity : float
+        g0, m/s^2.
+
+    Examples
+    --------
     >>> check_vertical_growth(1e6, 6.371e6, 9.80665)
     Traceback (most recent call last):
     ...
@@ -249,6 +281,15 @@ def grid_points(duration, step, names: tuple[str, str] = ("duration", "output_st
 
     Raises :class:`InvalidParameter` (naming ``names``) for a non-finite or
     non-positive duration or step, or a step longer than the duration.
+
+    Parameters
+    ----------
+    duration : float or ndarray
+        Simulated time of each case, s.
+    step : float or ndarray
+        Output step of each case, s.
+    names : tuple of str
+        Parameter names used in error messages.
     """
     duration = np.asarray(duration, dtype=float)
     step = np.asarray(step, dtype=float)
@@ -281,6 +322,8 @@ def time_grid(duration: float, step: float | None = None,
         s (> 0).
     step : float, optional
         s (> 0, at most ``duration``); default ``duration / 1000``.
+    names : tuple of str
+        Parameter names used in error messages.
     """
     step = duration / 1000.0 if step is None else step
     count = int(grid_points(duration, step, names))

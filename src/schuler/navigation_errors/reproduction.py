@@ -286,7 +286,13 @@ def plot(*, points: int) -> Problem3Figures:
 
 
 def report(figures_dir: Path) -> ReportSection:
-    """Write this system's figures into ``figures_dir`` and describe them with the reproduction table."""
+    """Write this system's figures into ``figures_dir`` and describe them with the reproduction table.
+
+    Parameters
+    ----------
+    figures_dir : Path
+        The report's figure folder.
+    """
     from schuler.io import save_figure_formats
 
     figures_dir = Path(figures_dir)

@@ -25,6 +25,17 @@ LENGTH_UNITS = ("m", "ft")
 def length_text(value_si: float | None, unit: str, floor: float = 0.0) -> str:
     """A length for people: thousands separated, no float noise below ``floor`` (m), no negative zero.
 
+    Parameters
+    ----------
+    value_si : float or None
+        The length, m (None or NaN: ``-``).
+    unit : str
+        Display unit (``m``, ``ft``).
+    floor : float
+        Magnitudes below it show as 0, m.
+
+    Examples
+    --------
     >>> length_text(87782.4, "ft"), length_text(-1e-12, "m", floor=1e-9), length_text(None, "m")
     ('288,000', '0', '-')
     """
@@ -37,13 +48,29 @@ def length_text(value_si: float | None, unit: str, floor: float = 0.0) -> str:
 
 
 def lengths(value_si: float | None, floor: float = 0.0) -> str:
-    """A length in metres and feet: ``1,000 m (3,280.84 ft)``."""
+    """A length in metres and feet: ``1,000 m (3,280.84 ft)``.
+
+    Parameters
+    ----------
+    value_si : float or None
+        The length, m (None or NaN: ``-``).
+    floor : float
+        Magnitudes below it show as 0, m.
+    """
     shown = [f"{length_text(value_si, unit, floor)} {unit}" for unit in LENGTH_UNITS]
     return f"{shown[0]} ({shown[1]})" if shown[0] != "- m" else "-"
 
 
 def sample_indices(size: int, count: int = 11) -> np.ndarray:
-    """About ``count`` evenly spread indices of a history of ``size`` points (first and last included)."""
+    """About ``count`` evenly spread indices of a history of ``size`` points (first and last included).
+
+    Parameters
+    ----------
+    size : int
+        Number of points of the history.
+    count : int
+        Number of indices wanted (about).
+    """
     return np.unique(np.linspace(0, size - 1, min(size, count)).round().astype(int))
 
 

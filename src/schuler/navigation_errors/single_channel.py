@@ -60,7 +60,13 @@ _SCHULER_SOURCES = ("tilt", "velocity", "accelerometer", "drift")
 
 
 def check_source(source: str) -> str:
-    """Return ``source`` if it is one of :data:`SOURCES`, else raise InvalidParameter."""
+    """Return ``source`` if it is one of :data:`SOURCES`, else raise InvalidParameter.
+
+    Parameters
+    ----------
+    source : str
+        Name of an error source.
+    """
     if source not in SOURCES:
         raise InvalidParameter("source", f"{source!r} is not one of {', '.join(SOURCES)}")
     return source
@@ -85,6 +91,13 @@ def _finite(value, name: str, nonnegative: bool = False):
 def one_minus_cos(x):
     """1 - cos x without cancellation near 0 (= 2 sin^2(x/2)).
 
+    Parameters
+    ----------
+    x : float or ndarray
+        Angle, rad.
+
+    Examples
+    --------
     >>> float(one_minus_cos(1e-8))
     5e-17
     """
@@ -94,6 +107,13 @@ def one_minus_cos(x):
 def x_minus_sin(x):
     """x - sin x, by its Taylor series where the subtraction would cancel (|x| < 0.25).
 
+    Parameters
+    ----------
+    x : float or ndarray
+        Angle, rad.
+
+    Examples
+    --------
     >>> float(x_minus_sin(1e-3))
     1.66666658333e-10
     """

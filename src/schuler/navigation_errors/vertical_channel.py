@@ -106,6 +106,15 @@ def unaided_model(radius: float, gravity: float) -> StateSpace:
     input ``accelerometer_error`` b (m/s^2). Eigenvalues +/- sqrt(2) omega_s: one is
     positive, the channel diverges.
 
+    Parameters
+    ----------
+    radius : float
+        R, m.
+    gravity : float
+        g0, m/s^2.
+
+    Examples
+    --------
     >>> import numpy as np
     >>> lam = unaided_model(6.371e6, 9.80665).eigenvalues().real
     >>> bool(np.isclose(lam.max(), np.sqrt(2 * 9.80665 / 6.371e6)))
@@ -158,6 +167,8 @@ def critically_damped_gains(order: int, time_constant: float, radius: float, gra
     radius, gravity : float
         R (m) and g0 (m/s^2).
 
+    Examples
+    --------
     >>> critically_damped_gains(3, 100.0, 6.371e6, 9.80665).k1
     0.03
     """
@@ -173,6 +184,17 @@ def critically_damped_gains(order: int, time_constant: float, radius: float, gra
 def check_stable(gains: BaroLoopGains, radius: float, gravity: float) -> None:
     """Raise InvalidParameter unless the aided loop is asymptotically stable (Routh-Hurwitz).
 
+    Parameters
+    ----------
+    gains : BaroLoopGains
+        k1 (1/s), k2 (1/s^2), k3 (1/s^3) and the order.
+    radius : float
+        R, m.
+    gravity : float
+        g0, m/s^2.
+
+    Examples
+    --------
     >>> check_stable(BaroLoopGains(0.02, 1e-6, 0.0, 2), 6.371e6, 9.80665)
     Traceback (most recent call last):
     ...
@@ -199,6 +221,17 @@ def baro_aided_model(gains: BaroLoopGains, radius: float, gravity: float) -> Sta
     ``accelerometer_error`` b (m/s^2) and ``baro_altitude_error`` delta_h_baro (m).
     Equations in the module docstring.
 
+    Parameters
+    ----------
+    gains : BaroLoopGains
+        k1 (1/s), k2 (1/s^2), k3 (1/s^3) and the order.
+    radius : float
+        R, m.
+    gravity : float
+        g0, m/s^2.
+
+    Examples
+    --------
     >>> gains = critically_damped_gains(2, 50.0, 6.371e6, 9.80665)
     >>> bool(np.allclose(baro_aided_model(gains, 6.371e6, 9.80665).eigenvalues(), -0.02))
     True

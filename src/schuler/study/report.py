@@ -14,6 +14,7 @@ from __future__ import annotations
 import html
 import importlib
 import math
+import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -192,6 +193,7 @@ def _section(entry: SystemEntry, figures_dir: Path | None = None) -> str:
         f'<section id="{_anchor(entry.name)}">',
         f"<h2>{html.escape(section.title)} <small><code>schuler {name}</code></small></h2>",
         f'<p class="source"><strong>Source:</strong> {html.escape(section.source)}</p>',
+        _guide_link(system, figures_dir),
         f"<p>{html.escape(section.summary)}</p>",
     ]
     if section.rows:
@@ -211,6 +213,23 @@ def _section(entry: SystemEntry, figures_dir: Path | None = None) -> str:
     parts.append(f'<p class="timing">Section built in {entry.seconds:.1f} s.</p>')
     parts.append("</section>")
     return "\n".join(parts)
+
+
+GUIDE = Path(__file__).resolve().parents[3] / "docs" / "_build" / "html" / "guide"
+"""Where ``make docs`` puts the user guide's pages, in a checkout (one page per system: ``System.guide``)."""
+
+
+def _guide_link(system: System | None, figures_dir: Path | None) -> str:
+    """The system's guide chapter: a relative link when the built guide is beside the report, else its name."""
+    if system is None or not system.guide:
+        return ""
+    page = GUIDE / f"{system.guide}.html"
+    if figures_dir is not None and page.exists():
+        href = os.path.relpath(page, Path(figures_dir).resolve().parent)
+        return (f'<p class="guide"><strong>Guide:</strong> <a href="{html.escape(href, quote=True)}">'
+                f"{html.escape(system.guide)}</a></p>")
+    return (f'<p class="guide"><strong>Guide:</strong> the chapter <code>guide/{html.escape(system.guide)}.html</code> '
+            "of the documentation (<code>make docs</code> builds it into <code>docs/_build/html</code>)</p>")
 
 
 def _number(value) -> str:

@@ -1,0 +1,179 @@
+"""What the API reference documents, and its index page generated from the package.
+
+The API reference is autosummary over the installed ``schuler`` package: this
+module decides which modules and members are public (the same rule the
+docstring test in ``tests/test_docs.py`` applies) and writes ``api/index.rst``
+with one autosummary group per layer, so a new system subpackage gets its page
+without editing the documentation. :func:`site_problems` checks the built site
+for what the documentation promises (run at the end of every build).
+
+Public: every module whose dotted name has no part starting with ``_`` (the
+numba kernels and ``__main__`` are private), outside the command line
+(``schuler.cli``, documented by its ``--help`` on the command-line page); in a
+module, the functions and classes defined in it whose names do not start with
+``_`` (what autosummary lists with ``autosummary_ignore_module_all``: names a
+package re-exports are documented where they are defined).
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import pkgutil
+import re
+from collections.abc import Iterator
+from pathlib import Path
+from types import ModuleType
+
+from schuler.registry import SYSTEM_MODULES, get_system
+
+PACKAGE = "schuler"
+EXCLUDED = ("schuler.cli",)
+"""Subpackages left out of the API reference (the command line has its own page)."""
+
+GUIDE_BACKLOG: tuple[str, ...] = ()
+"""Systems registered before their guide chapter and gallery script were written (they landed together with the
+documentation): the site check and ``tests/test_docs.py`` let them pass without, and fail once they have both, so
+that the name leaves this list. It only shrinks."""
+
+GROUPS = (
+    ("core", "The numerical core",
+     "Pure numerics in SI, used by every system: Earth constants, geometry, the exact linear-systems engine, "
+     "addressed random numbers, streaming statistics."),
+    ("boundary", "The contract and the boundary",
+     "The one contract every system fulfils, parameters and units (the only place human units are parsed), "
+     "result and reproduction types, the bibliography, memory limits and atomic files."),
+    ("systems", "Instrument systems and libraries",
+     "One subpackage per instrument system (its model modules cite the source's equation numbers), and the "
+     "libraries beside them."),
+    ("study", "Studies", "Scenario files, sweeps and the HTML report."),
+)
+
+
+def public_modules() -> list[str]:
+    """Dotted names of the documented modules and packages, sorted."""
+    package = importlib.import_module(PACKAGE)
+    names = [PACKAGE]
+    for info in pkgutil.walk_packages(package.__path__, PACKAGE + "."):
+        if any(part.startswith("_") for part in info.name.split(".")) or info.name.startswith(EXCLUDED):
+            continue
+        names.append(info.name)
+    return sorted(names)
+
+
+def group_of(module: str) -> str:
+    """The layer a top-level module or subpackage belongs to (see :data:`GROUPS`)."""
+    parts = module.split(".")
+    if parts[1] in ("core", "study"):
+        return parts[1]
+    top = importlib.import_module(".".join(parts[:2]))
+    return "systems" if hasattr(top, "__path__") else "boundary"
+
+
+def public_members(module: ModuleType) -> dict[str, object]:
+    """The module's documented functions and classes by name: its own, not re-exported, not ``_private``."""
+    return {name: value for name, value in vars(module).items()
+            if not name.startswith("_") and (inspect.isfunction(value) or inspect.isclass(value))
+            and getattr(value, "__module__", None) == module.__name__}
+
+
+def public_functions() -> Iterator[tuple[str, object]]:
+    """Every documented function and public method, with its dotted name.
+
+    A module that fails to import is skipped here (so that one broken module does
+    not hide the rest); the build's autosummary warning and
+    ``tests/test_docs.py::test_every_public_module_imports`` name it.
+    """
+    for name in public_modules():
+        try:
+            module = importlib.import_module(name)
+        except ImportError:
+            continue
+        for member_name, member in public_members(module).items():
+            if inspect.isfunction(member):
+                yield f"{name}.{member_name}", member
+            else:
+                for method_name, method in vars(member).items():
+                    if not method_name.startswith("_") and inspect.isfunction(method):
+                        yield f"{name}.{member_name}.{method_name}", method
+                    elif isinstance(method, (staticmethod, classmethod)) and not method_name.startswith("_"):
+                        yield f"{name}.{member_name}.{method_name}", method.__func__
+
+
+def index_text() -> str:
+    """The text of ``api/index.rst``: each layer's top-level modules and subpackages, recursively."""
+    tops = sorted({".".join(name.split(".")[:2]) for name in public_modules() if name != PACKAGE})
+    lines = [
+        ".. This file is generated by docs/_ext/schuler_api.py at every build: edit that file.",
+        "",
+        "API reference",
+        "=============",
+        "",
+        "Generated from the docstrings of the installed package. Every function states its parameters with "
+        "their units (SI inside; human units only where the boundary parses them), what it returns, the "
+        "source's equations it implements, and the document it follows (see :doc:`/bibliography`). "
+        "The layers and the rules between them are in :doc:`/architecture`.",
+        "",
+    ]
+    for key, title, text in GROUPS:
+        members = [name for name in tops if group_of(name) == key]
+        if not members:
+            continue
+        lines += [title, "-" * len(title), "", text, ""]
+        if key == "boundary":  # the package itself (get_system), without descending into everything
+            lines += [".. autosummary::", "   :toctree: generated", "", f"   {PACKAGE}", ""]
+        lines += [".. autosummary::", "   :toctree: generated", "   :recursive:", ""]
+        lines += [f"   {name}" for name in members]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def write_index(source_dir: Path) -> Path:
+    """Write ``api/index.rst`` under ``source_dir`` (only when its text changed, so rebuilds stay incremental).
+
+    Module pages of an earlier build whose module is gone (renamed, removed in a
+    merge) are deleted: autosummary only adds pages, and a page that cannot
+    import its module would fail the build.
+    """
+    path = Path(source_dir) / "api" / "index.rst"
+    text = index_text()
+    if not path.exists() or path.read_text(encoding="utf-8") != text:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+    modules = set(public_modules())
+    for page in (path.parent / "generated").glob("*.rst"):
+        if page.stem not in modules:
+            page.unlink()
+    return path
+
+
+_REMOTE_ASSET = re.compile(r"<(?:script|img|link|iframe|source)\b[^>]*\b(?:src|href)=[\"']?(https?:)?//", re.I)
+_GALLERY_IMAGE = re.compile(r"<img\b[^>]*\bsrc=\"[^\"]*/_images/sphx_glr_[^\"]+\.png\"")
+
+
+def site_problems(html_dir: Path) -> list[str]:
+    """What the built site under ``html_dir`` lacks of what the documentation promises.
+
+    A guide page and a gallery page with its figure for every registered system,
+    an API page for every subpackage and top-level module, and every script,
+    style sheet, image and font served by the site itself (none from
+    ``http(s)://`` or ``//``). ``make docs`` runs it after the build.
+    """
+    problems = []
+    if not (html_dir / "index.html").exists():
+        problems.append("index.html missing")
+    for name in (name for name in SYSTEM_MODULES if name not in GUIDE_BACKLOG):
+        guide = get_system(name).guide
+        if not (html_dir / "guide" / f"{guide}.html").exists():
+            problems.append(f"{name}: no guide page guide/{guide}.html (System.guide = {guide!r})")
+        examples = sorted((html_dir / "gallery" / guide).glob("plot_*.html"))
+        if not any(_GALLERY_IMAGE.search(page.read_text(encoding="utf-8")) for page in examples):
+            problems.append(f"{name}: no gallery page with a figure under gallery/{guide}/ "
+                            f"(examples/gallery/{guide}/plot_*.py)")
+    tops = sorted({".".join(module.split(".")[:2]) for module in public_modules()})
+    problems += [f"no API page for {top}" for top in tops
+                 if not (html_dir / "api" / "generated" / f"{top}.html").exists()]
+    for page in sorted(html_dir.rglob("*.html")):
+        if _REMOTE_ASSET.search(page.read_text(encoding="utf-8")):
+            problems.append(f"{page.relative_to(html_dir)}: loads an asset from another site")
+    return problems
