@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from dash import html
+from dash import html, no_update
 
 import schuler.lab
 import test_study_fake_system as fake
 from schuler.exceptions import InvalidParameter
-from schuler.lab import controls, figures, system_page, tasks, views
+from schuler.lab import compare_page, controls, figures, system_page, tasks, views
 from schuler.lab.app import MAX_REQUEST_BYTES, create_app, systems_available
 from schuler.lab.server import check_host, check_port
 from schuler.registry import get_system
@@ -335,6 +335,70 @@ def test_systems_without_interactive_figures_show_their_own_files():
     assert [name for name, _ in images] == ["align_time_history.png", "align_phase_trajectory.png"]
     assert all(uri.startswith("data:image/png;base64,iVBORw0KGgo") for _, uri in images)  # the PNG signature
     assert figures.interactive_stems(fake.FAKE) == () and figures.interactive_figures(fake.FAKE, result) is None
+
+
+# --- the alignment comparison: /align/compare ------------------------------------------------------------------
+
+COMPARE = compare_page.compare_action()
+
+
+def test_the_comparison_page_has_a_control_per_option_of_the_command():
+    page = compare_page.layout(COMPARE)
+    found = {attribute(c, "data-param"): c for c in walk(page) if attribute(c, "data-param")}
+    assert list(found) == list(COMPARE.parameters.names)
+    for name, div in found.items():
+        inputs = [c for c in walk(div) if type(c).__name__ == "Input"]
+        assert len(inputs) == 1 and inputs[0].debounce is True and inputs[0].type == "text", name
+        assert inputs[0].value == compare_page.STARTING_CASE.get(name, controls.initial_text(COMPARE.parameters[name]))
+    units = {c.children for div in found.values() for c in walk(div) if attribute(c, "className") == "unit"}
+    assert units == {"deg", "s", "Hz", "m/s"}
+
+
+def test_a_typed_comparison_gives_the_headings_of_the_command():
+    typed = {"imu": "tactical", "duration": "1 min", "heading": "-100", "seed": "3", "damping": "0.7"}
+    table, images, errors, message, _ = compare_page.show(typed)
+    direct = COMPARE.function(imu="tactical", duration=60.0, heading=math.radians(-100), seed=3, damping=0.7)
+    shown = compare_page.run_typed(typed)
+    assert list(shown.methods) == ["coarse", "inertial_frame", "kalman", "gyrocompass"]
+    for name, row in direct.methods.items():
+        assert shown.methods[name]["heading_rad"] == pytest.approx(row["heading_rad"], abs=1e-12)
+        # a minute of tactical-grade data: the error stays within 3 x the method's 1-sigma limit (7-8 deg)
+        error = math.remainder(row["heading_rad"] - math.radians(-100), 2 * math.pi)
+        assert abs(error) < 3 * row["limit_heading_rad"]
+    spans = {attribute(c, "data-result"): c.children for c in walk(table) if attribute(c, "data-result")}
+    assert len(spans) == 4 * len(compare_page.COLUMNS)
+    heading = math.degrees(direct.methods["kalman"]["heading_rad"])
+    assert spans["methods.kalman.heading_rad"] == f"{views.number_text(heading)} deg"
+    limit = direct.methods["gyrocompass"]["limit_heading_rad"] / ARCMIN
+    assert spans["methods.gyrocompass.limit_heading_rad"] == f"{views.number_text(limit)} arcmin"
+    assert float(spans["methods.kalman.heading_rad"].split()[0]) == pytest.approx(heading, rel=1e-3)
+    assert (errors, message) == ({}, "")
+    assert [attribute(f, "data-figure") for f in images] == ["align_compare_heading.png"]
+    assert images[0].children[0].src.startswith("data:image/png;base64,iVBORw0KGgo")  # the PNG signature
+
+
+def test_a_bad_latitude_on_the_comparison_page_gets_the_command_lines_message(run_cli):
+    table, images, errors, message, _ = compare_page.show({"imu": "tactical", "latitude": "95"})
+    out = run_cli("align", "compare", "--imu", "tactical", "--latitude", "95")
+    assert out.code == 2 and out.stderr == f"schuler: error: {errors['latitude']}\n"
+    assert errors == {"latitude": "--latitude: '95' is outside [-89, 89] deg"}
+    assert table is images is no_update and message == ""
+
+
+def test_a_comparison_without_record_or_grade_says_so_beside_the_record():
+    _, _, errors, message, _ = compare_page.show({})
+    assert list(errors) == ["record"] and errors["record"].startswith("--record: give --record FILE")
+
+
+def test_the_index_and_the_align_page_link_the_comparison(client):
+    from schuler.lab.app import COMPARE_HREF, _index
+
+    assert COMPARE_HREF == "/align/compare"
+    for page in (_index(systems_available()), system_page.layout(ALIGN)):
+        assert COMPARE_HREF in [getattr(c, "href", None) for c in walk(page)]
+    assert client.get(COMPARE_HREF).status_code == 200
+    outputs = [d["output"] for d in client.get("/_dash-dependencies").get_json()]
+    assert any("compare-methods" in output for output in outputs)
 
 
 # --- the KPI tasks ----------------------------------------------------------------------------------------------

@@ -249,3 +249,25 @@ def test_task1_marks_violated_constraints_and_exports_png_svg_csv(server, browse
     lines = saved["csv"].read_text().splitlines()
     assert lines[0].startswith("latitude (deg),azimuth_error_arcmin,") and len(lines) == 1 + 21
     assert watched.close() == {"console": [], "page": [], "failed": [], "outside": []}
+
+
+def test_the_alignment_comparison_runs_from_the_align_page_and_says_what_is_wrong(server, browser):
+    from schuler.lab import compare_page
+
+    watched = Watched(browser, server)
+    watched.open("align")
+    watched.page.locator("#compare-link").click()
+    heading = watched.page.locator('[data-result="methods.kalman.heading_rad"]')
+    # twice the usual wait: in a fresh checkout the job's process compiles the alignment kernels first (~20 s)
+    watched.wait_for(lambda: heading.count() == 1 and heading.inner_text().endswith(" deg"), "the methods' table",
+                     timeout=2 * WAIT_S)
+    assert watched.page.url == server + "align/compare"
+    expected = compare_page.run_typed(compare_page.STARTING_CASE).methods["kalman"]["heading_rad"]
+    assert float(heading.inner_text().split()[0]) == pytest.approx(math.degrees(expected), rel=5e-4)
+    image = watched.page.locator("[data-figure='align_compare_heading.png'] img")
+    watched.wait_for(lambda: image.count() == 1, "the comparison's figure")
+    watched.type_value("latitude", "95")
+    error = watched.page.locator("[data-param=latitude] .error")
+    watched.wait_for(lambda: error.inner_text().strip() != "", "the latitude's message")
+    assert error.inner_text().strip() == "--latitude: '95' is outside [-89, 89] deg"
+    assert watched.close() == {"console": [], "page": [], "failed": [], "outside": []}

@@ -2,8 +2,9 @@
 
 :func:`create_app` builds one Dash application. Its pages: ``/`` (what there
 is), ``/NAME`` for every registered system (:mod:`schuler.lab.system_page`),
-``/NAME/reproduction``, and the KPI lab tasks at ``/align/task1`` ...
-(:mod:`schuler.lab.tasks`). Systems whose module fails to import are listed as
+``/NAME/reproduction``, the KPI lab tasks at ``/align/task1`` ...
+(:mod:`schuler.lab.tasks`) and the alignment comparison at ``/align/compare``
+(:mod:`schuler.lab.compare_page`). Systems whose module fails to import are listed as
 "not available" with the reason, and the rest of the lab works.
 
 Every asset (Dash's renderer, React, plotly.js, the lab's CSS and scripts) is
@@ -28,13 +29,16 @@ from dash import Dash, DiskcacheManager, Input, Output, dcc, html
 
 from schuler import __version__
 from schuler.contract import System
-from schuler.lab import manual, system_page
+from schuler.lab import compare_page, manual, system_page
 from schuler.registry import SYSTEM_MODULES, get_system
 
 MAX_REQUEST_BYTES = 256 * 1024
 """Largest request body the lab accepts, bytes (a page's callbacks send a few kB)."""
 
 ASSETS = Path(__file__).parent / "assets"
+
+COMPARE_HREF = f"/{compare_page.SYSTEM}/{compare_page.ACTION}"
+"""The alignment comparison's page."""
 
 TASK_PAGES = {f"task{n}" for n in manual.TASK_TITLES}
 """The KPI task pages under ``/align/``."""
@@ -121,6 +125,7 @@ def create_app() -> Lab:
     available = systems_available()
     app.layout = lambda: _shell(available)
     system_page.register(app)
+    compare_page.register(app)
     _routing(app, {a.name: a for a in available}, _task_pages(app))
     _limits(app)
     return Lab(app, cache_dir, manager)
@@ -178,6 +183,8 @@ def _routing(app: Dash, by_name: dict[str, Availability], task_layout) -> None:
             return system_page.layout(item.system)
         if len(parts) == 2 and parts[1] == "reproduction":
             return system_page.reproduction_layout(item.system)
+        if (item.name, parts[1:]) == (compare_page.SYSTEM, [compare_page.ACTION]):
+            return compare_page.layout(compare_page.compare_action())
         if item.name == "align" and len(parts) == 2 and parts[1] in TASK_PAGES and task_layout is not None:
             return task_layout(item.system, parts[1])
         return _not_found(pathname)
@@ -195,6 +202,9 @@ def _index(available: list[Availability]) -> html.Div:
         html.H1("schuler lab bench"),
         html.P("Every system's parameters are controls; the numbers and figures follow as they change."),
         html.H2("Systems"), html.Ul(rows),
+        html.H2("Comparisons"),
+        html.Ul([html.Li([dcc.Link("Self-alignment methods compared", href=COMPARE_HREF),
+                          f" (schuler {compare_page.SYSTEM} {compare_page.ACTION})"])]),
         html.H2("KPI lab tasks (gyrocompassing)"),
         html.Ul([html.Li(dcc.Link(f"Task {n}: {title}", href=f"/align/task{n}"))
                  for n, title in manual.TASK_TITLES.items()]),

@@ -243,7 +243,12 @@ def interactive_figures(system: System, result) -> list[dict] | None:
 
 def file_figures(system: System, result) -> list[tuple[str, str]]:
     """The system's own PNG figures of a result as (file name, data URI) pairs."""
+    return png_figures(system.write_files, result)
+
+
+def png_figures(write_files: Callable[[Any, Path], list[Path]], result) -> list[tuple[str, str]]:
+    """The PNG figures ``write_files`` draws of a result as (file name, data URI) pairs."""
     with tempfile.TemporaryDirectory(prefix="schuler-lab-") as folder:
-        paths = system.write_files(result, Path(folder))
+        paths = write_files(result, Path(folder))
         return [(path.name, "data:image/png;base64," + base64.b64encode(path.read_bytes()).decode("ascii"))
                 for path in paths if path.suffix == ".png"]

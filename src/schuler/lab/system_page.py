@@ -33,6 +33,10 @@ POLL_MS = 50
 """How often the browser asks whether a background job has finished, ms (it bounds the added latency)."""
 
 
+ACTION_PAGES = {"align": {"compare": "Every self-alignment method on the same data, compared"}}
+"""System name -> its actions that have a page of their own (``/NAME/ACTION``) and the link's text."""
+
+
 def page_parameters(system: System) -> ParameterSet:
     """The page's controls: the system's parameters, ``monte_carlo``, ``seed`` and ``fidelity`` where offered."""
     extra = list(RUN_OPTIONS)
@@ -69,6 +73,8 @@ def layout(system: System) -> html.Div:
             html.P([dcc.Link("Reproduction table of the source's published case", href=f"/{name}/reproduction",
                              id="reproduction-link"),
                     f" (schuler {name} reproduce)"]),
+            *[html.P([dcc.Link(title, href=f"/{name}/{action}", id=f"{action}-link"), f" (schuler {name} {action})"])
+              for action, title in ACTION_PAGES.get(name, {}).items()],
         ], className="page-head"),
         html.Div([
             html.Aside([html.H2("Parameters"),
