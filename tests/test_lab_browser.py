@@ -251,6 +251,7 @@ def test_task1_marks_violated_constraints_and_exports_png_svg_csv(server, browse
     assert watched.close() == {"console": [], "page": [], "failed": [], "outside": []}
 
 
+@pytest.mark.slow  # its first job compiles the alignment kernels in a fresh process (about 20 s)
 def test_the_alignment_comparison_runs_from_the_align_page_and_says_what_is_wrong(server, browser):
     from schuler.lab import compare_page
 
