@@ -6,6 +6,7 @@ import json
 import math
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -69,3 +70,20 @@ def test_sweep_under_the_group_gives_the_summary_of_schuler_sweep(run_cli, tmp_p
     group_printed, plain_printed = ({k: v for k, v in out.json().items() if k not in varying}
                                     for out in (under_group, plain))
     assert group_printed == plain_printed
+
+
+@pytest.mark.slow
+def test_the_nonlinear_members_run_on_a_dask_cluster_as_in_process(run_cli, tmp_path):
+    """Beyond one run's members: `mission sweep --monte-carlo N --scheduler ...` (the sweeps' executors)."""
+    scenario = EXAMPLES / "mission_tactical.toml"
+
+    def members(name, *options):
+        out = run_cli("mission", "sweep", scenario, "--param", "duration=1800", "--monte-carlo", "6",
+                      "--no-csv", "--out", tmp_path / name, *options)
+        assert out.code == 0, out.stderr
+        return pd.read_parquet(tmp_path / name / "results.parquet")
+
+    dask = members("dask", "--chunk-size", "2", "--scheduler", "local", "--workers", "2")
+    alone = members("alone", "--chunk-size", "6")
+    assert dask["member_position_error_m"].nunique() == 6
+    pd.testing.assert_frame_equal(dask, alone, check_exact=False, rtol=1e-12)
