@@ -56,7 +56,19 @@ def compare_action() -> Action:
 
 
 def run_typed(typed: dict[str, str]):
-    """Run the comparison the user typed (values parsed as the command line parses them)."""
+    """Run the comparison the user typed (values parsed as the command line parses them).
+
+    Parameters
+    ----------
+    typed : dict of str to str
+        Option name -> the text typed in its field (a number in the option's display unit, or a value with a
+        unit), only for the fields the user changed.
+
+    Returns
+    -------
+    AlignmentComparison
+        What ``schuler align compare`` computes for the same options.
+    """
     action = compare_action()
     case, errors = parse_typed(action.parameters, typed)
     if case is None:
@@ -65,7 +77,13 @@ def run_typed(typed: dict[str, str]):
 
 
 def method_table(methods: dict[str, dict] | None = None) -> html.Table:
-    """Every method's numbers as ``span[data-result="methods.NAME.KEY"]`` in display units (``-``: none)."""
+    """Every method's numbers as ``span[data-result="methods.NAME.KEY"]`` in display units (``-``: none).
+
+    Parameters
+    ----------
+    methods : dict of str to dict, optional
+        ``methods`` of the comparison's JSON: method name -> its values in SI (rad, s); none: an empty table.
+    """
     header = html.Tr([html.Th("method"), *(html.Th(f"{c.description} [{c.shown_unit}]") for c in COLUMNS)])
     rows = []
     for name, row in (methods or {}).items():
@@ -77,14 +95,26 @@ def method_table(methods: dict[str, dict] | None = None) -> html.Table:
 
 
 def figure_elements(result) -> list:
-    """The action's PNG figures of a result as ``figure[data-figure=NAME]`` images."""
+    """The action's PNG figures of a result as ``figure[data-figure=NAME]`` images.
+
+    Parameters
+    ----------
+    result : AlignmentComparison
+        What the comparison returned (any result its figure writer accepts).
+    """
     images = png_figures(compare_action().write_files or get_system(SYSTEM).write_files, result)
     return [html.Figure([html.Img(src=uri, alt=stem), html.Figcaption(stem)], **views.data_attributes(figure=stem))
             for stem, uri in images] or [html.P("this comparison has no figures")]
 
 
 def layout(action: Action) -> html.Div:
-    """The page: the action's options as controls on the left, the table and the figure on the right."""
+    """The page: the action's options as controls on the left, the table and the figure on the right.
+
+    Parameters
+    ----------
+    action : Action
+        The ``align compare`` action (a choice: its options become the controls).
+    """
     return html.Div([
         html.Div([
             html.H1("Self-alignment methods compared"),
@@ -116,6 +146,11 @@ def show(typed: dict[str, str]) -> tuple[object, object, dict[str, str], str, li
     """What the page shows for a typed case: table, figures, messages per option, page message, notes.
 
     A wrong case leaves table and figures as they are (``no_update``).
+
+    Parameters
+    ----------
+    typed : dict of str to str
+        Option name -> the text typed in its field (display units), only for the fields the user changed.
     """
     parameters = compare_action().parameters
     _, errors = parse_typed(parameters, typed)
@@ -135,7 +170,13 @@ def show(typed: dict[str, str]) -> tuple[object, object, dict[str, str], str, li
 
 
 def register(app: Dash) -> None:
-    """The page's callback: check and run on every change, messages beside the options."""
+    """The page's callback: check and run on every change, messages beside the options.
+
+    Parameters
+    ----------
+    app : Dash
+        The lab's application (a choice: the callback is registered on it).
+    """
 
     @app.callback(
         Output("compare-methods", "children"),

@@ -247,7 +247,20 @@ def file_figures(system: System, result) -> list[tuple[str, str]]:
 
 
 def png_figures(write_files: Callable[[Any, Path], list[Path]], result) -> list[tuple[str, str]]:
-    """The PNG figures ``write_files`` draws of a result as (file name, data URI) pairs."""
+    """The PNG figures ``write_files`` draws of a result as (file name, data URI) pairs.
+
+    Parameters
+    ----------
+    write_files : callable
+        ``write_files(result, folder)`` -> the paths it wrote (a system's or an action's figure writer).
+    result : object
+        The result to draw (a choice of the writer: any result type it accepts).
+
+    Returns
+    -------
+    list of (str, str)
+        File name and ``data:image/png;base64`` URI of each PNG.
+    """
     with tempfile.TemporaryDirectory(prefix="schuler-lab-") as folder:
         paths = write_files(result, Path(folder))
         return [(path.name, "data:image/png;base64," + base64.b64encode(path.read_bytes()).decode("ascii"))
