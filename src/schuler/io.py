@@ -21,7 +21,7 @@ import tempfile
 from pathlib import Path
 
 PART_SUFFIX = ".part"
-"""Suffix of the temporary files (``.NAME.XXXXXXXX.part``) beside a target."""
+"""Suffix of the temporary files (``.NAME.<random letters>.part``) beside a target."""
 
 
 def _umask() -> int:
