@@ -30,6 +30,19 @@ ERROR = "param-error"
 def initial_text(parameter: Parameter) -> str:
     """The default as the input shows it: ``50``, ``0.0001``, ``full``; empty when not set.
 
+    Parameters
+    ----------
+    parameter : Parameter
+        The parameter whose default is shown (its ``default`` is in its display unit).
+
+    Returns
+    -------
+    str
+        The default as text in the display unit (12 significant digits for floats), ``true``/``false`` for a
+        flag, empty when the default is None.
+
+    Examples
+    --------
     >>> initial_text(Parameter("latitude", "deg", 50.0, "Latitude."))
     '50'
     >>> initial_text(Parameter("c_a", "1/s", None, "Gain."))
@@ -46,7 +59,18 @@ def initial_text(parameter: Parameter) -> str:
 
 
 def describe(parameter: Parameter) -> str:
-    """The line under a control: default and allowed range or choices."""
+    """The line under a control: default and allowed range or choices.
+
+    Parameters
+    ----------
+    parameter : Parameter
+        The parameter the control sets (default and bounds in its display unit).
+
+    Returns
+    -------
+    str
+        ``default ...; range ...`` (or ``one of ...`` for a choice, ``true or false`` for a flag).
+    """
     parts = [f"default {parameter.default_text()}"]
     if parameter.kind == "choice":
         parts.append("one of " + ", ".join(parameter.choices or ()))
@@ -58,11 +82,39 @@ def describe(parameter: Parameter) -> str:
 
 
 def unit_label(parameter: Parameter) -> str:
+    """The display unit written beside a control's name; empty for plain numbers and other kinds.
+
+    Parameters
+    ----------
+    parameter : Parameter
+        The parameter the control sets.
+
+    Returns
+    -------
+    str
+        Its display unit (``deg/h``) when it is a quantity with a unit, else empty.
+    """
     return parameter.unit if parameter.kind == "quantity" and parameter.unit else ""
 
 
 def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM) -> html.Div:
-    """One control: ``div[data-param=NAME]`` with label, ``<input>``, default and range, error line."""
+    """One control: ``div[data-param=NAME]`` with label, ``<input>``, default and range, error line.
+
+    Parameters
+    ----------
+    parameter : Parameter
+        The parameter the control sets.
+    value : str, optional
+        Text to show in the input instead of the default (as typed, display unit); None: the default.
+    id_type : str
+        Component-id type of the input (``{"type": id_type, "name": NAME}``); the message line's type is
+        ``param-error`` for the default, ``ID_TYPE-error`` otherwise, so that two pages' controls stay apart.
+
+    Returns
+    -------
+    dash.html.Div
+        ``div.control[data-param=NAME]`` holding label (with the display unit), input, hint and message line.
+    """
     name = parameter.name
     unit = unit_label(parameter)
     options = None
@@ -92,7 +144,22 @@ def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM
 
 def controls(parameters: Iterable[Parameter], id_type: str = PARAM, values: Mapping[str, str] | None = None
              ) -> list[html.Div]:
-    """A control per parameter; ``values`` are texts to start with instead of the defaults."""
+    """A control per parameter; ``values`` are texts to start with instead of the defaults.
+
+    Parameters
+    ----------
+    parameters : iterable of Parameter
+        The parameters to make controls for, in the order shown.
+    id_type : str
+        Component-id type of the inputs (see :func:`control`).
+    values : mapping of str to str, optional
+        Parameter name -> text to start with (as typed, display unit); names not in it show their default.
+
+    Returns
+    -------
+    list of dash.html.Div
+        One control per parameter.
+    """
     return [control(p, (values or {}).get(p.name), id_type=id_type) for p in parameters]
 
 
@@ -100,6 +167,20 @@ def typed_values(parameters: ParameterSet, ids: list[dict], values: list) -> dic
     """The values the user changed from the defaults shown, as typed (names of ``parameters`` only).
 
     An emptied field goes back to its default ("not set" where there is none).
+
+    Parameters
+    ----------
+    parameters : ParameterSet
+        The parameters the page shows; inputs naming any other parameter are ignored.
+    ids : list of dict
+        Component ids of the inputs (``{"type": ..., "name": NAME}``), as Dash passes them.
+    values : list
+        The inputs' current texts, in the order of ``ids`` (None for an input never filled).
+
+    Returns
+    -------
+    dict of str to str
+        Parameter name -> text as typed (display unit), only where it differs from the default shown.
     """
     typed: dict[str, str] = {}
     for ident, value in zip(ids, values):
@@ -119,6 +200,21 @@ def parse_typed(parameters: ParameterSet, typed: Mapping[str, str]) -> tuple[Cas
     message; then the set as a whole (options that exclude each other).
     Messages name the option as the command line does (``--latitude: '95' is
     outside (-90, 90) deg``).
+
+    Parameters
+    ----------
+    parameters : ParameterSet
+        The parameters of the system or command the page runs.
+    typed : mapping of str to str
+        Parameter name -> text as typed (a number in the parameter's display unit, or a value with its unit);
+        parameters not in it take their default.
+
+    Returns
+    -------
+    case : Case or None
+        The parsed case, values in SI (rad, rad/s, s, ...); None when any value is wrong.
+    errors : dict of str to str
+        Parameter name -> its one-line message naming the option; empty when the case parsed.
 
     Examples
     --------
@@ -162,6 +258,21 @@ def error_owner(parameters: ParameterSet, error: SchulerError) -> tuple[str | No
 
     An error naming a parameter (``latitude: ...``) goes beside that control and
     names its option (``--latitude: ...``); any other goes to the page (None).
+
+    Parameters
+    ----------
+    parameters : ParameterSet
+        The parameters of the page, whose controls may own the message.
+    error : SchulerError
+        The error the run raised (its ``name`` and ``reason`` when it has them, else its text
+        ``NAME: REASON``).
+
+    Returns
+    -------
+    owner : str or None
+        Name of the parameter whose control shows the message; None for the page.
+    message : str
+        The message, naming the option (``--latitude: ...``) when it has an owner.
     """
     name = getattr(error, "name", None)
     reason = getattr(error, "reason", None)

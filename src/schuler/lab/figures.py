@@ -47,6 +47,20 @@ DASHES = ("solid", "dash", "dot")
 def thin(*arrays: np.ndarray, limit: int = MAX_POINTS) -> list[np.ndarray]:
     """Every k-th point of equally long arrays so that at most ``limit`` remain (the last kept).
 
+    Parameters
+    ----------
+    *arrays : array_like
+        Equally long 1-D arrays (a trace's x and y values, any unit: only points are dropped).
+    limit : int
+        Largest number of points to keep, at least 2.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        The arrays thinned alike; the arrays themselves when they hold ``limit`` points or fewer.
+
+    Examples
+    --------
     >>> [a.tolist() for a in thin(np.arange(10), limit=4)]
     [[0, 3, 6, 9]]
     """
@@ -98,13 +112,38 @@ def _level(value: float, row: int, label: str, color: str = "black") -> tuple[di
 
 
 def shown_window(run) -> np.ndarray:
-    """The part of a run a history figure shows: a few settling times, at least the first 10 points."""
+    """The part of a run a history figure shows: a few settling times, at least the first 10 points.
+
+    Parameters
+    ----------
+    run : CaseRun
+        A gyrocompassing run: ``time`` in s and ``analytic["settling_time_s"]``, the analytic settling time, s.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        Mask over ``run.time``: True up to ``SETTLING_TIMES_SHOWN`` settling times (and at least samples 0 to 10).
+    """
     end = max(SETTLING_TIMES_SHOWN * run.analytic["settling_time_s"], run.time[min(10, run.time.size - 1)])
     return run.time <= end
 
 
 def time_history(runs: dict, title: str = "Azimuth and level errors (Fig. 1.4)") -> dict:
-    """delta [arcmin] and beta [arcsec] against time [min] for runs (label -> CaseRun), delta_y dotted."""
+    """delta [arcmin] and beta [arcsec] against time [min] for runs (label -> CaseRun), delta_y dotted.
+
+    Parameters
+    ----------
+    runs : dict of str to CaseRun
+        Legend label -> run (histories in SI: ``time`` s, ``delta`` and ``beta`` rad); the first run's
+        ``analytic["azimuth_error_analytic_rad"]`` (rad) is drawn as the dotted steady-state line.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    dict
+        A plotly figure (plain dict): delta in arcmin above beta in arcsec, against time in minutes.
+    """
     traces = []
     for number, (label, run) in enumerate(runs.items()):
         window = shown_window(run)
@@ -119,7 +158,21 @@ def time_history(runs: dict, title: str = "Azimuth and level errors (Fig. 1.4)")
 
 
 def phase_trajectory(runs: dict, title: str = "Phase trajectory in the (delta, beta) plane (task 5)") -> dict:
-    """The platform's path in the (delta [arcmin], beta [arcsec]) plane, start marked, steady state starred."""
+    """The platform's path in the (delta [arcmin], beta [arcsec]) plane, start marked, steady state starred.
+
+    Parameters
+    ----------
+    runs : dict of str to CaseRun
+        Legend label -> run (``delta`` and ``beta`` in rad); the first run's analytic steady state
+        (``azimuth_error_analytic_rad`` and ``level_error_beta_analytic_rad``, rad) is starred.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    dict
+        A plotly figure (plain dict): beta in arcsec against delta in arcmin.
+    """
     traces = []
     for number, (label, run) in enumerate(runs.items()):
         window = shown_window(run)  # past a few settling times the path sits on the steady point
@@ -135,7 +188,21 @@ def phase_trajectory(runs: dict, title: str = "Phase trajectory in the (delta, b
 
 
 def level_angles(run, title: str = "Level errors in mu, nu and in beta, alpha (task 3)") -> dict:
-    """mu, nu (platform axes, (1.17)) and beta, alpha (geographic, (1.18)) [arcsec] against time [min]."""
+    """mu, nu (platform axes, (1.17)) and beta, alpha (geographic, (1.18)) [arcsec] against time [min].
+
+    Parameters
+    ----------
+    run : CaseRun
+        A run of the full model (1.17): ``time`` in s, ``mu``, ``nu``, ``beta``, ``alpha`` in rad (a history
+        that is None is left out).
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    dict
+        A plotly figure (plain dict) of two rows: mu, nu above beta, alpha, in arcsec against time in minutes.
+    """
     window = shown_window(run)
     minutes = run.time[window] / 60.0
     traces = []
@@ -157,6 +224,27 @@ def sweep_curves(x, x_label: str, columns: dict, constraints, title: str = "Accu
     optionally ``simplified_azimuth_error_arcmin``. ``constraints``: (output key,
     symbol, limit, unit) of each constraint; a ratio of 1 or more is a violation
     (drawn red).
+
+    Parameters
+    ----------
+    x : array_like
+        Values of the swept parameter, shape (N,), in its display unit (as ``x_label`` states).
+    x_label : str
+        Title of the x axis, with the unit (``latitude (deg)``).
+    columns : dict of str to numpy.ndarray
+        Column name -> values, shape (N,) each: the display-unit columns above (arcmin, s) and the
+        constraints' maxima in SI (rad, rad/s).
+    constraints : iterable of (str, str, float, str)
+        Per constraint: key of its maximum in ``columns``, symbol, limit (SI, in the unit given next) and
+        unit.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    dict
+        A plotly figure (plain dict) of three rows: azimuth error in arcmin, settling time in s, and
+        maximum / limit (a plain ratio, log axis).
     """
     open_circle = {"symbol": "circle-open", "size": 8}
     traces = [_line(x, columns["azimuth_error_analytic_arcmin"], "analytic (1.21)"),
@@ -185,7 +273,18 @@ GRAPH = "lab-graph"
 
 
 def empty(note: str) -> dict:
-    """A figure with nothing drawn but a note (before the first run, or when a run has no histories)."""
+    """A figure with nothing drawn but a note (before the first run, or when a run has no histories).
+
+    Parameters
+    ----------
+    note : str
+        The text shown in the middle of the figure.
+
+    Returns
+    -------
+    dict
+        A plotly figure (plain dict) with hidden axes.
+    """
     return {"data": [], "layout": {"height": 200, "template": "plotly_white", "xaxis": {"visible": False},
                                    "yaxis": {"visible": False},
                                    "annotations": [{"text": note, "showarrow": False, "font": {"size": 14}}]}}
@@ -197,6 +296,22 @@ def block(stem: str, fig: dict, csv: bool = False, graph_id: dict | None = None)
     The CSV button (``{"type": "csv-export", "figure": stem}``) needs a
     callback of the page that knows the figure's data. ``graph_id`` gives the
     graph an id, so that a callback can replace its figure in place.
+
+    Parameters
+    ----------
+    stem : str
+        The figure's name (``data-figure`` attribute, export file name and button ids).
+    fig : dict
+        The plotly figure (plain dict).
+    csv : bool
+        Whether to add the CSV button and its download component.
+    graph_id : dict, optional
+        Component id of the graph; None: no id.
+
+    Returns
+    -------
+    dash.html.Div
+        ``div.figure[data-figure=STEM]`` with the graph and its export buttons.
     """
     buttons: list[Any] = [html.Button(fmt.upper(), id={"type": "image-export", "figure": stem, "format": fmt},
                            className="export", title=f"save the figure as {fmt.upper()}") for fmt in ("png", "svg")]
@@ -232,17 +347,54 @@ INTERACTIVE = {"align": Interactive(("align_time_history", "align_phase_trajecto
 
 
 def interactive_stems(system: System) -> tuple[str, ...]:
-    """Names of the interactive figures of a system's page (empty: it shows its own files' figures)."""
+    """Names of the interactive figures of a system's page (empty: it shows its own files' figures).
+
+    Parameters
+    ----------
+    system : System
+        The system whose page is drawn.
+
+    Returns
+    -------
+    tuple of str
+        The figures' names, in the order :func:`interactive_figures` builds them.
+    """
     return INTERACTIVE[system.name].stems if system.name in INTERACTIVE else ()
 
 
 def interactive_figures(system: System, result) -> list[dict] | None:
-    """The interactive figures of a result (in the order of :func:`interactive_stems`), or None."""
+    """The interactive figures of a result (in the order of :func:`interactive_stems`), or None.
+
+    Parameters
+    ----------
+    system : System
+        The system that computed ``result``.
+    result : object
+        What the system's ``run`` returned (for ``align``: an ``AlignmentResult``).
+
+    Returns
+    -------
+    list of dict or None
+        Plotly figures (plain dicts); None when the lab draws no interactive figures of this system.
+    """
     return INTERACTIVE[system.name].build(result) if system.name in INTERACTIVE else None
 
 
 def file_figures(system: System, result) -> list[tuple[str, str]]:
-    """The system's own PNG figures of a result as (file name, data URI) pairs."""
+    """The system's own PNG figures of a result as (file name, data URI) pairs.
+
+    Parameters
+    ----------
+    system : System
+        The system that computed ``result`` (its ``write_files`` draws the figures).
+    result : object
+        What the system's ``run`` returned.
+
+    Returns
+    -------
+    list of (str, str)
+        File name and ``data:image/png;base64`` URI of each PNG.
+    """
     return png_figures(system.write_files, result)
 
 

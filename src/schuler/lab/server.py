@@ -26,6 +26,19 @@ LOCAL_NAMES = frozenset({"localhost", "localhost.localdomain", "ip6-localhost"})
 def is_loopback(host: str) -> bool:
     """Whether ``host`` is a loopback address (127.0.0.0/8, ::1) or a name for it.
 
+    Parameters
+    ----------
+    host : str
+        An IPv4 or IPv6 address (brackets allowed) or a host name; names other than ``localhost`` and its
+        aliases are not resolved and count as not loopback.
+
+    Returns
+    -------
+    bool
+        True for 127.0.0.0/8, ::1 and the local names.
+
+    Examples
+    --------
     >>> is_loopback("127.0.0.1"), is_loopback("::1"), is_loopback("localhost"), is_loopback("0.0.0.0")
     (True, True, True, False)
     """
@@ -40,6 +53,18 @@ def is_loopback(host: str) -> bool:
 
 def check_host(host: str, allow_remote: bool = False) -> str:
     """The host to listen on; refuses a non-loopback one unless ``allow_remote``.
+
+    Parameters
+    ----------
+    host : str
+        The address or name given with ``--host``.
+    allow_remote : bool
+        Whether ``--allow-remote`` was given (any address is then accepted).
+
+    Returns
+    -------
+    str
+        ``host`` without surrounding blanks.
 
     Raises
     ------
@@ -69,6 +94,23 @@ it listens only on this machine (127.0.0.1, ::1, localhost) unless --allow-remot
 def check_port(port: int) -> int:
     """A TCP port number, 0 (any free port) to 65535.
 
+    Parameters
+    ----------
+    port : int
+        TCP port given with ``--port``, a plain number from 0 to 65535 (0: the system picks a free port).
+
+    Returns
+    -------
+    int
+        ``port`` itself.
+
+    Raises
+    ------
+    InvalidParameter
+        ``port`` is not an integer (a bool is not) or is outside [0, 65535].
+
+    Examples
+    --------
     >>> check_port(8050)
     8050
     """
@@ -80,6 +122,20 @@ def check_port(port: int) -> int:
 def url_of(host: str, port: int) -> str:
     """The URL people open: ``http://127.0.0.1:8050/`` (IPv6 in brackets).
 
+    Parameters
+    ----------
+    host : str
+        The address the lab listens on (``0.0.0.0`` and empty are shown as 127.0.0.1, ``::`` as localhost).
+    port : int
+        TCP port, a plain number from 0 to 65535.
+
+    Returns
+    -------
+    str
+        ``http://HOST:PORT/``.
+
+    Examples
+    --------
     >>> url_of("::1", 8050), url_of("0.0.0.0", 80)
     ('http://[::1]:8050/', 'http://127.0.0.1:80/')
     """
@@ -95,6 +151,23 @@ def listen(host: str, port: int) -> socket.socket:
     Bound here, before the application is built, so that a port in use is
     reported at once and in one line (the HTTP server would print several and
     exit by itself).
+
+    Parameters
+    ----------
+    host : str
+        Address to bind (IPv6 with or without brackets), as :func:`check_host` returned it.
+    port : int
+        TCP port, a plain number from 0 to 65535 (0: the system picks a free one).
+
+    Returns
+    -------
+    socket.socket
+        A bound socket listening with a backlog of 64 connections.
+
+    Raises
+    ------
+    InvalidParameter
+        The address cannot be bound (port in use, address not of this machine, no permission).
     """
     address = host.strip("[]")
     family = socket.AF_INET6 if ":" in address else socket.AF_INET
@@ -167,6 +240,16 @@ def serve_until_signal(server: LabServer) -> str:
 
     Both signals end :meth:`LabServer.serve` the same way (the socket is closed,
     ``on_stop`` runs); the previous handlers are restored afterwards.
+
+    Parameters
+    ----------
+    server : LabServer
+        The server to run (its ``serve`` blocks until stopped).
+
+    Returns
+    -------
+    str
+        ``"Ctrl-C"`` or ``"SIGTERM"``; ``"shutdown"`` when the server stopped for another reason.
     """
     received: list[str] = []
 

@@ -38,7 +38,19 @@ ACTION_PAGES = {"align": {"compare": "Every self-alignment method on the same da
 
 
 def page_parameters(system: System) -> ParameterSet:
-    """The page's controls: the system's parameters, ``monte_carlo``, ``seed`` and ``fidelity`` where offered."""
+    """The page's controls: the system's parameters, ``monte_carlo``, ``seed`` and ``fidelity`` where offered.
+
+    Parameters
+    ----------
+    system : System
+        The system the page shows.
+
+    Returns
+    -------
+    ParameterSet
+        The system's parameters followed by ``monte_carlo`` and ``seed`` (and ``fidelity``, a choice of the
+        system's fidelities, the first being the default, when it offers any).
+    """
     extra = list(RUN_OPTIONS)
     if system.fidelities:
         extra.append(Parameter("fidelity", "", system.fidelities[0],
@@ -48,7 +60,29 @@ def page_parameters(system: System) -> ParameterSet:
 
 
 def run_typed(system: System, typed: dict[str, str], progress=None):
-    """Run the case the user typed (values parsed as the command line parses them)."""
+    """Run the case the user typed (values parsed as the command line parses them).
+
+    Parameters
+    ----------
+    system : System
+        The system to run.
+    typed : dict of str to str
+        Parameter name -> the text typed in its field (a number in the parameter's display unit, or a value
+        with a unit), only for the fields the user changed; may include ``monte_carlo``, ``seed``,
+        ``fidelity``.
+    progress : callable, optional
+        ``progress(done, total)``, called as Monte Carlo members finish (members, number of).
+
+    Returns
+    -------
+    object
+        What ``system.run`` returns for the case (the system's result type).
+
+    Raises
+    ------
+    SchulerError
+        A typed value does not parse (the first message), or the run refuses the case.
+    """
     parameters = page_parameters(system)
     case, errors = parse_typed(parameters, typed)
     if case is None:
@@ -59,7 +93,18 @@ def run_typed(system: System, typed: dict[str, str], progress=None):
 
 
 def layout(system: System) -> html.Div:
-    """The page of one system: controls on the left, status, headline numbers and figures on the right."""
+    """The page of one system: controls on the left, status, headline numbers and figures on the right.
+
+    Parameters
+    ----------
+    system : System
+        The system the page shows (its parameters become the controls).
+
+    Returns
+    -------
+    dash.html.Div
+        The page's component tree.
+    """
     name = system.name
     return html.Div([
         dcc.Store(id="system-name", data=name),
@@ -102,6 +147,18 @@ def layout(system: System) -> html.Div:
 
 
 def reproduction_layout(system: System) -> html.Div:
+    """The reproduction page of one system: the table its ``reproduce`` computes, filled in by a background job.
+
+    Parameters
+    ----------
+    system : System
+        The system whose reproduction table is shown.
+
+    Returns
+    -------
+    dash.html.Div
+        The page's component tree (the table's place is empty until the job ends).
+    """
     return html.Div([
         dcc.Store(id="reproduction-system", data=system.name),
         html.H1(f"{system.title}: reproduction"),
@@ -112,7 +169,13 @@ def reproduction_layout(system: System) -> html.Div:
 
 
 def register(app: Dash) -> None:
-    """The callbacks of every system page (one set: the page says which system it shows)."""
+    """The callbacks of every system page (one set: the page says which system it shows).
+
+    Parameters
+    ----------
+    app : Dash
+        The lab's application, on which the callbacks are registered (it needs a background callback manager).
+    """
 
     @app.callback(
         Output({"type": ERROR, "name": ALL}, "children"),
@@ -249,17 +312,52 @@ def register(app: Dash) -> None:
 
 
 def internal_error(error: Exception) -> str:
-    """The one line a page shows for an unexpected failure (the server's log has the traceback)."""
+    """The one line a page shows for an unexpected failure (the server's log has the traceback).
+
+    Parameters
+    ----------
+    error : Exception
+        The unexpected exception.
+
+    Returns
+    -------
+    str
+        ``internal error: TYPE: MESSAGE``, cut at the message's first line break.
+    """
     return f"internal error: {type(error).__name__}: {error}".splitlines()[0]
 
 
 def notes(caught) -> list:
-    """Warnings raised during a computation, one line each (the command line prints them on stderr)."""
+    """Warnings raised during a computation, one line each (the command line prints them on stderr).
+
+    Parameters
+    ----------
+    caught : iterable of warnings.WarningMessage
+        The warnings recorded by ``warnings.catch_warnings(record=True)``.
+
+    Returns
+    -------
+    list of dash.html.P
+        One ``p.warning`` per warning.
+    """
     return [html.P(f"warning: {w.message}", className="warning") for w in caught]
 
 
 def files_archive(system: System, result) -> bytes:
-    """The system's files of a result (figures as PNG and SVG, data as CSV) in one zip archive."""
+    """The system's files of a result (figures as PNG and SVG, data as CSV) in one zip archive.
+
+    Parameters
+    ----------
+    system : System
+        The system that computed ``result`` (its ``write_files`` writes the files).
+    result : object
+        What the system's ``run`` returned.
+
+    Returns
+    -------
+    bytes
+        The zip archive (deflated), one entry per file written, by file name.
+    """
     buffer = io.BytesIO()
     with tempfile.TemporaryDirectory(prefix="schuler-lab-") as folder:
         paths = system.write_files(result, Path(folder))

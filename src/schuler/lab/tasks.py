@@ -81,7 +81,21 @@ class TaskView:
 
 
 def layout(system: System, page: str) -> html.Div:
-    """The guided page of one task."""
+    """The guided page of one task.
+
+    Parameters
+    ----------
+    system : System
+        The ``align`` system (its parameters become the controls).
+    page : {"task1", "task2", "task3", "task5"}
+        Which task's page.
+
+    Returns
+    -------
+    dash.html.Div
+        The page's component tree: the task's text and questions, the controls (with the sweep's for tasks 1
+        and 2) starting from :data:`STARTING_CASE`, and the places of tables and figures.
+    """
     number = PAGES[page]
     sweeps = number in (1, 2)
     questions = [html.Li([html.Span(manual.QUESTIONS[q], className="question"),
@@ -111,7 +125,29 @@ def layout(system: System, page: str) -> html.Div:
 
 
 def sweep_values(system: System, sweep_typed: dict[str, str]) -> tuple[str, np.ndarray]:
-    """The swept parameter and its SI values; ends parsed by that parameter (its range and unit)."""
+    """The swept parameter and its SI values; ends parsed by that parameter (its range and unit).
+
+    Parameters
+    ----------
+    system : System
+        The ``align`` system (the swept parameter's unit and range are its own).
+    sweep_typed : dict of str to str
+        The sweep controls' texts as typed: ``sweep`` (the parameter's name), ``sweep_from`` and ``sweep_to``
+        (in that parameter's display unit, or with a unit), ``sweep_points`` (cases, number of); a missing end
+        takes the parameter's range in :data:`SWEEP_RANGES`.
+
+    Returns
+    -------
+    name : str
+        The swept parameter.
+    values : numpy.ndarray
+        Its values, evenly spaced from first to last end, in SI (rad, rad/s, ...), shape (sweep_points,).
+
+    Raises
+    ------
+    SchulerError
+        A sweep control does not parse, or an end is outside the parameter's range.
+    """
     case, errors = parse_typed(SWEEP, sweep_typed)
     if case is None:
         raise SchulerError(next(iter(errors.values())))
@@ -129,6 +165,28 @@ def sweep_table(system: System, values: dict, name: str, x: np.ndarray, progress
 
     ``models`` adds the simulated azimuth error of other models (column
     ``<model>_azimuth_error_arcmin``).
+
+    Parameters
+    ----------
+    system : System
+        The ``align`` system.
+    values : dict
+        The case's other parameters, by name, in SI (as a parsed case holds them).
+    name : str
+        The swept parameter.
+    x : numpy.ndarray
+        Its values, shape (N,), SI.
+    progress : callable, optional
+        ``progress(done, total)``, called after each chunk of :data:`SWEEP_CHUNK` cases (cases, number of).
+    models : tuple of str
+        Other models whose simulated azimuth error is added (``"simplified"``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per value of ``x``: first the swept parameter in its display unit (column ``NAME (UNIT)``),
+        then azimuth and level errors in arcmin (the full-minus-simplified difference in arcsec), settling
+        times in s, the constraints' maxima in SI (rad, rad/s) and ``constraints_ok``.
     """
     outputs: dict[str, list] = {}
     extra: dict[str, list] = {model: [] for model in models}
@@ -160,7 +218,19 @@ def sweep_table(system: System, values: dict, name: str, x: np.ndarray, progress
 
 
 def history_table(run) -> pd.DataFrame:
-    """A run's histories in display units (arcmin for delta, arcsec for the level errors)."""
+    """A run's histories in display units (arcmin for delta, arcsec for the level errors).
+
+    Parameters
+    ----------
+    run : CaseRun
+        A gyrocompassing run (histories in SI: ``time`` s, angles rad, ``delta_rate`` rad/s).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``t_s`` (s), ``delta_arcmin``, ``beta_arcsec`` (and ``alpha_arcsec``, ``mu_arcsec``,
+        ``nu_arcsec`` where the run has them) and ``delta_rate_rad_s`` (rad/s).
+    """
     table = {"t_s": run.time, "delta_arcmin": to_unit(run.delta, "arcmin"), "beta_arcsec": to_unit(run.beta, "arcsec")}
     for name in ("alpha", "mu", "nu"):
         if getattr(run, name) is not None:
@@ -170,7 +240,19 @@ def history_table(run) -> pd.DataFrame:
 
 
 def constraint_panel(result) -> html.Table:
-    """The three constraints of the case: largest value over the run, limit, and whether it holds."""
+    """The three constraints of the case: largest value over the run, limit, and whether it holds.
+
+    Parameters
+    ----------
+    result : AlignmentResult
+        The ``align`` run's result; its ``max_abs_delta_rad``, ``max_abs_beta_rad`` (rad) and
+        ``max_abs_delta_rate_rad_s`` (rad/s) are compared with the limits of :data:`CONSTRAINTS`.
+
+    Returns
+    -------
+    dash.html.Table
+        One row per constraint, with ``data-constraint`` naming it.
+    """
     rows = []
     for key, symbol, limit, unit in CONSTRAINTS:
         value = getattr(result, key)
@@ -186,7 +268,19 @@ def constraint_panel(result) -> html.Table:
 
 
 def sweep_violations(table: pd.DataFrame) -> list[str]:
-    """One line per constraint that some case of a sweep breaks, naming those cases."""
+    """One line per constraint that some case of a sweep breaks, naming those cases.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A sweep as :func:`sweep_table` returns it (first column the swept parameter in its display unit,
+        constraints' maxima in SI).
+
+    Returns
+    -------
+    list of str
+        One line per constraint broken, naming up to 8 of the swept values (display unit) where it is.
+    """
     x_column = table.columns[0]
     lines = []
     for key, symbol, limit, unit in CONSTRAINTS:
@@ -198,7 +292,31 @@ def sweep_violations(table: pd.DataFrame) -> list[str]:
 
 
 def compute(system: System, page: str, typed: dict[str, str], sweep_typed: dict[str, str], progress=None) -> TaskView:
-    """Everything a task page shows for the typed case (and sweep)."""
+    """Everything a task page shows for the typed case (and sweep).
+
+    Parameters
+    ----------
+    system : System
+        The ``align`` system.
+    page : {"task1", "task2", "task3", "task5"}
+        Which task's page.
+    typed : dict of str to str
+        Parameter name -> the text typed (display unit, or a value with a unit), only for fields changed.
+    sweep_typed : dict of str to str
+        The sweep controls' texts (see :func:`sweep_values`); used by tasks 1 and 2 only.
+    progress : callable, optional
+        ``progress(done, total)`` during the sweep (cases, number of).
+
+    Returns
+    -------
+    TaskView
+        Tables, figures (each with its data as a table in display units) and notes (warnings, violations).
+
+    Raises
+    ------
+    SchulerError
+        A typed value does not parse, or the run refuses the case.
+    """
     number = PAGES[page]
     case, errors = parse_typed(system.parameters, typed)
     if case is None:
@@ -238,7 +356,28 @@ def compute(system: System, page: str, typed: dict[str, str], sweep_typed: dict[
 
 
 def wanted_case(values, sweep_texts, ids, sweep_ids) -> tuple[dict, dict[str, str], dict[str, str]]:
-    """The values typed on a task page ({"case": ..., "sweep": ...}) and the messages of the wrong ones."""
+    """The values typed on a task page ({"case": ..., "sweep": ...}) and the messages of the wrong ones.
+
+    Parameters
+    ----------
+    values : list
+        The case controls' texts, in the order of ``ids`` (None for a field never filled).
+    sweep_texts : list
+        The sweep controls' texts, in the order of ``sweep_ids``.
+    ids : list of dict
+        Component ids of the case controls (``{"type": ..., "name": NAME}``).
+    sweep_ids : list of dict
+        Component ids of the sweep controls (empty on pages without a sweep).
+
+    Returns
+    -------
+    wanted : dict
+        ``{"case": typed, "sweep": sweep_typed}``: name -> text as typed (display units).
+    errors : dict of str to str
+        Case parameter name -> its one-line message.
+    sweep_errors : dict of str to str
+        Sweep control name -> its one-line message.
+    """
     system = get_system("align")
     typed = typed_values(system.parameters, ids, values)
     sweep_typed = {i["name"]: str(v) for i, v in zip(sweep_ids, sweep_texts) if v not in (None, "")}
@@ -254,7 +393,13 @@ def wanted_case(values, sweep_texts, ids, sweep_ids) -> tuple[dict, dict[str, st
 
 
 def register(app: Dash) -> None:
-    """The callbacks of the task pages."""
+    """The callbacks of the task pages.
+
+    Parameters
+    ----------
+    app : Dash
+        The lab's application, on which the callbacks are registered (it needs a background callback manager).
+    """
 
     @app.callback(
         Output({"type": f"{TASK_PARAM}-error", "name": ALL}, "children"),

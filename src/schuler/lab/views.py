@@ -22,6 +22,19 @@ from schuler.units import to_unit
 def number_text(value: float) -> str:
     """A number for people: 4 significant digits (no trailing zeros), whole numbers below 10^6 in full.
 
+    Parameters
+    ----------
+    value : float
+        The number, already in the unit it is shown in (any unit: only its digits are chosen here).
+
+    Returns
+    -------
+    str
+        ``inf``/``-inf`` for infinities, ``0`` for zero (also -0.0), fixed-point with 4 significant digits
+        from 0.001 up to 10^6, otherwise ``%.4g``.
+
+    Examples
+    --------
     >>> number_text(3.55583), number_text(0.0533333), number_text(10800.0), number_text(1.2345e-7)
     ('3.556', '0.05333', '10800', '1.234e-07')
     >>> number_text(-0.0), number_text(float("inf")), number_text(30.0), number_text(0.8)
@@ -43,6 +56,20 @@ def number_text(value: float) -> str:
 def quantity_text(value_si, output: Output) -> str:
     """An output's value in its display unit: ``3.556 arcmin``; ``-`` when not computed.
 
+    Parameters
+    ----------
+    value_si : float or None
+        The output's value in its SI unit (``output.unit``: rad, s, ...); None or NaN: not computed.
+    output : Output
+        The output declaration (its ``display`` unit is the one shown; empty: the SI unit).
+
+    Returns
+    -------
+    str
+        The number (see :func:`number_text`) and the shown unit, or ``-``.
+
+    Examples
+    --------
     >>> quantity_text(1.0343e-3, Output("azimuth_error_rad", "rad", "arcmin"))
     '3.556 arcmin'
     >>> quantity_text(None, Output("settling_time_s", "s")), quantity_text(True, Output("constraints_ok", "1"))
@@ -59,7 +86,18 @@ def quantity_text(value_si, output: Output) -> str:
 
 
 def data_attributes(**values) -> dict[str, Any]:
-    """``data-*`` attributes for a Dash component: ``data_attributes(param="x")`` -> ``{"data-param": "x"}``."""
+    """``data-*`` attributes for a Dash component: ``data_attributes(param="x")`` -> ``{"data-param": "x"}``.
+
+    Parameters
+    ----------
+    **values
+        Attribute name (underscores become hyphens) -> value.
+
+    Returns
+    -------
+    dict of str to object
+        ``data-NAME`` -> value, to be passed to a component as keyword arguments.
+    """
     return {f"data-{key.replace('_', '-')}": value for key, value in values.items()}
 
 
@@ -71,6 +109,20 @@ def headline(system: System, values: Mapping[str, object], with_ids: bool = Fals
     """The system's outputs as a table of ``data-result`` numbers (values: SI, keyed as in ``to_dict``).
 
     ``with_ids`` gives each number an id, so that a callback can replace its text in place.
+
+    Parameters
+    ----------
+    system : System
+        The system whose declared outputs are the rows.
+    values : mapping of str to object
+        Output name -> value in SI (the output's ``unit``: rad, s, ...); a missing output shows ``-``.
+    with_ids : bool
+        Whether each number gets the id ``{"type": RESULT, "key": NAME}``.
+
+    Returns
+    -------
+    dash.html.Table
+        One row per output: description, number with its display unit, key.
     """
     rows = []
     for output in system.outputs:
@@ -85,12 +137,42 @@ def headline(system: System, values: Mapping[str, object], with_ids: bool = Fals
 
 
 def headline_texts(system: System, values: Mapping[str, object]) -> list[str]:
-    """The texts of :func:`headline`'s numbers, in the order of the system's outputs."""
+    """The texts of :func:`headline`'s numbers, in the order of the system's outputs.
+
+    Parameters
+    ----------
+    system : System
+        The system whose declared outputs are shown.
+    values : mapping of str to object
+        Output name -> value in SI (the output's ``unit``); a missing output gives ``-``.
+
+    Returns
+    -------
+    list of str
+        Number and display unit per output (see :func:`quantity_text`).
+    """
     return [quantity_text(values.get(output.name), output) for output in system.outputs]
 
 
 def monte_carlo_table(system: System, statistics: Mapping[str, Mapping[str, float | None]], members: int) -> html.Div:
-    """Mean, standard deviation and 5 %/95 % points of every output over the members (display units)."""
+    """Mean, standard deviation and 5 %/95 % points of every output over the members (display units).
+
+    Parameters
+    ----------
+    system : System
+        The system whose declared outputs are the rows.
+    statistics : mapping of str to mapping of str to float
+        Output name -> its statistics over the members in SI (the output's ``unit``): ``mean``, ``std``,
+        ``p05``, ``p95``, ``min``, ``max`` (None where not computed). Outputs whose ``min`` equals their
+        ``max`` (no spread) are left out.
+    members : int
+        Monte Carlo members, number of (shown in the heading).
+
+    Returns
+    -------
+    dash.html.Div
+        A heading and a table of the statistics in each output's display unit.
+    """
     header = html.Tr([html.Th("output")] + [html.Th(h) for h in ("mean", "std", "p05", "p95")])
     rows = []
     for output in system.outputs:
@@ -108,7 +190,19 @@ def monte_carlo_table(system: System, statistics: Mapping[str, Mapping[str, floa
 
 
 def reproduction_table(reproduction: Reproduction) -> html.Div:
-    """The source's printed values beside the computed ones, with verdicts, constants and notes."""
+    """The source's printed values beside the computed ones, with verdicts, constants and notes.
+
+    Parameters
+    ----------
+    reproduction : Reproduction
+        A system's reproduction of its source's published case (each row's printed and computed values are
+        in the row's own ``unit``).
+
+    Returns
+    -------
+    dash.html.Div
+        Source, constants, the table (one row per printed number) and the notes.
+    """
     headings = ("quantity", "printed", "where", "computed", "unit", "verdict", "note")
     rows = [html.Tr([
         html.Td(row.quantity), html.Td(row.printed or "-", className="number"), html.Td(row.where),
