@@ -19,6 +19,20 @@ class InProcess:
     name = "in-process"
 
     def map(self, function, tasks: Iterable) -> Iterator:
+        """Results of ``function`` on each task, in the order of the tasks (each computed when asked for).
+
+        Parameters
+        ----------
+        function : callable
+            ``function(task)`` -> the task's result (a sweep chunk's evaluation).
+        tasks : iterable
+            The tasks (sweep chunks), consumed lazily.
+
+        Returns
+        -------
+        iterator
+            The results, one per task.
+        """
         for task in tasks:
             yield function(task)
 
@@ -38,6 +52,20 @@ class LocalProcesses:
         self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
 
     def map(self, function, tasks: Iterable) -> Iterator:
+        """Results of ``function`` on each task as they complete (any order), twice ``workers`` tasks in flight.
+
+        Parameters
+        ----------
+        function : callable
+            ``function(task)`` -> the task's result; it and the tasks must pickle (spawned processes).
+        tasks : iterable
+            The tasks (sweep chunks), consumed as room frees up.
+
+        Returns
+        -------
+        iterator
+            The results, one per task, in order of completion.
+        """
         yield from _windowed(lambda task: self.pool.submit(function, task), tasks, 2 * self.workers, _wait_futures)
 
     def close(self) -> None:
@@ -73,6 +101,20 @@ class DaskCluster:
             raise ScenarioError(f"--scheduler: {scheduler!r} is neither 'local' nor an address like tcp://HOST:8786")
 
     def map(self, function, tasks: Iterable) -> Iterator:
+        """Results of ``function`` on each task as they complete (any order), twice the cluster's threads in flight.
+
+        Parameters
+        ----------
+        function : callable
+            ``function(task)`` -> the task's result; it and the tasks must pickle (sent to the workers).
+        tasks : iterable
+            The tasks (sweep chunks), consumed as room frees up.
+
+        Returns
+        -------
+        iterator
+            The results, one per task, in order of completion (each released on the cluster once fetched).
+        """
         from distributed import as_completed
 
         threads = max(1, sum(self.client.nthreads().values()))
@@ -116,7 +158,26 @@ def _windowed(submit, tasks: Iterable, window: int, next_done) -> Iterator:
 
 
 def make_executor(scheduler: str | None = None, workers: int | None = None):
-    """In-process (default), local processes (``workers`` > 1) or Dask (``scheduler``)."""
+    """In-process (default), local processes (``workers`` > 1) or Dask (``scheduler``).
+
+    Parameters
+    ----------
+    scheduler : str, optional
+        ``"local"`` (a Dask LocalCluster started here) or a Dask scheduler's address (``tcp://HOST:8786``);
+        None: no Dask.
+    workers : int, optional
+        Worker processes, number of, at least 1 (for a local Dask cluster: its workers, default 2).
+
+    Returns
+    -------
+    InProcess or LocalProcesses or DaskCluster
+        The executor; close it with ``close()`` when done.
+
+    Raises
+    ------
+    ScenarioError
+        ``workers`` below 1, Dask missing, or a scheduler that is neither ``local`` nor reachable.
+    """
     if workers is not None and workers < 1:
         raise ScenarioError(f"--workers: {workers} must be at least 1")
     if scheduler:

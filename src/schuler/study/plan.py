@@ -91,12 +91,34 @@ class SweepPlan:
         return -(-self.total // self.chunk_size)
 
     def chunk_range(self, index: int) -> tuple[int, int]:
-        """First case and one past the last case of chunk ``index``."""
+        """First case and one past the last case of chunk ``index``.
+
+        Parameters
+        ----------
+        index : int
+            Chunk index, 0 to ``chunks - 1``.
+
+        Returns
+        -------
+        start, stop : int
+            Case numbers (indices): chunk ``index`` holds cases ``start .. stop-1``.
+        """
         start = index * self.chunk_size
         return start, min(start + self.chunk_size, self.total)
 
     def grid_index(self, cases: np.ndarray) -> tuple[np.ndarray, ...]:
-        """Index along each axis of the given case numbers."""
+        """Index along each axis of the given case numbers.
+
+        Parameters
+        ----------
+        cases : numpy.ndarray of int
+            Case numbers (indices), 0 to ``total - 1``, any shape.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            One index array per axis (outermost first), shaped like ``cases``; empty without axes.
+        """
         if not self.axes:
             return ()
         return np.unravel_index(cases // self.draws, self.grid_shape)
@@ -107,12 +129,40 @@ class SweepPlan:
         return self.draws > 1 or bool(self.distributions)
 
     def cases(self, start: int, stop: int) -> Cases:
-        """Cases ``start .. stop-1`` for the system's ``evaluate``: members are the global case numbers."""
+        """Cases ``start .. stop-1`` for the system's ``evaluate``: members are the global case numbers.
+
+        Parameters
+        ----------
+        start : int
+            First case number (index).
+        stop : int
+            One past the last case number (index).
+
+        Returns
+        -------
+        Cases
+            The cases' parameters in SI (see :meth:`case_values`), their members (global case numbers), the
+            seed's random streams when the plan draws random terms, and the plan's fidelity.
+        """
         return Cases(self.case_values(start, stop), members=np.arange(start, stop, dtype=np.int64),
                      random=RandomStreams(self.seed) if self.random else None, fidelity=self.fidelity)
 
     def case_values(self, start: int, stop: int) -> dict[str, np.ndarray]:
-        """Every parameter of cases ``start .. stop-1``, as arrays (SI)."""
+        """Every parameter of cases ``start .. stop-1``, as arrays (SI).
+
+        Parameters
+        ----------
+        start : int
+            First case number (index).
+        stop : int
+            One past the last case number (index).
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            Parameter name -> its values, shape (stop - start,), SI (choices as strings; an unset number is NaN,
+            an unset text None): swept, drawn or the scenario's constant.
+        """
         cases = np.arange(start, stop, dtype=np.int64)
         n = cases.size
         index = dict(zip((axis.name for axis in self.axes), self.grid_index(cases)))
@@ -173,6 +223,27 @@ def grid_values(start: float, stop: float, step: float) -> np.ndarray:
     ``start`` and ``stop`` themselves), so ``0:1:0.1`` has 11 points whose
     last is exactly 1.
 
+    Parameters
+    ----------
+    start : float
+        First value, in SI as the sweep uses it (rad, rad/s, ...; any unit works when all three share it).
+    stop : float
+        Last value wanted, in the unit of ``start``.
+    step : float
+        Step, in the unit of ``start``; finite, non-zero, towards ``stop``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The grid's values, in the unit of ``start``.
+
+    Raises
+    ------
+    ValueError
+        A zero or non-finite value, a step away from ``stop``, or more than :data:`MAX_CASES` points.
+
+    Examples
+    --------
     >>> float(grid_values(0.0, 1.0, 0.1)[-1]), len(grid_values(0.0, 1.0, 0.1))
     (1.0, 11)
     >>> grid_values(0.0, 1.0, 0.3).tolist()
@@ -214,6 +285,19 @@ def parse_axis(text: str, parameters: Iterable[Parameter]) -> Axis:
 
     A unit written only after the step applies to all three numbers:
     ``drift_east=0.001:0.01:0.001 deg/h``.
+
+    Parameters
+    ----------
+    text : str
+        ``NAME=START:STOP:STEP`` (numbers in the parameter's display unit, or each with its unit; a range only
+        for numbers and integers) or ``NAME=V1,V2,...``.
+    parameters : iterable of Parameter
+        The system's parameters (``NAME`` must be one; ``-`` may stand for ``_``).
+
+    Returns
+    -------
+    Axis
+        The axis: its values in SI (choices as strings, integers as int64) and the text as written.
 
     Raises
     ------
@@ -286,16 +370,31 @@ def plan_sweep(
     Parameters
     ----------
     scenario : Scenario
+        The scenario: the base case (SI), its ``[monte_carlo]`` table (draws, distributions, seed) and
+        fidelity.
     system : System
+        The system swept (its parameters are the axes' and the cases').
     params : iterable of str
         ``NAME=START:STOP:STEP`` or ``NAME=V1,V2,...`` texts.
     monte_carlo : int, optional
-        Draws per grid point; defaults to ``[monte_carlo] cases`` of the scenario
+        Monte Carlo draws per grid point, number of, at least 1; defaults to ``[monte_carlo] cases`` of the scenario
         (no Monte Carlo when neither is given).
     chunk_size : int
-        Cases per chunk.
+        Cases per chunk, number of, at least 1.
     fidelity : str, optional
         The system's evaluation fidelity (default: the scenario's, else the system's default).
+
+    Returns
+    -------
+    SweepPlan
+        The plan (no per-case arrays).
+
+    Raises
+    ------
+    ScenarioError
+        A malformed or repeated ``--param``, a chunk size or draw count below 1, Monte Carlo without random
+        parameters, a swept parameter that is also random, an unknown fidelity, or more than
+        :data:`MAX_CASES` cases.
     """
     axes = tuple(parse_axis(text, system.parameters) for text in params)
     names = [axis.name for axis in axes]

@@ -21,6 +21,28 @@ def plot_sweep_summary(plan, statistics: dict, per_axis: dict, histograms: dict,
     Values are shown in the result's display unit (``display_units``: name ->
     unit, e.g. arcmin for an angle in rad). Returns the files written
     (``summary_<result>.png``).
+
+    Parameters
+    ----------
+    plan : SweepPlan
+        The sweep's plan (its axes, parameters' units, system name and number of cases).
+    statistics : dict of str to dict
+        Result name -> ``count``, ``min``, ``max``, ``mean``, ``p05``, ``p50``, ``p95``, ... over all cases,
+        in the result's SI unit (as :func:`~schuler.study.summary.gather` returns them).
+    per_axis : dict of (str, str) to dict
+        (axis name, result name) -> arrays over the axis' values of ``mean``, ``min``, ``max`` (SI) and
+        ``count``.
+    histograms : dict of str to (numpy.ndarray, numpy.ndarray)
+        Result name -> (counts, bin edges in SI), as :func:`~schuler.study.summary.histograms` returns them.
+    out_dir : str or Path
+        Folder the PNG files are written to.
+    display_units : dict of str to str, optional
+        Result name -> the unit it is shown in (``arcmin``); a result not in it is shown in SI.
+
+    Returns
+    -------
+    list of Path
+        The files written, one per varying result (at most :data:`MAX_RESULTS_PLOTTED`).
     """
     import matplotlib.pyplot as plt
 

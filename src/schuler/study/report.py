@@ -43,17 +43,23 @@ class SystemEntry:
 def build_report(out_dir, systems=None, jobs: int = 1) -> Path:
     """Build the report into ``out_dir``; returns the path of ``index.html``.
 
+    A system whose module does not exist in this installation is listed as not
+    yet available; any error inside an existing system propagates.
+
     Parameters
     ----------
     out_dir : path
         Report folder (created if missing); figures go into ``out_dir/figures``.
     systems : iterable of str, optional
-        System names to include (default: all five, in the order of the toolkit).
+        System names to include (default: every system of :data:`~schuler.registry.SYSTEM_MODULES`, in the
+        order of the toolkit).
     jobs : int
-        Sections built at once, each in its own process (1: in this process).
+        Sections built at once, number of, each in its own process (1 or less: all in this process).
 
-    A system whose module does not exist in this installation is listed as not
-    yet available; any error inside an existing system propagates.
+    Returns
+    -------
+    Path
+        The report page, ``out_dir/index.html``.
     """
     out_dir = Path(out_dir)
     figures = out_dir / FIGURES
@@ -80,7 +86,27 @@ def build_report(out_dir, systems=None, jobs: int = 1) -> Path:
 
 
 def build_section(module: str, figures: Path) -> tuple[ReportSection, float]:
-    """The report section of the system defined in ``module`` and the seconds it took."""
+    """The report section of the system defined in ``module`` and the seconds it took.
+
+    Parameters
+    ----------
+    module : str
+        The module holding the system's ``SYSTEM`` (a value of :data:`~schuler.registry.SYSTEM_MODULES`).
+    figures : Path
+        Folder the section's figures are written into.
+
+    Returns
+    -------
+    section : ReportSection
+        What the system's ``report`` returned.
+    seconds : float
+        Wall-clock time it took, s.
+
+    Raises
+    ------
+    SchulerError
+        The system's report failed (the message names the module).
+    """
     began = time.perf_counter()
     try:
         section = importlib.import_module(module).SYSTEM.report(figures)
@@ -95,6 +121,21 @@ def render_html(entries: list[SystemEntry], seconds: float, figures_dir: Path | 
 
     ``seconds`` is the time the whole report took, shown in the footer;
     ``figures_dir`` holds the figures (their sizes and fonts set how they are shown).
+
+    Parameters
+    ----------
+    entries : list of SystemEntry
+        The systems, in the order shown (an entry without a section is listed as not yet available).
+    seconds : float
+        Wall-clock time the whole report took, s.
+    figures_dir : Path, optional
+        The folder holding the figures (their pixel widths and fonts set how they are shown, their SVG
+        copies are linked); None: the page is written without looking at the files.
+
+    Returns
+    -------
+    str
+        The page's HTML (self-contained but for the figure files).
     """
     available = [e for e in entries if e.section is not None]
     parts = [

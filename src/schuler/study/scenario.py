@@ -85,6 +85,18 @@ SIMULATION_KEYS = ("duration", "output_step")
 def simulation_keys(parameters) -> dict[str, str]:
     """``[simulation]`` key -> run parameter name, for the keys a system has.
 
+    Parameters
+    ----------
+    parameters : iterable of Parameter
+        The system's ``run`` parameters.
+
+    Returns
+    -------
+    dict of str to str
+        ``[simulation]`` key -> parameter name, for ``duration`` and ``output_step`` where the system has them.
+
+    Examples
+    --------
     >>> from schuler.params import Parameter
     >>> simulation_keys([Parameter("output_step", "s", 1.0, "Output step.")])
     {'output_step': 'output_step'}
@@ -134,6 +146,22 @@ class Distribution:
 
     def draw(self, spec: Parameter, base, seed: int, cases: np.ndarray) -> np.ndarray:
         """The parameter's value for each case number (counter-based: independent of chunking).
+
+        Parameters
+        ----------
+        spec : Parameter
+            The random parameter (its kind, range and display unit; an integer's draws are rounded).
+        base : float
+            The scenario's value of the parameter, SI: the mean of a ``normal`` draw (unused by ``uniform``).
+        seed : int
+            The Monte Carlo's seed (plain number, 0 or more).
+        cases : numpy.ndarray of int
+            Case (member) numbers, shape (N,); the same number always draws the same value.
+
+        Returns
+        -------
+        numpy.ndarray
+            The drawn values, shape (N,), SI (int64 for an integer parameter).
 
         Raises
         ------
@@ -222,7 +250,23 @@ class Scenario:
         return get_system(self.system)
 
     def draw(self, cases: np.ndarray) -> dict[str, np.ndarray]:
-        """The values of the ``[monte_carlo]`` random parameters for the given case (member) numbers."""
+        """The values of the ``[monte_carlo]`` random parameters for the given case (member) numbers.
+
+        Parameters
+        ----------
+        cases : numpy.ndarray of int
+            Case (member) numbers, shape (N,).
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            Random parameter name -> its values, shape (N,), SI; empty without a ``[monte_carlo]`` table.
+
+        Raises
+        ------
+        ScenarioError
+            A draw outside its parameter's range.
+        """
         table = self.monte_carlo
         if table is None:
             return {}
@@ -237,6 +281,16 @@ class Scenario:
 
 def load_scenario(path) -> Scenario:
     """Read and validate a scenario file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The scenario's TOML file (UTF-8).
+
+    Returns
+    -------
+    Scenario
+        The validated scenario (values in SI).
 
     Raises
     ------
@@ -254,7 +308,25 @@ def load_scenario(path) -> Scenario:
 
 
 def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
-    """Validate scenario TOML text (see the module documentation for the layout)."""
+    """Validate scenario TOML text (see the module documentation for the layout).
+
+    Parameters
+    ----------
+    text : str
+        The scenario's TOML text.
+    source : str
+        Where the text came from (a file name), used in messages.
+
+    Returns
+    -------
+    Scenario
+        The validated scenario (values in SI).
+
+    Raises
+    ------
+    ScenarioError
+        Not valid TOML, an unknown or missing system, or a table, key or value the system does not accept.
+    """
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
@@ -280,6 +352,16 @@ def scenario_model(system: System) -> type[ScenarioTables]:
 
     Every parameter is validated by its :meth:`Parameter.parse` (unit dimension
     and range), so a scenario accepts exactly what the command line accepts.
+
+    Parameters
+    ----------
+    system : System
+        The system the scenario runs (its parameters, fidelities and instrument options).
+
+    Returns
+    -------
+    type
+        A pydantic model, subclass of :class:`ScenarioTables`, whose ``model_validate`` checks a parsed file.
     """
     parameters = {spec.name: spec for spec in system.parameters}
     # (type, default) pairs built at run time: pydantic reads them, a type checker cannot

@@ -27,6 +27,18 @@ from schuler.units import to_unit
 def column_name(spec: Parameter) -> str:
     """Results column of a parameter: its name and display unit (``drift_east_deg_per_h``).
 
+    Parameters
+    ----------
+    spec : Parameter
+        The parameter (a quantity's column holds its values in the display unit ``spec.unit``).
+
+    Returns
+    -------
+    str
+        The name, with ``_UNIT`` appended for a quantity with a unit (``/`` written ``_per_``, ``.`` as ``p``).
+
+    Examples
+    --------
     >>> column_name(Parameter("drift_east", "deg/h", 0.0, "Drift."))
     'drift_east_deg_per_h'
     """
@@ -64,6 +76,24 @@ def evaluate_chunk(task: ChunkTask) -> ChunkResult:
     (category, message) pairs so that the client reports each once.
     Errors a user can cause come back as a :class:`ScenarioError` naming the
     cases (it pickles across processes and Dask workers).
+
+    Parameters
+    ----------
+    task : ChunkTask
+        The plan, the chunk's index and the system's vectorised ``evaluate``.
+
+    Returns
+    -------
+    ChunkResult
+        The chunk's index, its cases (number of), the table as Parquet bytes (parameters in their display
+        units, each column named by :func:`column_name`; results as ``evaluate`` returns them, SI) and the
+        warnings raised.
+
+    Raises
+    ------
+    ScenarioError
+        The system refused some case of the chunk (naming the chunk's cases), or a result does not have one
+        value per case.
     """
     import pandas as pd
 
@@ -95,6 +125,20 @@ def evaluate_chunk(task: ChunkTask) -> ChunkResult:
 
 
 def chunk_path(out_dir: Path, index: int) -> Path:
+    """Where chunk ``index`` of a sweep is stored.
+
+    Parameters
+    ----------
+    out_dir : Path
+        The sweep's folder.
+    index : int
+        Chunk index, 0 to ``plan.chunks - 1``.
+
+    Returns
+    -------
+    Path
+        ``out_dir/chunks/chunk-NNNNNN.parquet`` (index written with six digits).
+    """
     return Path(out_dir) / "chunks" / f"chunk-{index:06d}.parquet"
 
 

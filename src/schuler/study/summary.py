@@ -194,6 +194,31 @@ def gather(plan: SweepPlan, out_dir: Path, *, write_csv: bool = True) -> tuple[d
 
     One chunk is in memory at a time. Returns the statistics per result, the
     per-axis means and extremes, and the files written.
+
+    Parameters
+    ----------
+    plan : SweepPlan
+        The sweep's plan (number of chunks, axes, parameters).
+    out_dir : Path
+        The sweep's folder holding the chunk files; the results files are written there.
+    write_csv : bool
+        Whether to write ``results.csv`` beside ``results.parquet``.
+
+    Returns
+    -------
+    statistics : dict of str to dict
+        Result name -> ``count`` and ``nan_count`` (cases, number of), ``mean``, ``std``, ``min``, ``max``,
+        ``p05``, ``p50``, ``p95`` over the finite values, in the result's SI unit (None when none is finite).
+    per_axis : dict of (str, str) to dict of str to numpy.ndarray
+        (axis name, result name) -> ``count``, ``mean``, ``std``, ``min``, ``max`` at each value of the axis
+        (SI; NaN where no case is finite).
+    files : list of Path
+        The results files written.
+
+    Raises
+    ------
+    ScenarioError
+        The sweep has no chunk to gather.
     """
     import pyarrow.csv as pa_csv
     import pyarrow.parquet as pq
@@ -238,6 +263,21 @@ def histograms(plan: SweepPlan, out_dir: Path, statistics: dict) -> dict[str, tu
 
     A second streamed pass over the chunk files, reading only the result
     columns, with bins spanning each result's minimum to maximum.
+
+    Parameters
+    ----------
+    plan : SweepPlan
+        The sweep's plan (number of chunks).
+    out_dir : Path
+        The sweep's folder holding the chunk files.
+    statistics : dict of str to dict
+        Result name -> its ``count``, ``min`` and ``max`` (SI), as :func:`gather` returns them.
+
+    Returns
+    -------
+    dict of str to (numpy.ndarray, numpy.ndarray)
+        Result name -> (counts, cases per bin; the :data:`HISTOGRAM_BINS` + 1 bin edges, SI), only for the
+        results whose values vary.
     """
     import pyarrow.parquet as pq
 

@@ -87,13 +87,14 @@ def run_sweep(
     params : iterable of str
         Grid axes ``NAME=START:STOP:STEP`` or ``NAME=V1,V2,...``.
     monte_carlo : int, optional
-        Random draws per grid point.
+        Random draws per grid point, number of, at least 1 (default: the scenario's ``[monte_carlo] cases``;
+        neither: no Monte Carlo).
     chunk_size : int
-        Cases per chunk (one vectorised evaluation, one file).
+        Cases per chunk, number of, at least 1 (one vectorised evaluation, one file).
     scheduler : str, optional
         ``"local"`` (start a Dask LocalCluster) or a Dask scheduler address.
     workers : int, optional
-        Processes of a local pool (without ``scheduler``), or of the LocalCluster.
+        Processes of a local pool (without ``scheduler``), or of the LocalCluster, number of, at least 1.
     progress : bool
         Show a progress bar on stderr.
     write_csv, plots : bool
@@ -102,6 +103,18 @@ def run_sweep(
         Called with each chunk index once its file is stored.
     fidelity : str, optional
         The system's evaluation fidelity (``--fidelity``).
+
+    Returns
+    -------
+    SweepSummary
+        Cases and chunks (computed, resumed), timings in s, the statistics of every result (SI) overall and
+        per swept value, and the files written.
+
+    Raises
+    ------
+    ScenarioError
+        A malformed plan (see :func:`~schuler.study.plan.plan_sweep`), ``out_dir`` holding a different
+        sweep, or a case the system refuses.
     """
     from schuler.study.plots import plot_sweep_summary
 

@@ -13,6 +13,23 @@ from schuler.registry import SYSTEM_MODULES, System, get_system
 def load_system(name: str) -> System | None:
     """The system registered under ``name``, or None when its module does not exist.
 
+    Parameters
+    ----------
+    name : str
+        A registered system's name (a key of ``SYSTEM_MODULES``: ``"align"``, ``"errors"``, ...).
+
+    Returns
+    -------
+    System or None
+        The system; None when its module (or the subpackage holding it) is not installed.
+
+    Raises
+    ------
+    ModuleNotFoundError
+        A module the system needs (other than its own) is missing.
+
+    Examples
+    --------
     >>> load_system("errors") is None or load_system("errors").name == "errors"
     True
     """
