@@ -400,6 +400,33 @@ def reading_closed_form(
     and S = int_0^tau theta_b - int_tau^{tau+tau_2} theta_b.
     Parameters as in :func:`simulate_cycle` (no noise).
 
+    Parameters
+    ----------
+    stabilizer : Stabilizer
+        The instrument (its loop time constant and integrator leak are taken as ideal here).
+    rate : array_like, shape (N,) or scalar
+        omega_dX + omega_X0 (plus any tilt coupling) about +X, rad/s.
+    initial_angle : array_like
+        alpha0, the angle at t0, rad.
+    sensor_scale_error : array_like
+        kappa, relative error of K1 (dimensionless).
+    amplitude_mismatch, duration_mismatch : array_like
+        epsilon and delta = L / tau: the second pulse is -(1 + epsilon) i, its gate open tau_2 = (1 + delta) tau
+        with the final current held (dimensionless).
+    tilt : array_like
+        Pulse asymmetry: both pulses get the ramp ``tilt * (2u - 1)`` (dimensionless).
+    integrator_offset : array_like
+        b, input offset of the integrator as an angle of the command sensor, rad.
+    sway_angle, sway_rate : array_like
+        Base sway angle theta_b (rad) and rate (rad/s) about X at t0.
+
+    Returns
+    -------
+    numpy.ndarray
+        Delta U, the integrator's reading over the cycle, V s, in the broadcast shape of the arguments.
+
+    Examples
+    --------
     >>> from schuler.drift_calibration.pulses import rectangular
     >>> stab = Stabilizer(57.3, 0.02, 0.1, 1e-3, 5.0, rectangular())
     >>> float(reading_closed_form(stab, 1e-5) / (-57.3 * 25 * 1e-5))

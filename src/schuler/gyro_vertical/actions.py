@@ -55,9 +55,9 @@ def friction(dead_zone: float = 0.01, inner_ratio: float = 1.0, initial_beta: fl
     Parameters
     ----------
     dead_zone : float
-        R q_1, m/s.
+        R q_1, m/s: half-width of the velocity dead zone of the outer axis x (> 0).
     inner_ratio : float
-        q_2 / q_1.
+        q_2 / q_1: friction of the inner (y) bearing relative to the outer, plain number (>= 0).
     initial_beta : float
         Initial tilt about y, rad.
     ramp_acceleration : float
@@ -70,6 +70,9 @@ def friction(dead_zone: float = 0.01, inner_ratio: float = 1.0, initial_beta: fl
     Returns
     -------
     FrictionResult
+        Friction rates q_1, q_2 (rad/s) and dead zones (m/s), the stick intervals and switches (number of),
+        the largest static and overall velocity errors (m/s), the slip growth rates (m/s^2) and the response
+        with its histories (SI).
 
     Raises
     ------

@@ -137,16 +137,25 @@ def forcing(kinematics: Kinematics, radius, schuler_tuning=1.0, earth_rate_compe
     Parameters
     ----------
     kinematics : Kinematics
+        The trajectory's kinematics at the times wanted (SI: velocities m/s, rates rad/s).
     radius : float or ndarray
         R, m.
     schuler_tuning : float or ndarray
         kappa = k R / H, dimensionless (1: the Schuler condition (11)).
     earth_rate_compensation, transport_coriolis_compensation : bool or ndarray of bool
-        Apply the torques (8); subtract W* (21) from the accelerometer signals.
+        Apply the torques (8); subtract W* (21) from the accelerometer signals. Flags (dimensionless), one
+        per member when arrays.
     accelerometer_bias : pair of float or ndarray
         (b_x, b_y), m/s^2.
     gyro_drift : pair of float or ndarray
         (eps_x, eps_y), rad/s.
+
+    Returns
+    -------
+    f_x, f_y : ndarray
+        Specific-force inputs, m/s^2, broadcast to a common shape (times, or members).
+    e_x, e_y : ndarray
+        Angular-rate inputs, rad/s, same shape.
 
     Examples
     --------

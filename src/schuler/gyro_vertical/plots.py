@@ -169,7 +169,27 @@ def plot_spectrum(analysis, title: str = "Spectrum of the velocity-error oscilla
 
 def plot_friction(response, q, radius, title: str = "Coulomb friction: velocity errors and the dead zone +-R q",
                   zoom_hours: float = 3.0):
-    """Delta v_x, Delta v_y (m/s) with the dead zone and stick intervals; below, the first hours enlarged."""
+    """Delta v_x, Delta v_y (m/s) with the dead zone and stick intervals; below, the first hours enlarged.
+
+    Parameters
+    ----------
+    response : FrictionResponse
+        The friction simulation: ``time`` in s, ``velocity_error_x`` and ``velocity_error_y`` in m/s, and the
+        stick intervals as (begin, end) pairs in s.
+    q : pair of float
+        (q_1, q_2) = M_fr / H of the outer (x) and inner (y) axis, rad/s.
+    radius : float
+        R, m (the dead zone is +-R q).
+    title : str
+        Title of the top panel.
+    zoom_hours : float
+        Length of the enlarged start shown in the bottom panel, hours.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three panels: Delta v_x and Delta v_y against time in hours, then the first ``zoom_hours`` enlarged.
+    """
     import matplotlib
 
     matplotlib.use("Agg")

@@ -149,6 +149,27 @@ def printed_mu_nu_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_RAT
     positive loop gain c_a U_y U_z and the model diverges. Parameters as in
     :func:`full_mu_nu_model`.
 
+    Parameters
+    ----------
+    latitude : float or ndarray
+        Latitude phi, rad.
+    azimuth : float or ndarray
+        Azimuth A, rad.
+    c_gamma : float or ndarray
+        Level correction gain c_Gamma, 1/s.
+    c_a : float or ndarray
+        Azimuth correction gain c_a, 1/s.
+    earth_rate : float
+        U, rad/s.
+    gravity : float
+        g turning accelerometer errors into eps = Delta a / g, m/s^2.
+
+    Returns
+    -------
+    StateSpace
+        States (mu, nu, delta), rad; inputs :data:`INPUTS`; outputs delta, beta, alpha, mu, nu (rad) and
+        delta_rate (rad/s), as :func:`full_mu_nu_model`'s; batched over the broadcast shape of the arguments.
+
     Examples
     --------
     >>> m = printed_mu_nu_model(np.radians(50), 0.0, 0.0533, 23.7)
@@ -227,6 +248,26 @@ def full_alpha_beta_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_R
     dU_eta = -U sin(phi) dphi, dU_z = U cos(phi) dphi. It is (1.17) corrected,
     rotated by (1.11). Parameters as in :func:`full_mu_nu_model`.
 
+    Parameters
+    ----------
+    latitude : float or ndarray
+        Latitude phi, rad.
+    azimuth : float or ndarray
+        Azimuth A, rad.
+    c_gamma : float or ndarray
+        Level correction gain c_Gamma, 1/s.
+    c_a : float or ndarray
+        Azimuth correction gain c_a, 1/s.
+    earth_rate : float
+        U, rad/s.
+    gravity : float
+        g turning accelerometer errors into eps = Delta a / g, m/s^2.
+
+    Returns
+    -------
+    StateSpace
+        States (beta, alpha, delta), rad; batched over the broadcast shape of the arguments.
+
     Examples
     --------
     >>> m = full_alpha_beta_model(np.radians([0, 50]), 0.0, 0.0533, 23.7)
@@ -270,6 +311,26 @@ def simplified_model(latitude, azimuth, c_gamma, c_a, *, earth_rate=EARTH_RATE, 
     Valid after levelling (tilts of a few arcminutes) with c_gamma, c_a much larger
     than the Earth rate. Its characteristic equation p^2 + c_gamma p + U_eta c_a = 0
     gives (1.20). Parameters as in :func:`full_mu_nu_model`.
+
+    Parameters
+    ----------
+    latitude : float or ndarray
+        Latitude phi, rad.
+    azimuth : float or ndarray
+        Azimuth A, rad.
+    c_gamma : float or ndarray
+        Level correction gain c_Gamma, 1/s.
+    c_a : float or ndarray
+        Azimuth correction gain c_a, 1/s.
+    earth_rate : float
+        U, rad/s.
+    gravity : float
+        g turning accelerometer errors into eps = Delta a / g, m/s^2.
+
+    Returns
+    -------
+    StateSpace
+        States (beta, delta), rad; batched over the broadcast shape of the arguments.
 
     Examples
     --------

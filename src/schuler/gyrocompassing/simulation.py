@@ -134,6 +134,25 @@ def evaluate_cases(case: AlignmentCase, model: str = "full", *, simulate_runs: b
     ``settling_time_simulated_s`` (1 % band), ``max_abs_delta_rad``,
     ``max_abs_beta_rad``, ``max_abs_delta_rate_rad_per_s`` and ``constraints_ok``.
 
+    Parameters
+    ----------
+    case : AlignmentCase
+        N cases (parameters in SI, broadcast to (N,)); it must leave the azimuth observable.
+    model : {"full", "full-ab", "simplified"}
+        The model simulated (:data:`~schuler.gyrocompassing.models.MODELS`); the closed form uses it too.
+    simulate_runs : bool
+        Whether to simulate every case as well.
+    duration : float, optional
+        Simulated time, s (default: :func:`automatic_duration` of the longest analytic settling time).
+    time_step : float
+        Output step of the simulation, s.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Result name -> values, shape (N,), in the unit the name ends with (``_rad``, ``_s``, ``_rad_per_s``);
+        the gains ``c_gamma`` and ``c_a`` in 1/s, ``damping`` a plain number, ``constraints_ok`` a bool array.
+
     Examples
     --------
     >>> case = AlignmentCase(latitude=np.radians([10.0, 50.0]), drift_east=np.radians(0.01) / 3600)

@@ -118,7 +118,35 @@ def altitude_errors(time, gains: BaroLoopGains, accel_bias_up: float, baro_bias:
 
 def loop_gains(order: int, time_constant: float, k1: float | None, k2: float | None, k3: float | None,
                radius: float, gravity: float) -> BaroLoopGains:
-    """The aided loop's gains: explicit ones where given, the critically damped ones of tau otherwise."""
+    """The aided loop's gains: explicit ones where given, the critically damped ones of tau otherwise.
+
+    Parameters
+    ----------
+    order : {2, 3}
+        Order of the baro-aided loop.
+    time_constant : float
+        tau, s (> 0): the default gains put every pole at -1/tau.
+    k1 : float, optional
+        Altitude feedback, 1/s (None: the critically damped one).
+    k2 : float, optional
+        Velocity feedback, 1/s^2 (None: the critically damped one).
+    k3 : float, optional
+        Accelerometer-error estimator gain, 1/s^3, third order only (None: the critically damped one).
+    radius : float
+        R, m.
+    gravity : float
+        g0, m/s^2.
+
+    Returns
+    -------
+    BaroLoopGains
+        k1 (1/s), k2 (1/s^2), k3 (1/s^3; 0 for the second order) and the order.
+
+    Raises
+    ------
+    InvalidParameter
+        ``k3`` given for the second order, or gains that leave the loop unstable.
+    """
     if order == 2 and k3 is not None:
         raise InvalidParameter("k3", "applies to the third-order loop only (order 3)")
     default = critically_damped_gains(order, time_constant, radius, gravity)
@@ -152,12 +180,18 @@ def vertical(*, accel_bias_up: float, duration: float, output_step: float | None
         Explicit gains (1/s, 1/s^2, 1/s^3); k3 for the third order only.
     baro_bias : float
         Constant barometric altitude error, m (measured - true).
-    earth, radius, gravity
-        Preset and overrides (:func:`~schuler.navigation_errors.inputs.earth_constants`).
+    earth : str
+        Preset of the Earth constants (:func:`~schuler.navigation_errors.inputs.earth_constants`).
+    radius : float, optional
+        R overriding the preset's, m.
+    gravity : float, optional
+        g0 overriding the preset's, m/s^2.
 
     Returns
     -------
     VerticalResult
+        The unaided and aided altitude errors (m) over time (s), the closed form beside them, and the loop's
+        gains and poles.
 
     Examples
     --------
@@ -196,13 +230,23 @@ def period(*, thrust_factor: float, speed: float, path_radius: float | None, ear
     Parameters
     ----------
     thrust_factor : float
-        n (> 0).
+        n (> 0), vertical thrust in units of g: plain number.
     speed : float
         V, m/s (>= 0).
     path_radius : float, optional
         r, m (default R).
-    earth, radius, gravity
-        Preset and overrides (:func:`~schuler.navigation_errors.inputs.earth_constants`).
+    earth : str
+        Preset of the Earth constants (:func:`~schuler.navigation_errors.inputs.earth_constants`).
+    radius : float, optional
+        R overriding the preset's, m.
+    gravity : float, optional
+        g0 overriding the preset's, m/s^2.
+
+    Returns
+    -------
+    PeriodResult
+        R (m), g (m/s^2), the nominal Schuler period, the period under thrust n g and in level flight at V
+        (all s), the orbital speed (m/s) and the flight's effective gravity (m/s^2).
 
     Examples
     --------

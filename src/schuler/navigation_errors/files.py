@@ -69,7 +69,23 @@ def write_files(result: Result, out_dir: Path, formats=("png", "svg")) -> list[P
 
 
 def write_problem3(curves: Problem3Curves, out_dir: Path, formats=("png", "svg")) -> list[Path]:
-    """Problem 3's figures (each source, flat vs spherical; the log overview), Problem 4's, and their CSV."""
+    """Problem 3's figures (each source, flat vs spherical; the log overview), Problem 4's, and their CSV.
+
+    Parameters
+    ----------
+    curves : Problem3Curves
+        The curves to draw (SI: times in s, errors in m; the figures show them in ft).
+    out_dir : Path
+        Folder the files are written into (created if missing).
+    formats : tuple of str
+        Figure file formats (extensions such as ``"png"``, ``"svg"``).
+
+    Returns
+    -------
+    list of Path
+        The files written: per source, the overview and Problem 4 one figure per format, then
+        ``errors_problem3.csv`` and ``errors_problem4.csv`` (columns in s and m).
+    """
     import pandas as pd
 
     paths = []

@@ -228,11 +228,19 @@ def earth_constant_arrays(earth: np.ndarray, radius: np.ndarray, gravity: np.nda
     Parameters
     ----------
     earth : ndarray
-        Preset name of each case (None: the default).
+        Preset name of each case (None: the default), shape (N,), object array of str (names: no unit).
     radius : ndarray
         R of each case, m (NaN: the preset's).
     gravity : ndarray
         g0 of each case, m/s^2 (NaN: the preset's).
+
+    Returns
+    -------
+    R : ndarray
+        Radius of each case, m, shape (N,).
+    g : ndarray
+        Gravity of each case, m/s^2, shape (N,): the preset's loop effective gravity when neither radius nor
+        gravity is given, its g0 when only the radius is (as :func:`earth_constants` does).
     """
     # numpy's stubs leave out None, which object arrays compare elementwise
     earth = np.where(np.equal(earth, None), "default", earth)  # type: ignore[call-overload]

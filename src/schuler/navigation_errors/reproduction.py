@@ -232,6 +232,18 @@ def problem3_curves(points: int = FIGURE_POINTS, simulated_points: int = SIMULAT
     Closed forms on ``points`` times, the simulated spherical errors on
     ``simulated_points`` times (markers), and the pure-inertial altitude error
     beside the second- and third-order baro-aided loops (tau = 100 s).
+
+    Parameters
+    ----------
+    points : int
+        Times of the closed forms over the flight, number of (at least 2).
+    simulated_points : int
+        Times of the simulated errors (markers), number of (at least 2).
+
+    Returns
+    -------
+    Problem3Curves
+        Times in s and errors in m, with Bollay's constants (R and the loop's effective g).
     """
     R, g = BOLLAY.radius, BOLLAY.effective_gravity
     t = time_grid(FLIGHT_TIME, FLIGHT_TIME / (points - 1))
@@ -265,6 +277,17 @@ PLOT_PARAMETERS = ParameterSet((
 
 def plot(*, points: int) -> Problem3Figures:
     """Problem 3's curves (figures with ``--out``): each source flat vs spherical, the overview, Problem 4.
+
+    Parameters
+    ----------
+    points : int
+        Times of the closed forms over 0..10,120 s, number of (3 to 100,001).
+
+    Returns
+    -------
+    Problem3Figures
+        The largest flat and spherical errors per source (m), the largest simulated - closed-form difference
+        (m) and the curves.
 
     Examples
     --------

@@ -201,6 +201,44 @@ def three_d(*, latitude: float, velocity_north: float, velocity_east: float, dur
     ``case()``, which fills the defaults and refuses unknown names); signs in the
     module notes.
 
+    Parameters
+    ----------
+    latitude : float
+        Latitude L of the vehicle, rad, in (-pi/2, pi/2).
+    velocity_north, velocity_east : float
+        Vehicle's constant ground speeds V_N, V_E, m/s (coefficients frozen at L).
+    duration : float
+        Length of the run, s (> 0, at most :data:`MAX_DURATION`).
+    output_step : float
+        Output step, s (> 0; the simulation is exact between outputs).
+    drift_north, drift_east, drift_down : float
+        Platform drift rate epsilon about north, east, down, rad/s: -(gyro bias) resolved in the level frame.
+    accel_bias_north, accel_bias_east, accel_bias_down : float
+        Accelerometer bias nabla resolved north, east, down, m/s^2, measured - true (down: vertical channel
+        only).
+    initial_velocity_error_north, initial_velocity_error_east : float
+        Velocity errors at the start, m/s (computed - true).
+    initial_attitude_error_north, initial_attitude_error_east, initial_attitude_error_down : float
+        Platform attitude errors psi(0) about north, east, down, rad.
+    vertical_channel : bool
+        Whether to include the pure-inertial vertical channel (unstable); without it the down errors are held
+        at zero.
+    earth : str
+        Preset of the Earth constants (:func:`~schuler.navigation_errors.inputs.earth_constants`).
+    radius : float, optional
+        R overriding the preset's, m.
+    gravity : float, optional
+        g0 overriding the preset's, m/s^2.
+    earth_rate : float, optional
+        Earth rate Omega, rad/s (None: the preset's; 0: a non-rotating Earth).
+
+    Returns
+    -------
+    ThreeDResult
+        Final errors (m, m/s, rad; computed - true in NED), the largest horizontal position error (m), the
+        Schuler period (s), the Foucault rate (rad/s), the eigenvalues (real part 1/s, imaginary rad/s) and
+        the histories over ``t_s`` (s).
+
     Raises
     ------
     InvalidParameter

@@ -92,6 +92,26 @@ def printed_hover_expression(time, k, radius, gravity):
     vehicle starts on the right height. ``k`` is the accelerometer error in
     units of g0 (dimensionless); other parameters as in :func:`hover_altitude_error`.
 
+    Parameters
+    ----------
+    time : float or ndarray
+        t, s (>= 0).
+    k : float or ndarray
+        Accelerometer error in units of g0, dimensionless, positive when it reads low (b = -k g0; Bollay (1966)
+        Problem 4: 1e-4).
+    radius : float
+        R, m (> 0).
+    gravity : float
+        g0, m/s^2 (> 0); omega_s^2 = g0 / R.
+
+    Returns
+    -------
+    ndarray
+        (k R / 2) sinh(sqrt(2) omega_s t), m, as printed: how far the indicated height falls below the true
+        one (positive for k > 0).
+
+    Examples
+    --------
     >>> float(printed_hover_expression(0.0, 1e-4, 6.371e6, 9.80665))
     0.0
     """
@@ -260,6 +280,26 @@ def aided_steady_state_error(gains: BaroLoopGains, accelerometer_error, baro_err
     accelerometer error leaves a standing offset. Third order: delta_h_baro (the
     integrator estimates b, only the barometer's own error remains).
 
+    Parameters
+    ----------
+    gains : BaroLoopGains
+        The loop's gains k1 (1/s), k2 (1/s^2), k3 (1/s^3) and order.
+    accelerometer_error : float or ndarray
+        b, m/s^2 (measured - true, positive up).
+    baro_error : float or ndarray
+        delta_h_baro, constant barometric altitude error, m (measured - true).
+    radius : float
+        R, m.
+    gravity : float
+        g0, m/s^2; omega_s^2 = g0 / R.
+
+    Returns
+    -------
+    ndarray
+        The standing altitude error, m (indicated - true, positive up), in the broadcast shape of the errors.
+
+    Examples
+    --------
     >>> gains = critically_damped_gains(2, 100.0, 6.371e6, 9.80665)
     >>> round(float(aided_steady_state_error(gains, 1e-3, 0.0, 6.371e6, 9.80665)), 6)
     10.0
