@@ -310,7 +310,7 @@ def compute(system: System, page: str, typed: dict[str, str], sweep_typed: dict[
     Returns
     -------
     TaskView
-        Tables, figures (each with its data as a table in display units) and notes (warnings, violations).
+        Tables, figures (stem, plotly figure, its data as a table) and notes (warnings, violations).
 
     Raises
     ------
