@@ -187,8 +187,9 @@ def member_bytes(case: Case) -> int:
     Parameters
     ----------
     case : Case
-        The member's parameters, SI. Not used: a member keeps two output points (start and end) and one
-        block of 4096 IMU intervals whatever its duration and rate, so the estimate is the same for every case.
+        The member's parameters, SI. Not used: the estimate assumes two output points per member (the Monte
+        Carlo keeps only the start and the end) and a block of 4096 IMU intervals, whatever the duration and
+        rate, so it is the same for every case.
 
     Returns
     -------
