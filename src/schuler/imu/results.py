@@ -143,7 +143,8 @@ class AllanResult(Result):
         Returns
         -------
         dict of str to float
-            Term -> identified value in the units of :data:`TERM_UNITS` (also unresolved terms' fitted values).
+            Term -> identified value in the units of :data:`TERM_UNITS` (unresolved terms too: check
+            ``noise[channel].terms.resolved``).
         """
         return dict(self.noise[channel].terms.values)
 

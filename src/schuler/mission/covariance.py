@@ -186,7 +186,8 @@ def process_noise(F: np.ndarray, noise_input: np.ndarray, dt: float) -> np.ndarr
     Parameters
     ----------
     F : ndarray
-        System matrix of each step, shape (K, n, n), 1/s (psi-angle model, states in m, m/s, rad).
+        System matrix of each step, shape (K, n, n), SI (psi-angle model: each state's rate per unit of each
+        state, states in m, m/s, rad).
     noise_input : ndarray
         G Q_c G^T of each step, shape (K, n, n): the white input's PSD mapped onto the state derivatives,
         (state unit)^2 / s (e.g. rad^2/s on psi from an angle random walk N^2).
