@@ -89,7 +89,32 @@ def _pairs(text: str, name: str) -> dict[str, str]:
 
 
 def csv_options(file: Path, kind=None, axes=None, columns=None, units=None, latitude=None) -> dict:
-    """The keyword options of :func:`~schuler.imu.readers.open_csv` the user set; refused for other formats."""
+    """The keyword options of :func:`~schuler.imu.readers.open_csv` the user set; refused for other formats.
+
+    Parameters
+    ----------
+    file : Path
+        The IMU file; its suffix decides whether CSV options apply (``.imu`` and ``.parquet`` state their own
+        layout).
+    kind : {"rate", "increment"}, optional
+        CSV only: what the sensor columns hold (not set: rate).
+    axes : str, optional
+        CSV only: where the file's x, y, z axes point, three letters of F B R L D U (not set: FRD).
+    columns : str, optional
+        CSV only: ``channel=column`` pairs separated by commas, e.g. ``time=t,gyro_x=wx`` (not set: the
+        project's header).
+    units : str, optional
+        CSV only: ``channel=unit`` pairs separated by commas, e.g. ``gyro=deg/s,accel=g,time=ms``; ``gyro`` and
+        ``accel`` set their three axes (not set: s, rad/s, m/s^2).
+    latitude : float, optional
+        CSV only: site latitude, rad (a CSV file does not carry it).
+
+    Returns
+    -------
+    dict
+        ``open_csv`` keywords: ``kind``, ``axes``, ``columns`` and ``units`` (dicts per channel, ``gyro`` and
+        ``accel`` expanded to their axes) and ``latitude_rad``, only those the user set.
+    """
     given = [name for name, value in (("kind", kind), ("axes", axes), ("columns", columns), ("units", units),
                                       ("latitude", latitude)) if value not in (None, "")]
     suffix = Path(file).suffix.lower()
@@ -120,12 +145,41 @@ def csv_options(file: Path, kind=None, axes=None, columns=None, units=None, lati
 
 
 def info(file: Path, **options) -> ImuInfo:
-    """What an IMU file holds: samples, rate, duration, mean rates (body x forward, y right, z down), site."""
+    """What an IMU file holds: samples, rate, duration, mean rates (body x forward, y right, z down), site.
+
+    Parameters
+    ----------
+    file : Path
+        The IMU file: the project's CSV (or any CSV with ``columns`` and ``units``), PSINS ``.imu`` or
+        ``.parquet``.
+    **options
+        The CSV options of :func:`csv_options` (``kind``, ``axes``, ``columns``, ``units``, ``latitude`` in rad).
+
+    Returns
+    -------
+    ImuInfo
+        Samples, sample interval, duration, mean gyro rates (rad/s) and specific forces (m/s^2), site.
+    """
     return file_info(file, **csv_options(file, **options))
 
 
 def allan(file: Path, per_octave: int = 2, **options) -> AllanResult:
-    """Allan deviation with confidence intervals and IEEE 952 terms of the six channels of a file, streamed."""
+    """Allan deviation with confidence intervals and IEEE 952 terms of the six channels of a file, streamed.
+
+    Parameters
+    ----------
+    file : Path
+        The IMU file (any format of :func:`info`).
+    per_octave : int
+        Averaging times per octave of tau, number of (1 to 16).
+    **options
+        The CSV options of :func:`csv_options` (``kind``, ``axes``, ``columns``, ``units``, ``latitude`` in rad).
+
+    Returns
+    -------
+    AllanResult
+        Curves, terms and grade of the six channels.
+    """
     source = open_record(file, **csv_options(file, **options))
     require(source.estimated_samples * ALLAN_BYTES_PER_SAMPLE + CHUNK_BYTES, "this Allan analysis",
             "the file (analyse a part of it)")
@@ -134,7 +188,35 @@ def allan(file: Path, per_octave: int = 2, **options) -> AllanResult:
 
 def simulate(output: Path, grade=None, spec=None, duration=3600.0, imu_rate=100.0, output_step=None,
              latitude=math.radians(45.0), azimuth=0.0, seed: int = 0) -> SimulationResult:
-    """Simulate a record of a grade or spec file at rest into ``output`` (.parquet streamed, .csv in memory)."""
+    """Simulate a record of a grade or spec file at rest into ``output`` (.parquet streamed, .csv in memory).
+
+    Parameters
+    ----------
+    output : Path
+        File to write: ``.parquet`` (native, written window by window) or ``.csv`` (the project's format).
+    grade : str, optional
+        Grade preset of the simulated IMU (:data:`~schuler.imu.spec.GRADES`; not set: tactical).
+    spec : str, optional
+        TOML spec file of the simulated IMU, instead of ``grade``.
+    duration : float
+        Length of the record, s (rounded to whole samples).
+    imu_rate : float
+        Sample rate, Hz (used when ``output_step`` is not set).
+    output_step : float, optional
+        Sample interval dt, s (instead of ``imu_rate``).
+    latitude : float
+        Site latitude, rad.
+    azimuth : float
+        Heading of the body x axis, clockwise from north, rad.
+    seed : int
+        Seed of the record's random numbers.
+
+    Returns
+    -------
+    SimulationResult
+        The file written, model, samples, duration (s), sample interval (s), seed, site (rad) and file size
+        (bytes).
+    """
     output = Path(output)
     suffix = output.suffix.lower()
     if suffix not in (".parquet", ".csv"):

@@ -102,6 +102,30 @@ def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, k
 
     ``expected_samples`` sets the lags (an estimate is fine: lags beyond
     ``max_fraction`` of the samples actually seen are dropped).
+
+    Parameters
+    ----------
+    chunks : iterable of (ndarray, ndarray, ndarray)
+        ``(time_s, gyro, accel)`` per chunk: times, s, shape (n,); gyro and accelerometer samples, arrays of
+        shape (n, 3), body axes x forward, y right, z down: rad/s and m/s^2 (``kind="rate"``) or rad and m/s
+        over each interval (``kind="increment"``). Only the sensor columns are used.
+    sample_interval_s : float
+        Sample interval dt, s.
+    expected_samples : int
+        Samples the record is expected to hold, number of (sets the lags; at least 4 used).
+    kind : {"rate", "increment"}
+        What the sensor columns hold; increments are divided by dt.
+    source : str
+        Name of the record shown in the result (e.g. the file name).
+    per_octave : int
+        Averaging times per octave of tau, number of.
+    max_fraction : float
+        Longest lag as a fraction of the samples seen, ratio (default 1/8).
+
+    Returns
+    -------
+    AllanResult
+        Curves with confidence intervals, identified terms of the six channels and the grade they match.
     """
     dt = float(sample_interval_s)
     lags = allan_lags(max(4, int(expected_samples)), per_octave=per_octave, max_fraction=max_fraction)
@@ -122,6 +146,22 @@ def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, k
 def analyse_record(record: ImuRecord, per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION) -> AllanResult:
     """Allan curves with confidence intervals and IEEE 952 terms of the six channels of a record.
 
+    Parameters
+    ----------
+    record : ImuRecord
+        The samples (rates in SI, body axes).
+    per_octave : int
+        Averaging times per octave of tau, number of.
+    max_fraction : float
+        Longest lag as a fraction of the record's samples, ratio (default 1/8).
+
+    Returns
+    -------
+    AllanResult
+        Curves, terms and grade of the six channels.
+
+    Examples
+    --------
     >>> from schuler.imu.spec import preset
     >>> record = simulate_record(preset("consumer"), duration_s=60.0, sample_interval_s=0.01, seed=2)
     >>> result = analyse_record(record)
@@ -135,7 +175,22 @@ def analyse_record(record: ImuRecord, per_octave: int = 2, max_fraction: float =
 
 def analyse_source(source: RecordSource, per_octave: int = 2,
                    max_fraction: float = DEFAULT_MAX_FRACTION) -> AllanResult:
-    """Allan analysis of an opened file, chunk by chunk (memory bounded by the longest lag, not the file)."""
+    """Allan analysis of an opened file, chunk by chunk (memory bounded by the longest lag, not the file).
+
+    Parameters
+    ----------
+    source : RecordSource
+        The opened file (:func:`~schuler.imu.files.open_record`); its chunks are consumed.
+    per_octave : int
+        Averaging times per octave of tau, number of.
+    max_fraction : float
+        Longest lag as a fraction of the samples read, ratio (default 1/8).
+
+    Returns
+    -------
+    AllanResult
+        Curves, terms and grade of the six channels; ``source`` is the file's name.
+    """
     chunks = source.chunks()
     first = next(chunks, None)
     if first is None:
@@ -151,12 +206,43 @@ def analyse_source(source: RecordSource, per_octave: int = 2,
 
 
 def analyse_file(path, per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION, **options) -> AllanResult:
-    """Allan analysis of an IMU file (any format of :func:`~schuler.imu.files.open_record`), streamed."""
+    """Allan analysis of an IMU file (any format of :func:`~schuler.imu.files.open_record`), streamed.
+
+    Parameters
+    ----------
+    path : str or Path
+        The IMU file.
+    per_octave : int
+        Averaging times per octave of tau, number of.
+    max_fraction : float
+        Longest lag as a fraction of the samples read, ratio (default 1/8).
+    **options
+        Keywords of the reader (:func:`~schuler.imu.readers.open_csv` for CSV files).
+
+    Returns
+    -------
+    AllanResult
+        Curves, terms and grade of the six channels.
+    """
     return analyse_source(open_record(path, **options), per_octave=per_octave, max_fraction=max_fraction)
 
 
 def true_terms(errors: SensorErrors, axis: int) -> dict[str, float]:
-    """The IEEE 952 terms a model puts on one axis, SI (B only for flicker: a Gauss-Markov bias has no single B)."""
+    """The IEEE 952 terms a model puts on one axis, SI (B only for flicker: a Gauss-Markov bias has no single B).
+
+    Parameters
+    ----------
+    errors : SensorErrors
+        The triad's error model.
+    axis : int
+        Body axis index: 0 x forward, 1 y right, 2 z down.
+
+    Returns
+    -------
+    dict of str to float
+        Term -> value: Q (rad or m/s), N (rad/sqrt(s) or m/s/sqrt(s)), B (rad/s or m/s^2), K (rad/s/sqrt(s)
+        or m/s^2/sqrt(s)), R (always 0: the model has no rate ramp), for a gyro or an accelerometer triad.
+    """
     return {"Q": errors.quantization[axis], "N": errors.random_walk[axis],
             "B": errors.bias_instability[axis] if errors.gm_sigma[axis] == 0 else 0.0,
             "K": errors.rate_random_walk[axis], "R": 0.0}
@@ -168,6 +254,20 @@ def expected_terms(errors: SensorErrors, axis: int, curve: AllanCurve) -> dict[s
     The simulated flicker is a band-limited Gauss-Markov sum and IEEE 952's B is
     flat at every tau, so even a noise-free curve fits N, B slightly off the
     true values; a round trip allows for that difference.
+
+    Parameters
+    ----------
+    errors : SensorErrors
+        The triad's error model.
+    axis : int
+        Body axis index: 0 x forward, 1 y right, 2 z down.
+    curve : AllanCurve
+        A measured curve whose averaging times (s) and edf the exact curve takes.
+
+    Returns
+    -------
+    dict of str to float
+        Term -> value identified on the exact curve, SI (the units of :func:`true_terms`).
     """
     exact = np.sqrt(errors.allan_variance(curve.tau_s, axis))
     model_curve = AllanCurve(tau_s=curve.tau_s, adev=exact, adev_lower=exact, adev_upper=exact, edf=curve.edf,
@@ -256,6 +356,18 @@ def model_from_analysis(result: AllanResult, name: str | None = None) -> ErrorMo
     zero; R has no counterpart (a rate ramp is a trend, not noise). Constant
     biases, scale factors and misalignments cannot be seen in an Allan curve and
     stay zero.
+
+    Parameters
+    ----------
+    result : AllanResult
+        The analysis of the six channels.
+    name : str, optional
+        Name of the model (not set: "identified from" the analysed record).
+
+    Returns
+    -------
+    ErrorModel
+        Gyro and accelerometer triads, SI.
     """
     def triad(sensor: str) -> SensorErrors:
         values = {term: np.zeros(3) for term in ("Q", "N", "B", "K")}

@@ -90,9 +90,15 @@ def gauss_markov_allan_variance(tau, sigma: float, correlation_time: float):
     tau : float or ndarray
         Averaging time, s (> 0).
     sigma : float
-        Stationary standard deviation of the process.
+        Stationary standard deviation of the process, in the rate's unit (rad/s for a gyro, m/s^2 for an
+        accelerometer); the result is in its square.
     correlation_time : float
         T, s.
+
+    Returns
+    -------
+    float or ndarray
+        sigma_A^2 at each ``tau``, (units of sigma)^2, the shape of ``tau``.
 
     Notes
     -----
@@ -113,7 +119,21 @@ GAUSS_MARKOV_PEAK = _gm_peak()
 
 
 def gauss_markov_for_bias_instability(bias_instability: float, correlation_time: float) -> float:
-    """The Gauss-Markov sigma whose Allan-deviation peak equals the flicker floor of B: sigma = B 0.6643 / 0.6174."""
+    """The Gauss-Markov sigma whose Allan-deviation peak equals the flicker floor of B: sigma = B 0.6643 / 0.6174.
+
+    Parameters
+    ----------
+    bias_instability : float
+        B (IEEE 952), rad/s (gyro) or m/s^2 (accelerometer).
+    correlation_time : float
+        T of the Gauss-Markov process, s. The peak ratio does not depend on it (the peak only moves to
+        tau = 1.893 T), so it does not enter the result.
+
+    Returns
+    -------
+    float
+        Stationary standard deviation sigma of the Gauss-Markov bias, in the unit of ``bias_instability``.
+    """
     return bias_instability * FLICKER_FLOOR / GAUSS_MARKOV_PEAK[1]
 
 
@@ -145,7 +165,7 @@ def flicker_terms(bias_instability: float, tau_range: tuple[float, float],
     tau_range : (float, float)
         Averaging times, s, over which the Allan deviation should be flat.
     per_decade : int
-        Terms per decade of correlation time.
+        Terms per decade of correlation time, number of.
 
     Returns
     -------
@@ -242,7 +262,18 @@ class SensorErrors:
             object.__setattr__(self, f.name, value)
 
     def scaled(self, factor: float) -> SensorErrors:
-        """Every magnitude times ``factor`` (correlation times and tau range kept)."""
+        """Every magnitude times ``factor`` (correlation times and tau range kept).
+
+        Parameters
+        ----------
+        factor : float
+            Scale of every error magnitude, plain number (0.5 halves them).
+
+        Returns
+        -------
+        SensorErrors
+            A copy with the scaled magnitudes.
+        """
         keep = {"flicker_tau_range_s", "gm_correlation_time_s"}
         return replace(self, **{f.name: getattr(self, f.name) * factor for f in fields(self) if f.name not in keep})
 
@@ -250,6 +281,18 @@ class SensorErrors:
         """The model's Allan variance on ``axis`` at averaging times ``tau`` (s): IEEE 952 terms + Gauss-Markov.
 
         The flicker term is represented by its Gauss-Markov sum (what the simulation produces).
+
+        Parameters
+        ----------
+        tau : float or array_like
+            Averaging times tau, s (> 0).
+        axis : int
+            Body axis index: 0 x forward, 1 y right, 2 z down.
+
+        Returns
+        -------
+        ndarray
+            sigma^2(tau), the shape of ``tau``: (rad/s)^2 for a gyro triad, (m/s^2)^2 for an accelerometer triad.
         """
         tau = np.asarray(tau, dtype=float)
         q, n, k = self.quantization[axis], self.random_walk[axis], self.rate_random_walk[axis]
@@ -291,5 +334,16 @@ class ErrorModel:
                                    "g-sensitivity is a gyro error; leave it 0 for accelerometers")
 
     def scaled(self, factor: float) -> ErrorModel:
-        """Every error magnitude times ``factor`` (a first-order check halves them and expects half the effect)."""
+        """Every error magnitude times ``factor`` (a first-order check halves them and expects half the effect).
+
+        Parameters
+        ----------
+        factor : float
+            Scale of every error magnitude of both triads, plain number (correlation times and tau ranges kept).
+
+        Returns
+        -------
+        ErrorModel
+            A copy with both triads scaled, same name, source and notes.
+        """
         return replace(self, gyro=self.gyro.scaled(factor), accel=self.accel.scaled(factor))

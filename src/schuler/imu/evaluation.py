@@ -82,7 +82,20 @@ PARAMETERS = ParameterSet((
 
 
 def output_name(channel: str, term: str) -> str:
-    """Flat output key of a channel's term: ``noise_gyro_x_N`` (the JSON's ``noise.gyro_x.N``)."""
+    """Flat output key of a channel's term: ``noise_gyro_x_N`` (the JSON's ``noise.gyro_x.N``).
+
+    Parameters
+    ----------
+    channel : str
+        One of :data:`~schuler.imu.results.CHANNELS` (``gyro_x`` .. ``accel_z``).
+    term : str
+        An IEEE 952 term letter, one of :data:`OUTPUT_TERMS`.
+
+    Returns
+    -------
+    str
+        The output's name.
+    """
     return f"noise_{channel}_{term}"
 
 
@@ -96,17 +109,56 @@ OUTPUTS = (
 
 
 def case_model(grade: str | None, spec: str | None) -> ErrorModel:
-    """The error model of a case: the spec file when given, else the grade preset."""
+    """The error model of a case: the spec file when given, else the grade preset.
+
+    Parameters
+    ----------
+    grade : str or None
+        Grade preset, one of :data:`~schuler.imu.spec.GRADES` (None: the default, tactical).
+    spec : str or None
+        Path of a TOML spec file (figures in spec-sheet units); when set it wins over ``grade``.
+
+    Returns
+    -------
+    ErrorModel
+        The IMU's error terms, SI.
+    """
     return load_spec_file(spec) if spec else preset(grade or PARAMETERS["grade"].default)
 
 
 def sample_interval(imu_rate: float, output_step: float | None) -> float:
-    """dt, s: ``output_step`` when set, else 1 / ``imu_rate``."""
+    """dt, s: ``output_step`` when set, else 1 / ``imu_rate``.
+
+    Parameters
+    ----------
+    imu_rate : float
+        Sample rate, Hz.
+    output_step : float or None
+        Sample interval, s; None or NaN: not set.
+
+    Returns
+    -------
+    float
+        Sample interval dt, s.
+    """
     return float(output_step) if output_step is not None and not math.isnan(output_step) else 1.0 / float(imu_rate)
 
 
 def record_samples(duration: float, dt: float) -> int:
-    """Samples of a record, refused below :data:`MIN_SAMPLES` and beyond the memory budget."""
+    """Samples of a record, refused below :data:`MIN_SAMPLES` and beyond the memory budget.
+
+    Parameters
+    ----------
+    duration : float
+        Length of the record, s.
+    dt : float
+        Sample interval, s.
+
+    Returns
+    -------
+    int
+        round(duration / dt), number of samples.
+    """
     samples = int(round(duration / dt))
     if samples < MIN_SAMPLES:
         raise InvalidParameter("duration", f"{duration:g} s at {dt:g} s per sample gives {samples:,} samples; an "
@@ -128,7 +180,18 @@ def _round_trip(case: Case, seed: int, member: int, models: dict) -> tuple[Error
 
 
 def outputs_of(trip: RoundTripResult) -> dict[str, float]:
-    """The flat outputs of one round trip: identified terms (NaN unless resolved) and the share within tolerance."""
+    """The flat outputs of one round trip: identified terms (NaN unless resolved) and the share within tolerance.
+
+    Parameters
+    ----------
+    trip : RoundTripResult
+        The simulated record's analysis and its checks against the true terms.
+
+    Returns
+    -------
+    dict of str to float
+        Output name (:data:`OUTPUTS`) -> value, SI (NaN: a term not resolved; the share NaN without checks).
+    """
     out = {}
     for channel in CHANNELS:
         terms = trip.analysis.noise[channel].terms
@@ -140,7 +203,19 @@ def outputs_of(trip: RoundTripResult) -> dict[str, float]:
 
 
 def evaluate(cases: Cases) -> dict[str, np.ndarray]:
-    """Every output of :data:`OUTPUTS` for a batch of cases: one simulated record per case (see the module notes)."""
+    """Every output of :data:`OUTPUTS` for a batch of cases: one simulated record per case (see the module notes).
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values); the record's random numbers from ``cases.random`` (seed
+        :data:`NOMINAL_SEED` when None) at ``cases.members``.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Output name -> values of shape (number of cases,), SI.
+    """
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     seed = NOMINAL_SEED if cases.random is None else cases.random.seed
@@ -154,6 +229,18 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
 
 def run_case(case: Case, fidelity: str | None = None) -> ImuRunResult:
     """One case in full: the round trip of the nominal record (seed 0, member 0) with its Allan curves.
+
+    Parameters
+    ----------
+    case : Case
+        Every parameter of :data:`PARAMETERS`, SI.
+    fidelity : str or None
+        The contract's evaluation fidelity; this system has a single way of evaluating, so it is not used.
+
+    Returns
+    -------
+    ImuRunResult
+        The model, the round trip with its curves, the outputs (SI) and the true terms per channel.
 
     Examples
     --------
@@ -172,7 +259,18 @@ def run_case(case: Case, fidelity: str | None = None) -> ImuRunResult:
 
 
 def member_bytes(case: Case) -> int:
-    """Memory one member holds while evaluated: its record and analysis (:data:`BYTES_PER_SAMPLE` per sample)."""
+    """Memory one member holds while evaluated: its record and analysis (:data:`BYTES_PER_SAMPLE` per sample).
+
+    Parameters
+    ----------
+    case : Case
+        The member's parameters, SI (``duration`` s, ``imu_rate`` Hz, ``output_step`` s).
+
+    Returns
+    -------
+    int
+        Memory, bytes.
+    """
     dt = sample_interval(case["imu_rate"], case["output_step"])
     return int(BYTES_PER_SAMPLE * max(1.0, case["duration"] / dt))
 

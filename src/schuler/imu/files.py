@@ -26,7 +26,21 @@ from schuler.imu.record import ImuInfo, ImuRecord, info_from_means
 
 
 def open_record(path, **options) -> RecordSource:
-    """Open an IMU file by its suffix; keyword options go to :func:`~schuler.imu.readers.open_csv` (CSV only)."""
+    """Open an IMU file by its suffix; keyword options go to :func:`~schuler.imu.readers.open_csv` (CSV only).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file: ``.imu`` (PSINS), ``.parquet`` (native) or anything else (CSV).
+    **options
+        Keywords of :func:`~schuler.imu.readers.open_csv` (column mapping, units, kind, axes, site in rad and m);
+        refused for ``.imu`` and ``.parquet``.
+
+    Returns
+    -------
+    RecordSource
+        The opened file: metadata and an iterator over its chunks, nothing read yet beyond the header.
+    """
     path = Path(path)
     if not path.is_file():
         raise ImuFileError(path, "no such file")
@@ -41,7 +55,22 @@ def open_record(path, **options) -> RecordSource:
 
 
 def read_record(path, max_memory_bytes: int = DEFAULT_MAX_MEMORY_BYTES, **options) -> ImuRecord:
-    """Read an IMU file into memory (see :func:`open_record`); refuses files over ``max_memory_bytes``."""
+    """Read an IMU file into memory (see :func:`open_record`); refuses files over ``max_memory_bytes``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file (any format of :func:`open_record`).
+    max_memory_bytes : int
+        Largest memory the record may need while being built, bytes (default 2 GiB).
+    **options
+        Keywords of :func:`~schuler.imu.readers.open_csv` (CSV only).
+
+    Returns
+    -------
+    ImuRecord
+        The whole record, rates in SI, body axes x forward, y right, z down.
+    """
     return open_record(path, **options).read(max_memory_bytes)
 
 
@@ -50,6 +79,19 @@ def file_info(path, **options) -> ImuInfo:
 
     Every chunk is read and checked (time steps, finite values), so a damaged
     line is reported wherever it is; ``options`` as for :func:`open_record`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file (any format of :func:`open_record`).
+    **options
+        Keywords of :func:`~schuler.imu.readers.open_csv` (CSV only).
+
+    Returns
+    -------
+    ImuInfo
+        Samples, kind, sample interval (s), mean gyro rate (rad/s) and specific force (m/s^2), body axes, and the
+        site the file states.
     """
     source = open_record(path, **options)
     samples, gyro, accel = 0, np.zeros(3), np.zeros(3)
@@ -66,7 +108,20 @@ def file_info(path, **options) -> ImuInfo:
 
 
 def write_record(record: ImuRecord, path) -> Path:
-    """Write a record: ``.parquet`` native, ``.csv`` the project's CSV (rates, SI)."""
+    """Write a record: ``.parquet`` native, ``.csv`` the project's CSV (rates, SI).
+
+    Parameters
+    ----------
+    record : ImuRecord
+        The samples to write.
+    path : str or Path
+        Output file; its suffix (``.parquet`` or ``.csv``) chooses the format.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     suffix = Path(path).suffix.lower()
     if suffix == ".parquet":
         return write_parquet(record, path)

@@ -63,7 +63,18 @@ DEFAULT_LATITUDE = math.radians(45.0)
 
 
 def instrument_options(system: str) -> ParameterSet:
-    """The options ``system``'s run gets from the IMU layer (empty when it has none)."""
+    """The options ``system``'s run gets from the IMU layer (empty when it has none).
+
+    Parameters
+    ----------
+    system : str
+        A system's name; only those of :data:`IMU_SYSTEMS` get options.
+
+    Returns
+    -------
+    ParameterSet
+        ``imu``, plus ``imu_window`` (align, errors) and ``imu_latitude`` (errors).
+    """
     if system not in IMU_SYSTEMS:
         return ParameterSet((), owner=system)
     options = [IMU_OPTION]
@@ -103,7 +114,27 @@ def resolve_model(text: str, base: Path | None = None) -> ErrorModel:
 
 def system_inputs(system: str, model: ErrorModel, case: Case, *, window_s: float | None = None,
                   latitude_rad: float | None = None) -> SystemInputs:
-    """The mapping for one system: :mod:`~schuler.imu.system_inputs` with what it needs from the case."""
+    """The mapping for one system: :mod:`~schuler.imu.system_inputs` with what it needs from the case.
+
+    Parameters
+    ----------
+    system : {"align", "calibrate", "north", "errors"}
+        The system whose parameters the IMU sets.
+    model : ErrorModel
+        The IMU, SI.
+    case : Case
+        The system's case, SI: align uses its ``azimuth`` (rad), north its ``output_step`` (s), errors its
+        ``source``.
+    window_s : float, optional
+        Time between the gyro calibration and use, s (align, errors; not set: 600 s).
+    latitude_rad : float, optional
+        Latitude of the errors system's static gyrocompassing limit, rad (not set: 45 deg).
+
+    Returns
+    -------
+    SystemInputs
+        The system's parameter values and Monte Carlo sigmas, SI, with their units and notes.
+    """
     window = DEFAULT_WINDOW_S if window_s is None else window_s
     if system == "align":
         return align_inputs(model, heading_rad=case["azimuth"], window_s=window)
@@ -124,6 +155,28 @@ def system_inputs(system: str, model: ErrorModel, case: Case, *, window_s: float
 def apply_instrument(system: str, parameters: ParameterSet, case: Case, imu: str, *, window_s: float | None = None,
                      latitude_rad: float | None = None, base: Path | None = None) -> tuple[Case, SystemInputs]:
     """The case with the IMU's values for every parameter the user did not give, and the mapping used.
+
+    Parameters
+    ----------
+    system : {"align", "calibrate", "north", "errors"}
+        The system being run.
+    parameters : ParameterSet
+        The system's parameters (the merged case is validated against them).
+    case : Case
+        The case as the user gave it, SI; its ``given`` names win over the IMU's values.
+    imu : str
+        A grade name, a ``.toml`` spec file or a recording (``.csv``, ``.imu``, ``.parquet``).
+    window_s : float, optional
+        Time between the gyro calibration and use, s (not set: 600 s).
+    latitude_rad : float, optional
+        Latitude of the errors system's static gyrocompassing limit, rad (not set: 45 deg).
+    base : Path, optional
+        Folder relative paths in ``imu`` start from (a scenario's folder); default: the current one.
+
+    Returns
+    -------
+    case, inputs : Case, SystemInputs
+        The merged, validated case and the mapping used.
 
     Raises
     ------

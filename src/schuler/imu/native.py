@@ -73,7 +73,18 @@ class ParquetRecordWriter:
         self.path = Path(path)
 
     def write(self, time_s, gyro, accel) -> None:
-        """Append ``time_s`` (n,), ``gyro`` (n, 3), ``accel`` (n, 3) as one row group."""
+        """Append ``time_s`` (n,), ``gyro`` (n, 3), ``accel`` (n, 3) as one row group.
+
+        Parameters
+        ----------
+        time_s : array_like
+            Time at the end of each sample interval, s, shape (n,).
+        gyro : array_like
+            Gyro samples, shape (n, 3), body axes x forward, y right, z down: rad/s (``kind="rate"``) or rad
+            (``kind="increment"``).
+        accel : array_like
+            Accelerometer samples, shape (n, 3), body axes: m/s^2 (rate) or m/s (increment).
+        """
         import pyarrow as pa
 
         gyro, accel = np.asarray(gyro, dtype=float), np.asarray(accel, dtype=float)
@@ -99,7 +110,22 @@ class ParquetRecordWriter:
 
 
 def write_parquet(record: ImuRecord, path, rows_per_group: int = 1 << 20) -> Path:
-    """Write a record in the native format; returns the path."""
+    """Write a record in the native format; returns the path.
+
+    Parameters
+    ----------
+    record : ImuRecord
+        The samples and their metadata (kind, sample interval, site, attitude, gravity, source).
+    path : str or Path
+        Output file (appears atomically).
+    rows_per_group : int
+        Samples per Parquet row group, number of (the chunk a reader streams).
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     with ParquetRecordWriter(path, record.kind, record.sample_interval_s, latitude_rad=record.latitude_rad,
                              longitude_rad=record.longitude_rad, height_m=record.height_m,
                              initial_attitude_rad=record.initial_attitude_rad, gravity_m_s2=record.gravity_m_s2,
@@ -111,7 +137,18 @@ def write_parquet(record: ImuRecord, path, rows_per_group: int = 1 << 20) -> Pat
 
 
 def open_parquet(path) -> RecordSource:
-    """Open a native file: metadata now, samples chunk by chunk."""
+    """Open a native file: metadata now, samples chunk by chunk.
+
+    Parameters
+    ----------
+    path : str or Path
+        A ``.parquet`` file written by :func:`write_parquet` or :class:`ParquetRecordWriter`.
+
+    Returns
+    -------
+    RecordSource
+        Kind, sample interval (s), exact sample count and site; chunks in SI, body axes.
+    """
     import pyarrow.parquet as pq
 
     path = Path(path)

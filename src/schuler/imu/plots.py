@@ -80,6 +80,22 @@ def channel_curves(result: AllanResult, sensor: str = "gyro", true_model: ErrorM
 
     Markers: the overlapping Allan deviation of x, y, z with 68 % bars; lines:
     the IEEE 952 fit of each; dotted: the true model's curve when given.
+
+    Parameters
+    ----------
+    result : AllanResult
+        The analysis whose curves (SI) are drawn; gyros shown in deg/h, accelerometers in ug.
+    sensor : {"gyro", "accel"}
+        Which triad's three axes to draw.
+    true_model : ErrorModel, optional
+        Draw the model's exact curve too (round trips).
+    title : str, optional
+        Title of the plot (not set: "<sensor> Allan deviation").
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, 6.5 x 4.4 in.
     """
     import matplotlib
 
@@ -114,7 +130,21 @@ def channel_curves(result: AllanResult, sensor: str = "gyro", true_model: ErrorM
 
 
 def monte_carlo_figure(summary, true_terms: dict):
-    """Identified / true of each resolved term over the Monte Carlo records, gyro x and accelerometer x."""
+    """Identified / true of each resolved term over the Monte Carlo records, gyro x and accelerometer x.
+
+    Parameters
+    ----------
+    summary : MonteCarloSummary
+        The Monte Carlo of ``schuler imu run``: its ``samples`` of ``noise_<channel>_<term>`` (SI) per member.
+    true_terms : dict of str to dict of str to float
+        Channel -> term -> true value, SI (:attr:`~schuler.imu.run_results.ImuRunResult.true_terms`); the ratio
+        identified / true is a plain number, so only matching units matter.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Box plots of the ratios (terms with a zero true value or no finite sample are left out).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -141,7 +171,22 @@ def monte_carlo_figure(summary, true_terms: dict):
 
 
 def write_figures(figures: dict, outdir, formats=("png", "svg")) -> list[Path]:
-    """Save figures (stem -> Figure) into ``outdir`` in ``formats``; returns the paths."""
+    """Save figures (stem -> Figure) into ``outdir`` in ``formats``; returns the paths.
+
+    Parameters
+    ----------
+    figures : dict of str to matplotlib.figure.Figure
+        File stem -> figure.
+    outdir : str or Path
+        Folder to write into.
+    formats : tuple of str
+        File formats (suffixes without the dot), e.g. ``("png", "svg")``.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     paths = []
     for stem, fig in figures.items():
         paths += save_figure_formats(fig, Path(outdir) / stem, formats)

@@ -106,7 +106,19 @@ class RecordSource:
     metadata: dict = field(default_factory=dict)
 
     def chunks(self, rows: int = CHUNK_ROWS) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        """Yield ``(time_s, gyro, accel)`` chunks of at most ``rows`` samples, checked for continuity."""
+        """Yield ``(time_s, gyro, accel)`` chunks of at most ``rows`` samples, checked for continuity.
+
+        Parameters
+        ----------
+        rows : int
+            Largest chunk, number of samples (>= 2).
+
+        Yields
+        ------
+        time_s, gyro, accel : ndarray
+            Times, s, shape (n,); gyro and accelerometer samples, shape (n, 3), body axes x forward, y right,
+            z down, in the units of ``kind`` (rad/s and m/s^2, or rad and m/s).
+        """
         if int(rows) < 2:
             raise InvalidParameter("rows", f"chunk size must be >= 2, got {rows!r}")
         checker = _TimeCheck(self.path, self.sample_interval_s, self.metadata.get("first_data_line", 2))
@@ -127,7 +139,18 @@ class RecordSource:
         return int(self.estimated_samples * _BYTES_PER_SAMPLE)
 
     def read(self, max_memory_bytes: int = DEFAULT_MAX_MEMORY_BYTES) -> ImuRecord:
-        """The whole file as an :class:`ImuRecord`, refused when it would need more than ``max_memory_bytes``."""
+        """The whole file as an :class:`ImuRecord`, refused when it would need more than ``max_memory_bytes``.
+
+        Parameters
+        ----------
+        max_memory_bytes : int
+            Largest memory the record may need while being built, bytes (default 2 GiB).
+
+        Returns
+        -------
+        ImuRecord
+            Every sample, in the units of ``kind``, with the file's metadata.
+        """
         needed = self.estimated_bytes()
         if needed > max_memory_bytes:
             raise ImuFileError(self.path, f"about {self.estimated_samples:,} samples need ~{needed / 1e9:.1f} GB in "
@@ -187,6 +210,16 @@ class _TimeCheck:
 
 def detect_encoding(path) -> str:
     """The text encoding to read ``path`` with: 'utf-8-sig', 'utf-16', 'utf-8' or 'latin-1'.
+
+    Parameters
+    ----------
+    path : str or Path
+        The text file; its first 64 KiB decide.
+
+    Returns
+    -------
+    str
+        A codec name for :func:`open`.
 
     Raises
     ------
@@ -416,6 +449,11 @@ def _check_accel_units(path, accel, scales, mapping, names, first_line) -> None:
 def open_psins(path) -> RecordSource:
     """Open a PSINS ``.imu`` text file (see the module notes for the format and frames).
 
+    Parameters
+    ----------
+    path : str or Path
+        The ``.imu`` file (three numeric header lines, then integer counts).
+
     Returns
     -------
     RecordSource
@@ -497,6 +535,18 @@ def psins_attitude_to_ned(pitch_deg: float, roll_deg: float, yaw_deg: float) -> 
     NED is ``T C_b^n P^T`` with T the ENU -> NED swap and P :func:`axes_matrix`
     ("RFU"), read back as aerospace roll, pitch, heading (Euler z-y-x).
 
+    Parameters
+    ----------
+    pitch_deg, roll_deg, yaw_deg : float
+        PSINS attitude of the file's first header line, deg (yaw positive towards west).
+
+    Returns
+    -------
+    roll, pitch, heading : float
+        Attitude of the x-forward/y-right/z-down body in NED, rad; heading in [0, 2 pi).
+
+    Examples
+    --------
     >>> [round(math.degrees(a), 6) for a in psins_attitude_to_ned(0.0, 0.0, -90.6)]
     [0.0, 0.0, 90.6]
     """
@@ -510,7 +560,20 @@ def psins_attitude_to_ned(pitch_deg: float, roll_deg: float, yaw_deg: float) -> 
 
 
 def write_csv(record: ImuRecord, path) -> Path:
-    """Write a record in the project's CSV format (rates, SI), atomically."""
+    """Write a record in the project's CSV format (rates, SI), atomically.
+
+    Parameters
+    ----------
+    record : ImuRecord
+        The samples (increments are written as rates).
+    path : str or Path
+        Output file.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
     from schuler.io import atomic_path
 
     data = np.column_stack([record.time_s, record.gyro_rate_rad_s, record.accel_m_s2])

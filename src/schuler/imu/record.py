@@ -181,7 +181,19 @@ class ImuRecord:
                 **{f"accel_{a}": accel[:, i] for i, a in enumerate("xyz")}}
 
     def rotated(self, matrix) -> ImuRecord:
-        """The record with both triads rotated: ``v_new = matrix v`` (e.g. :func:`axes_matrix`)."""
+        """The record with both triads rotated: ``v_new = matrix v`` (e.g. :func:`axes_matrix`).
+
+        Parameters
+        ----------
+        matrix : array_like
+            Rotation from the record's axes to the new ones, array of shape (3, 3), plain numbers
+            (direction cosines).
+
+        Returns
+        -------
+        ImuRecord
+            A copy with gyro and accelerometer samples rotated; times and metadata kept.
+        """
         matrix = np.asarray(matrix, dtype=float)
         return dataclasses.replace(self, gyro=self.gyro @ matrix.T, accel=self.accel @ matrix.T)
 
@@ -279,6 +291,29 @@ def info_from_means(source: str, samples: int, kind: str, sample_interval_s: flo
 
     ``site``: ``latitude_rad``, ``longitude_rad``, ``height_m``, ``gravity_m_s2``,
     ``initial_attitude_rad`` where known.
+
+    Parameters
+    ----------
+    source : str
+        Name of the record (e.g. the file name).
+    samples : int
+        Samples in the record, number of.
+    kind : {"rate", "increment"}
+        What the file's sensor columns hold.
+    sample_interval_s : float
+        Sample interval dt, s.
+    mean_gyro_rad_s : array_like
+        Mean angular rate, rad/s, shape (3,), body axes x forward, y right, z down.
+    mean_accel_m_s2 : array_like
+        Mean specific force, m/s^2, shape (3,), body axes.
+    **site
+        ``latitude_rad``, ``longitude_rad`` (rad), ``height_m`` (m), ``gravity_m_s2`` (m/s^2),
+        ``initial_attitude_rad`` (roll, pitch, heading in NED, rad), each None or absent when unknown.
+
+    Returns
+    -------
+    ImuInfo
+        SI fields; the expected Earth-rate components when the latitude is known.
     """
     gyro = np.asarray(mean_gyro_rad_s, dtype=float)
     accel = np.asarray(mean_accel_m_s2, dtype=float)

@@ -112,7 +112,18 @@ def _grade_rows() -> list:
 
 
 def psins_path(recording: str | None) -> Path | None:
-    """The PSINS file: ``recording`` (must exist), else ``$SCHULER_PSINS_IMU`` when that file exists, else None."""
+    """The PSINS file: ``recording`` (must exist), else ``$SCHULER_PSINS_IMU`` when that file exists, else None.
+
+    Parameters
+    ----------
+    recording : str or None
+        Path the user gave (``--recording``); None or empty: not given.
+
+    Returns
+    -------
+    Path or None
+        The file to reproduce, or None when there is none.
+    """
     if recording:
         path = Path(recording)
         if not path.is_file():
@@ -129,7 +140,19 @@ def _quarters(record) -> list:
 
 
 def psins_rows(path: Path) -> tuple[list, dict, dict, AllanResult]:
-    """Rows, details (SI), their units and the Allan analysis of the PSINS recording."""
+    """Rows, details (SI), their units and the Allan analysis of the PSINS recording.
+
+    Parameters
+    ----------
+    path : Path
+        The PSINS ``lasergyro.imu`` file (its header must state the site latitude).
+
+    Returns
+    -------
+    rows, details, units, analysis : list, dict, dict, AllanResult
+        Comparison rows (latitude and heading in deg, specific force in m/s^2), details in SI, the units of
+        the details, and the Allan analysis of the six channels.
+    """
     record = read_record(path)
     if record.latitude_rad is None:
         raise InvalidParameter("recording", f"{path.name} states no site latitude; the PSINS reproduction reads a "
@@ -171,7 +194,19 @@ def psins_rows(path: Path) -> tuple[list, dict, dict, AllanResult]:
 
 
 def resolved_terms_text(analysis) -> str:
-    """The resolved terms of each channel in display units, one line (channels with none left out)."""
+    """The resolved terms of each channel in display units, one line (channels with none left out).
+
+    Parameters
+    ----------
+    analysis : AllanResult
+        The analysis whose resolved terms (SI) are written in display units (gyro N in deg/sqrt(h), B in deg/h
+        ..., :data:`~schuler.imu.results.DISPLAY_UNITS`).
+
+    Returns
+    -------
+    str
+        ``gyro_x N = ... deg/√h, ...; gyro_y ...``, or "none".
+    """
     parts = []
     for name, channel in analysis.noise.items():
         units = DISPLAY_UNITS[sensor_of(name)]
@@ -223,7 +258,18 @@ def reproduce(recording: str | None = None) -> Reproduction:
 
 
 def report(outdir: Path) -> ReportSection:
-    """Write this system's figures into ``outdir`` and describe them (a few seconds, more with the PSINS file)."""
+    """Write this system's figures into ``outdir`` and describe them (a few seconds, more with the PSINS file).
+
+    Parameters
+    ----------
+    outdir : Path
+        Folder the PNG figures are written into.
+
+    Returns
+    -------
+    ReportSection
+        The report's section: summary, comparison rows, figures with captions, commands and notes.
+    """
     from schuler.imu.plots import channel_curves, write_figures
 
     outdir = Path(outdir)

@@ -50,12 +50,34 @@ _SHOWN = {"deg/h^0.5": "deg/√h", "deg/h^1.5": "deg/h/√h", "m/s/h^0.5": "m/s/
 
 
 def shown_unit(unit: str) -> str:
-    """A display unit as people write it (deg/h^0.5 -> deg/√h)."""
+    """A display unit as people write it (deg/h^0.5 -> deg/√h).
+
+    Parameters
+    ----------
+    unit : str
+        A display unit as :mod:`schuler.units` parses it (e.g. a value of :data:`DISPLAY_UNITS`).
+
+    Returns
+    -------
+    str
+        The unit with square roots and micro written as such (units without a special form unchanged).
+    """
     return _SHOWN.get(unit, unit)
 
 
 def sensor_of(channel: str) -> str:
-    """'gyro' or 'accel'."""
+    """'gyro' or 'accel'.
+
+    Parameters
+    ----------
+    channel : str
+        A channel name, ``gyro_x`` .. ``accel_z`` (:data:`CHANNELS`).
+
+    Returns
+    -------
+    str
+        The sensor part of the name, "gyro" or "accel".
+    """
     return channel.split("_")[0]
 
 
@@ -111,7 +133,19 @@ class AllanResult(Result):
                 "units": dict(self.units)}
 
     def values(self, channel: str) -> dict[str, float]:
-        """Identified N, B, K, Q, R of a channel, SI."""
+        """Identified N, B, K, Q, R of a channel, SI.
+
+        Parameters
+        ----------
+        channel : str
+            A channel name, ``gyro_x`` .. ``accel_z``.
+
+        Returns
+        -------
+        dict of str to float
+            Term -> identified value in the units of :data:`TERM_UNITS` (unresolved terms too: check
+            ``noise[channel].terms.resolved``).
+        """
         return dict(self.noise[channel].terms.values)
 
     def render(self):

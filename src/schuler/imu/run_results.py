@@ -30,7 +30,19 @@ from schuler.results import Result, RunResult, json_safe
 
 
 def flat_unit(name: str) -> str:
-    """SI unit of a flat output: ``noise_gyro_x_N`` -> rad/s^0.5; anything else "1"."""
+    """SI unit of a flat output: ``noise_gyro_x_N`` -> rad/s^0.5; anything else "1".
+
+    Parameters
+    ----------
+    name : str
+        An output name of :data:`~schuler.imu.evaluation.OUTPUTS`.
+
+    Returns
+    -------
+    str
+        Its SI unit as :mod:`schuler.units` writes it (:data:`~schuler.imu.results.TERM_UNITS`), "1" for plain
+        numbers.
+    """
     parts = name.split("_")
     if len(parts) == 4 and parts[0] == "noise":
         return TERM_UNITS[parts[1]][parts[3]]
@@ -135,7 +147,19 @@ class SimulationResult(Result):
 
 
 def curves_frame(result: AllanResult):
-    """The six Allan curves as a table: tau_s, then adev, bounds and edf per channel (SI units in the names)."""
+    """The six Allan curves as a table: tau_s, then adev, bounds and edf per channel (SI units in the names).
+
+    Parameters
+    ----------
+    result : AllanResult
+        The analysis; every channel's curve shares the first channel's averaging times.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per averaging time: ``tau_s`` (s), ``<channel>_adev_rad_s`` / ``_m_s2`` with their lower and
+        upper bounds (rad/s or m/s^2) and ``<channel>_edf`` (plain number).
+    """
     import pandas as pd
 
     first = next(iter(result.noise.values())).curve
@@ -149,7 +173,24 @@ def curves_frame(result: AllanResult):
 
 
 def write_analysis(result: AllanResult, out_dir: Path, stem: str, true_model: ErrorModel | None = None) -> list[Path]:
-    """Allan figures of the gyros and accelerometers (PNG, SVG) and the curves as CSV."""
+    """Allan figures of the gyros and accelerometers (PNG, SVG) and the curves as CSV.
+
+    Parameters
+    ----------
+    result : AllanResult
+        The analysis to draw and tabulate.
+    out_dir : Path
+        Folder to write into.
+    stem : str
+        File name stem: ``<stem>_gyro.png``, ``<stem>_accel.svg``, ``<stem>.csv`` ...
+    true_model : ErrorModel, optional
+        Draw the model's exact curves too (round trips).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     from schuler.imu.plots import allan_figure, write_figures
     from schuler.io import write_dataframe_csv
 
@@ -159,7 +200,21 @@ def write_analysis(result: AllanResult, out_dir: Path, stem: str, true_model: Er
 
 
 def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """Figures and CSV of a run (with its Monte Carlo), an Allan analysis or the reproduction; nothing for the rest."""
+    """Figures and CSV of a run (with its Monte Carlo), an Allan analysis or the reproduction; nothing for the rest.
+
+    Parameters
+    ----------
+    result : Result
+        What an ``imu`` command returned: :class:`ImuRunResult`, :class:`~schuler.imu.results.AllanResult`,
+        a :class:`~schuler.reproduction.Reproduction`, or an info or simulation result (no files).
+    out_dir : Path
+        Folder to write into.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     from schuler.imu.plots import monte_carlo_figure, write_figures
 
     out_dir = Path(out_dir)

@@ -114,6 +114,21 @@ def residual_bias(errors: SensorErrors, window_s: float, include_turn_on: bool) 
 
     ``sigma_A,slow`` is the Allan deviation of the slow terms only (flicker,
     Gauss-Markov, rate random walk).
+
+    Parameters
+    ----------
+    errors : SensorErrors
+        The triad's error model, SI.
+    window_s : float
+        Time between the bias estimate and use, which is also the averaging window, s (> 0).
+    include_turn_on : bool
+        True: the turn-on bias b stays in the residual (nothing removed it); False: only its change counts.
+
+    Returns
+    -------
+    ndarray
+        Residual bias, shape (3,), body axes x forward, y right, z down: rad/s (gyro triad) or m/s^2
+        (accelerometer triad).
     """
     window_s = _check_window(window_s)
     slow = replace(errors, random_walk=np.zeros(3), quantization=np.zeros(3))
@@ -186,6 +201,16 @@ def calibrate_inputs(model: ErrorModel) -> SystemInputs:
     (= body y) and Y (= body x) gyros for the 1-sigma turn-on bias: what the
     procedure estimates; ``angle_random_walk`` (rad/sqrt(s)) is the rms of
     their N.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The IMU, SI; only its gyro turn-on bias and random walk are used.
+
+    Returns
+    -------
+    SystemInputs
+        ``drift_x``, ``drift_y`` (rad/s), ``angle_random_walk`` (rad/sqrt(s)), and the drifts' 1-sigma spreads.
     """
     bias, walk = model.gyro.bias, model.gyro.random_walk
     values = {"drift_x": float(-bias[1]), "drift_y": float(-bias[0]), "angle_random_walk": _horizontal_rms(walk)}
@@ -202,6 +227,18 @@ def north_inputs(model: ErrorModel, *, step_s: float) -> SystemInputs:
     angle random walk N sqrt(h) and the angle quantisation Q (IEEE 952, white
     angle noise of standard deviation Q): noise = sqrt(Q^2 + N^2 h) (z gyro, the
     azimuth axis).
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The IMU, SI; only the z gyro's quantisation Q (rad) and random walk N (rad/sqrt(s)) are used.
+    step_s : float
+        Sample step h of an azimuth observation, s (> 0; the ``north`` case's ``output_step``).
+
+    Returns
+    -------
+    SystemInputs
+        ``readout_noise``, rad, and the same value as its 1-sigma spread.
     """
     step_s = _check_window(step_s, "output_step")
     q, n = model.gyro.quantization[2], model.gyro.random_walk[2]
@@ -222,6 +259,20 @@ def errors_inputs(model: ErrorModel, *, latitude_rad: float, window_s: float = D
     * ``azimuth`` (rad): the gyrocompassing error sqrt((drift / (Omega cos L))^2 + (accelerometer tan L / g)^2)
       (the static limit of spec 06, independent east components);
     * ``velocity`` (m/s): 0, a start at rest knows its velocity.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The IMU, SI.
+    latitude_rad : float
+        Latitude L of the static gyrocompassing limit, rad (within +/-89 deg).
+    window_s : float
+        Time between the gyro calibration and use (also the averaging window), s.
+
+    Returns
+    -------
+    SystemInputs
+        Source name -> 1-sigma magnitude in the units above, and the same as sigmas (velocity has none).
     """
     latitude_rad = _check_latitude(latitude_rad)
     gyro = residual_bias(model.gyro, window_s, include_turn_on=False)

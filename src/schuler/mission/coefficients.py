@@ -73,6 +73,29 @@ def step_coefficients(trajectory, latitude: float, height: float, duration: floa
                       substeps: int = SUBSTEPS, rate: float = EARTH_RATE) -> StepCoefficients:
     """The trajectory's kinematics averaged over each step of ``step`` s (``duration`` a whole number of steps).
 
+    Parameters
+    ----------
+    trajectory : Stationary, GreatCircle or WaypointProfile
+        A trajectory of :mod:`schuler.navigate.trajectory`: ``kinematics(time)`` gives the NED velocity (m/s)
+        and the attitude quaternion q_bn.
+    latitude : float
+        Latitude L of the start point, rad.
+    height : float
+        Height h of the start point, m.
+    duration : float
+        Length of the analysis, s (rounded to whole steps).
+    step : float
+        Step over which the coefficients are frozen, s.
+    substeps : int
+        Points per step of the trapezoidal means, number of.
+    rate : float
+        Earth rate Omega, rad/s.
+
+    Returns
+    -------
+    StepCoefficients
+        Means over each of K = round(duration / step) steps, SI.
+
     Examples
     --------
     At rest the specific force holds the vehicle against gravity (with its centrifugal part):

@@ -101,17 +101,52 @@ class CovarianceBudget:
     states: int
 
     def horizontal(self, kind: str = "position") -> np.ndarray:
-        """Contributions to the horizontal variance (north + east), (K + 1, n_sources)."""
+        """Contributions to the horizontal variance (north + east), (K + 1, n_sources).
+
+        Parameters
+        ----------
+        kind : {"position", "velocity"}
+            Which horizontal error.
+
+        Returns
+        -------
+        ndarray
+            Each source's variance at each step boundary, shape (K + 1, n_sources): m^2 (position) or
+            (m/s)^2 (velocity).
+        """
         return self.variance[f"{kind}_north"] + self.variance[f"{kind}_east"]
 
     def sigma(self, channel: str) -> np.ndarray:
-        """1-sigma history of a channel (or ``horizontal_position``, ``horizontal_velocity``)."""
+        """1-sigma history of a channel (or ``horizontal_position``, ``horizontal_velocity``).
+
+        Parameters
+        ----------
+        channel : str
+            One of :data:`OUTPUT_CHANNELS`, or ``horizontal_position`` / ``horizontal_velocity``.
+
+        Returns
+        -------
+        ndarray
+            The total 1-sigma error (all sources) at each step boundary, shape (K + 1,): m (position), m/s
+            (velocity) or rad (heading).
+        """
         if channel.startswith("horizontal_"):
             return np.sqrt(self.horizontal(channel.removeprefix("horizontal_")).sum(axis=1))
         return np.sqrt(self.variance[channel].sum(axis=1))
 
     def shares(self, index: int = -1) -> dict[str, float]:
-        """Each source's share of the horizontal position-error variance at step boundary ``index`` (sum 1)."""
+        """Each source's share of the horizontal position-error variance at step boundary ``index`` (sum 1).
+
+        Parameters
+        ----------
+        index : int
+            Step boundary index into :attr:`time` (-1: the end of the mission).
+
+        Returns
+        -------
+        dict of str to float
+            Source -> share, plain number (all 0 when the variance is 0).
+        """
         contributions = self.horizontal()[index]
         total = contributions.sum()
         if total <= 0.0:
@@ -148,6 +183,24 @@ def _output_rows(coefficients: StepCoefficients, n: int) -> np.ndarray:
 def process_noise(F: np.ndarray, noise_input: np.ndarray, dt: float) -> np.ndarray:
     """Van Loan's discrete process noise of each step: integral of e^(F s) Qc e^(F^T s) over dt, (K, n, n).
 
+    Parameters
+    ----------
+    F : ndarray
+        System matrix of each step, shape (K, n, n), SI (psi-angle model: each state's rate per unit of each
+        state, states in m, m/s, rad).
+    noise_input : ndarray
+        G Q_c G^T of each step, shape (K, n, n): the white input's PSD mapped onto the state derivatives,
+        (state unit)^2 / s (e.g. rad^2/s on psi from an angle random walk N^2).
+    dt : float
+        Step length, s.
+
+    Returns
+    -------
+    ndarray
+        Q_k, shape (K, n, n), (state unit)^2, symmetrised.
+
+    Examples
+    --------
     >>> q = process_noise(np.zeros((1, 1, 1)), np.ones((1, 1, 1)), 2.0)
     >>> float(q[0, 0, 0])
     2.0

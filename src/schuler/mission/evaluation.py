@@ -88,7 +88,19 @@ _BUDGET_KEYS = tuple(p.name for p in PARAMETERS if p.name != "imu_rate")
 
 
 def budget_outputs(budget: CovarianceBudget) -> dict[str, float]:
-    """The covariance outputs of :data:`OUTPUTS` from a budget, SI."""
+    """The covariance outputs of :data:`OUTPUTS` from a budget, SI.
+
+    Parameters
+    ----------
+    budget : CovarianceBudget
+        The mission's covariance analysis.
+
+    Returns
+    -------
+    dict of str to float
+        Every output but ``member_position_error_m``: sigmas in m, m/s and rad, ``dominant_share`` a plain
+        number.
+    """
     shares = budget.shares()
     initial = budget.initial_covariance
     n = budget.states
@@ -110,7 +122,20 @@ def _values(cases: Cases, i: int) -> dict:
 
 
 def evaluate(cases: Cases) -> dict[str, np.ndarray]:
-    """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``)."""
+    """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values); with ``cases.random`` set, member ``cases.members[i]`` also flies
+        the nonlinear INS with its own draws.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Output name -> values of shape (number of cases,), SI (``member_position_error_m`` 0 without random
+        streams).
+    """
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     out["member_position_error_m"] = np.zeros(n)
@@ -128,6 +153,19 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
 def run_case(case: Case, fidelity: str | None = None) -> MissionResult:
     """One mission in full: the covariance outputs, the budget's shares and its histories.
 
+    Parameters
+    ----------
+    case : Case
+        Every parameter of :data:`PARAMETERS`, SI.
+    fidelity : str or None
+        The contract's evaluation fidelity; this system has a single way of evaluating, so it is not used.
+
+    Returns
+    -------
+    MissionResult
+        The outputs (SI), each source's share of the final horizontal position variance, the dominant source,
+        the instrument's name and the budget's histories.
+
     Examples
     --------
     >>> r = run_case(PARAMETERS.case(grade="navigation", trajectory="stationary", duration=3600.0))
@@ -144,7 +182,20 @@ def run_case(case: Case, fidelity: str | None = None) -> MissionResult:
 
 
 def member_bytes(case: Case) -> int:
-    """Memory one Monte Carlo member holds: its outputs and a block of noise and truth, bytes."""
+    """Memory one Monte Carlo member holds: its outputs and a block of noise and truth, bytes.
+
+    Parameters
+    ----------
+    case : Case
+        The member's parameters, SI. Not used: the estimate assumes two output points per member (the Monte
+        Carlo keeps only the start and the end) and a block of 4096 IMU intervals, whatever the duration and
+        rate, so it is the same for every case.
+
+    Returns
+    -------
+    int
+        Memory, bytes.
+    """
     return int(estimate_memory(1, 2, 4096, True)) + 64 * 1024
 
 

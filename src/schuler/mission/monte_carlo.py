@@ -85,6 +85,24 @@ class BlockWhiteNoise:
     seed: int = 0
 
     def increments(self, members, start: int, stop: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """The noise added to the angle and velocity increments of IMU intervals ``start .. stop - 1``.
+
+        Parameters
+        ----------
+        members : array_like of int
+            Global member numbers, shape (M,).
+        start, stop : int
+            Global index of the first IMU interval and one past the last, number of intervals (interval k ends
+            at t = (k + 1) dt).
+        dt : float
+            IMU interval, s.
+
+        Returns
+        -------
+        gyro, accel : ndarray
+            Shape (M, stop - start, 3), body axes: angle increment errors, rad, and velocity increment errors,
+            m/s (standard deviation N sqrt(dt) per axis).
+        """
         members = np.asarray(members, dtype=np.int64)
         first, last = start // NOISE_BLOCK, max(start, stop - 1) // NOISE_BLOCK
         width = (last - first + 1) * NOISE_BLOCK
@@ -115,7 +133,28 @@ class BlockWhiteNoise:
 
 def member_draws(setup: MissionSetup, members, streams: RandomStreams, n_states: int,
                  start_rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Each member's constant sources (N, n_sources, SI) and initial psi-model state (N, n_states)."""
+    """Each member's constant sources (N, n_sources, SI) and initial psi-model state (N, n_states).
+
+    Parameters
+    ----------
+    setup : MissionSetup
+        The mission: the 1-sigma of every source, SI.
+    members : array_like of int
+        Global member numbers, shape (N,).
+    streams : RandomStreams
+        The Monte Carlo's addressed random streams (``mission/<source>`` and ``mission/alignment/...``).
+    n_states : int
+        Number of states of the psi-angle model, 7 or 9.
+    start_rotation : ndarray
+        C_b^n at the start, shape (3, 3), plain numbers (direction cosines).
+
+    Returns
+    -------
+    draws, x0 : ndarray
+        Drawn values of :data:`~schuler.mission.setup.CONSTANT_SOURCES`, shape (N, n_sources), SI (rad/s,
+        m/s^2, plain-number scale factors, rad, m); initial states, shape (N, n_states), m, m/s and rad
+        (including the alignment's noise-limited residuals).
+    """
     members = np.asarray(members, dtype=np.int64)
     unit = np.stack([streams.normal(f"mission/{name}", members) for name in CONSTANT_SOURCES], axis=1)
     draws = unit * setup.constant_sigmas
@@ -129,7 +168,23 @@ def member_draws(setup: MissionSetup, members, streams: RandomStreams, n_states:
 
 
 def initial_errors(x0: np.ndarray, setup: MissionSetup, start_quaternion: np.ndarray) -> InitialErrors:
-    """The navigate layer's initial errors of psi-model states x0 (N, n) at rest (velocity error zero)."""
+    """The navigate layer's initial errors of psi-model states x0 (N, n) at rest (velocity error zero).
+
+    Parameters
+    ----------
+    x0 : ndarray
+        Psi-model states, shape (N, n): position errors north, east first (m), psi last three (rad, NED).
+    setup : MissionSetup
+        The mission: latitude (rad) and height (m) of the start.
+    start_quaternion : ndarray
+        True attitude q_bn at the start, shape (4,), plain numbers (unit quaternion, Hamilton, scalar first).
+
+    Returns
+    -------
+    InitialErrors
+        Position errors north and east (m) and roll, pitch, heading errors (rad) of the computed attitude,
+        errors = computed - true.
+    """
     L, h = setup.latitude, setup.height
     radius_north, radius_east = radii_of_curvature(L)
     north, east = x0[:, 0], x0[:, 1]
@@ -145,7 +200,26 @@ def initial_errors(x0: np.ndarray, setup: MissionSetup, start_quaternion: np.nda
 
 def run_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate: float,
                 output_step: float | None = None) -> NavigationResult:
-    """The nonlinear INS of the given members (global numbers), batched: their error histories."""
+    """The nonlinear INS of the given members (global numbers), batched: their error histories.
+
+    Parameters
+    ----------
+    setup : MissionSetup
+        The mission: trajectory, duration, vertical channel and the sources' sigmas, SI.
+    members : array_like of int
+        Global member numbers, shape (N,).
+    streams : RandomStreams
+        The Monte Carlo's addressed random streams.
+    imu_rate : float
+        IMU rate of the strapdown INS, Hz.
+    output_step : float, optional
+        Step of the error histories, s (not set: the mission's ``output_step``).
+
+    Returns
+    -------
+    NavigationResult
+        Each member's navigation errors along the trajectory, SI (computed - true).
+    """
     members = np.asarray(members, dtype=np.int64)
     trajectory = setup.trajectory()
     start_quaternion = trajectory.kinematics(np.array([0.0]))[1][0]
@@ -173,6 +247,17 @@ def run_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate: 
 
 
 def final_horizontal_errors(result: NavigationResult) -> np.ndarray:
-    """Each member's final horizontal position error sqrt(north^2 + east^2), m."""
+    """Each member's final horizontal position error sqrt(north^2 + east^2), m.
+
+    Parameters
+    ----------
+    result : NavigationResult
+        The members' error histories (position errors north and east, m).
+
+    Returns
+    -------
+    ndarray
+        Shape (N,), m.
+    """
     return np.hypot(np.atleast_2d(result.position_error_north_m)[:, -1],
                     np.atleast_2d(result.position_error_east_m)[:, -1])

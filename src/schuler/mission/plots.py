@@ -13,7 +13,18 @@ SHOWN_SOURCES = 8
 
 
 def stacked_budget(budget: CovarianceBudget):
-    """Horizontal position-error variance over time, stacked by source (largest final shares first)."""
+    """Horizontal position-error variance over time, stacked by source (largest final shares first).
+
+    Parameters
+    ----------
+    budget : CovarianceBudget
+        The mission's covariance analysis (variances in m^2, times in s; drawn in km^2 over hours).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two panels: the variance stacked by source, and each source's share of it.
+    """
     import matplotlib.pyplot as plt
 
     horizontal = budget.horizontal()
@@ -43,7 +54,22 @@ def stacked_budget(budget: CovarianceBudget):
 
 
 def write_figures(figures: dict, out_dir, formats=("png", "svg")) -> list[Path]:
-    """Save figures (stem -> Figure) into ``out_dir`` in ``formats``; returns the paths."""
+    """Save figures (stem -> Figure) into ``out_dir`` in ``formats``; returns the paths.
+
+    Parameters
+    ----------
+    figures : dict of str to matplotlib.figure.Figure
+        File stem -> figure.
+    out_dir : str or Path
+        Folder to write into.
+    formats : tuple of str
+        File formats (suffixes without the dot), e.g. ``("png", "svg")``.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     from schuler.io import save_figure_formats
 
     paths: list[Path] = []

@@ -102,7 +102,18 @@ def reproduce() -> Reproduction:
 
 
 def report(figures_dir: Path) -> ReportSection:
-    """The mission's section of the HTML report: the stage checks and a tactical 2-h cruise's budget."""
+    """The mission's section of the HTML report: the stage checks and a tactical 2-h cruise's budget.
+
+    Parameters
+    ----------
+    figures_dir : Path
+        Folder the budget figure (PNG) is written into.
+
+    Returns
+    -------
+    ReportSection
+        The report's section: the reproduction's rows, the budget figure with its caption, commands and notes.
+    """
     reproduction = reproduce()
     files = plots.write_figures({"mission_budget": plots.stacked_budget(reproduction.data)}, figures_dir,
                                 formats=("png",))

@@ -82,7 +82,22 @@ class MissionResult(RunResult):
 
 
 def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """The stacked budget plot (PNG, SVG) and the budget's histories (CSV) of a run."""
+    """The stacked budget plot (PNG, SVG) and the budget's histories (CSV) of a run.
+
+    Parameters
+    ----------
+    result : Result
+        What a ``mission`` command returned: a :class:`MissionResult` (files when it holds its history) or a
+        reproduction (no files).
+    out_dir : Path
+        Folder to write into.
+
+    Returns
+    -------
+    list of Path
+        The files written: ``mission_budget.png``, ``.svg`` and ``.csv`` (sigmas in m, m/s, rad and each
+        source's horizontal variance in m^2 over ``t_s``).
+    """
     import pandas as pd
 
     from schuler.io import write_dataframe_csv

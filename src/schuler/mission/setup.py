@@ -211,6 +211,20 @@ def error_model(grade: str, imu_spec: str | None, instrument: str | None = None)
     scale-factor errors: what calibration leaves of it is the noise floor and
     the slow terms' change. Else ``imu_spec`` (a TOML spec file), else the
     grade's preset.
+
+    Parameters
+    ----------
+    grade : str
+        Grade preset, one of :data:`~schuler.imu.spec.GRADES`.
+    imu_spec : str or None
+        Path of a TOML spec file; replaces the grade.
+    instrument : str, optional
+        A grade, a TOML spec file or a recording (``.csv``, ``.imu``, ``.parquet``); replaces both.
+
+    Returns
+    -------
+    ErrorModel
+        The instrument's errors, SI.
     """
     if instrument:
         path = Path(instrument)
@@ -235,6 +249,18 @@ def mission_setup(values) -> MissionSetup:
 
     With a ``profile`` file, its ``[start]`` table and first waypoint's heading
     are the start point and heading (where the alignment happens).
+
+    Parameters
+    ----------
+    values : Mapping of str to object
+        Every parameter of :data:`~schuler.mission.evaluation.PARAMETERS` by name, SI (latitude, longitude,
+        heading in rad; height in m; durations and steps in s; speed in m/s; ``pulse_relative_error`` a plain
+        ratio; ``north_reference_error`` in rad; ``initial_position_error`` in m), choices and paths as text.
+
+    Returns
+    -------
+    MissionSetup
+        The resolved mission: error model, stage choices, start point and trajectory.
     """
     if values["profile"]:
         profile = _profile(values["profile"])

@@ -82,6 +82,24 @@ def sensor_inputs(setup: MissionSetup, body_to_ned, body_rate, body_force) -> np
 
     ``body_to_ned`` (..., 3, 3), ``body_rate`` and ``body_force`` (..., 3): the
     rotation and the body's angular rate and specific force where they act.
+
+    Parameters
+    ----------
+    setup : MissionSetup
+        The mission (not used by the map itself: every source has unit size here).
+    body_to_ned : array_like
+        C_b^n, shape (..., 3, 3), plain numbers (direction cosines), body x forward, y right, z down.
+    body_rate : array_like
+        omega_ib^b, rad/s, shape (..., 3), body axes (what gyro scale factors multiply).
+    body_force : array_like
+        f^b, m/s^2, shape (..., 3), body axes (what accelerometer scale factors multiply).
+
+    Returns
+    -------
+    ndarray
+        Shape (..., n_sources, 6): NED accelerometer error nabla (m/s^2) then drift epsilon (rad/s) per unit
+        of each of :data:`~schuler.mission.setup.CONSTANT_SOURCES` (1 rad/s, 1 m/s^2, a scale factor of 1);
+        zero for the sources that act only through the initial state.
     """
     C = np.asarray(body_to_ned, dtype=float)
     rate = np.asarray(body_rate, dtype=float)
@@ -101,7 +119,19 @@ def _levelling(nabla: np.ndarray, gravity: float) -> tuple[np.ndarray, np.ndarra
 
 
 def gyrocompass_gains(setup: MissionSetup) -> tuple[float, float]:
-    """c_Gamma, c_a (1/s) of system 4's loop from its time constant and damping (KPI manual, Sec. 2)."""
+    """c_Gamma, c_a (1/s) of system 4's loop from its time constant and damping (KPI manual, Sec. 2).
+
+    Parameters
+    ----------
+    setup : MissionSetup
+        The mission: its ``gyrocompass_time_constant`` T (s), ``gyrocompass_damping`` zeta (plain number) and
+        ``latitude`` (rad).
+
+    Returns
+    -------
+    c_gamma, c_a : float
+        The loop's correction gains, 1/s.
+    """
     c_gamma, c_a = gains_from_design(setup.gyrocompass_time_constant, setup.gyrocompass_damping, setup.latitude)
     return float(c_gamma), float(c_a)
 
@@ -111,6 +141,21 @@ def initial_state_map(setup: MissionSetup, body_to_ned: np.ndarray, n_states: in
 
     States as :func:`schuler.navigation_errors.three_d.wgs84_psi_angle_model`
     (7 with the vertical channel off, 9 with it free).
+
+    Parameters
+    ----------
+    setup : MissionSetup
+        The mission: latitude (rad), height (m), alignment method and its gyrocompass design.
+    body_to_ned : ndarray
+        C_b^n at the start (where the alignment happens), shape (3, 3), plain numbers (direction cosines).
+    n_states : int
+        Number of states of the psi-angle model, 7 or 9.
+
+    Returns
+    -------
+    ndarray
+        Shape (n_sources, n_states): position (m), velocity (m/s) and psi (rad) errors per unit of each
+        constant source (1 rad/s, 1 m/s^2, 1 scale factor, 1 rad of north reference, 1 m of position).
     """
     L, g = setup.latitude, setup.gravity
     omega = earth_rate_ned(L, EARTH_RATE)
@@ -144,7 +189,24 @@ def initial_state_map(setup: MissionSetup, body_to_ned: np.ndarray, n_states: in
 
 
 def alignment_noise(setup: MissionSetup, body_to_ned: np.ndarray, n_states: int) -> dict[str, np.ndarray]:
-    """Initial covariance the white noises leave through the alignment: {source: (n, n)}."""
+    """Initial covariance the white noises leave through the alignment: {source: (n, n)}.
+
+    Parameters
+    ----------
+    setup : MissionSetup
+        The mission: latitude (rad), alignment method and duration T_a (s), angle random walk (rad/sqrt(s)) and
+        velocity random walk (m/s/sqrt(s)) per body axis.
+    body_to_ned : ndarray
+        C_b^n at the start, shape (3, 3), plain numbers (direction cosines).
+    n_states : int
+        Number of states of the psi-angle model, 7 or 9.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``gyro_random_walk`` and ``accel_random_walk`` -> covariance, shape (n_states, n_states), in the states'
+        units squared (only the psi block, rad^2, is non-zero).
+    """
     L, g, T = setup.latitude, setup.gravity, setup.alignment_duration
     ned_gyro = (body_to_ned**2) @ setup.gyro_random_walk**2
     ned_accel = (body_to_ned**2) @ setup.accel_random_walk**2
