@@ -34,6 +34,18 @@ import numpy as np
 def wrap_angle(angle):
     """Angle wrapped to (-pi, pi], rad.
 
+    Parameters
+    ----------
+    angle : float or array_like
+        Angle, rad, any shape.
+
+    Returns
+    -------
+    ndarray
+        The same angle in (-pi, pi], rad, shape of ``angle``.
+
+    Examples
+    --------
     >>> float(wrap_angle(3 * np.pi / 2))
     -1.5707963267948966
     """
@@ -44,6 +56,23 @@ def wrap_angle(angle):
 def quaternion_from_euler(roll, pitch, heading) -> np.ndarray:
     """q_bn from roll, pitch and heading (rad): q = q_z(psi) q_y(theta) q_x(phi), shape (..., 4).
 
+    Parameters
+    ----------
+    roll : float or array_like
+        Roll phi, rad (rotation about body x, forward).
+    pitch : float or array_like
+        Pitch theta, rad (rotation about body y, right; nose up positive).
+    heading : float or array_like
+        Heading psi, rad (rotation about z, down; clockwise from north seen from above).
+        The three angles broadcast against each other.
+
+    Returns
+    -------
+    ndarray
+        Unit quaternion q_bn, Hamilton, scalar first (plain numbers), shape (..., 4).
+
+    Examples
+    --------
     >>> quaternion_from_euler(0.0, 0.0, np.pi).round(12)
     array([0., 0., 0., 1.])
     """
@@ -62,6 +91,18 @@ def quaternion_from_euler(roll, pitch, heading) -> np.ndarray:
 def rotation_matrix(q) -> np.ndarray:
     """C_b^n = R(q) of unit quaternions, shape (..., 3, 3).
 
+    Parameters
+    ----------
+    q : array_like
+        Unit quaternions q_bn, Hamilton, scalar first, plain numbers, shape (..., 4).
+
+    Returns
+    -------
+    ndarray
+        Direction cosine matrices C_b^n (body to NED), dimensionless, shape (..., 3, 3).
+
+    Examples
+    --------
     >>> rotation_matrix(quaternion_from_euler(0.0, 0.0, np.pi / 2)).round(12) @ [1.0, 0.0, 0.0]
     array([0., 1., 0.])
     """
@@ -80,6 +121,16 @@ def euler_from_quaternion(q) -> np.ndarray:
 
     Pitch is taken by atan2 of the matrix's third row, so it stays accurate
     near +/- 90 deg (where roll and heading become one degree of freedom).
+
+    Parameters
+    ----------
+    q : array_like
+        Unit quaternions q_bn, Hamilton, scalar first, plain numbers, shape (..., 4).
+
+    Returns
+    -------
+    ndarray
+        Roll, pitch and heading, rad, shape (..., 3).
     """
     C = rotation_matrix(q)
     roll = np.arctan2(C[..., 2, 1], C[..., 2, 2])
@@ -89,7 +140,19 @@ def euler_from_quaternion(q) -> np.ndarray:
 
 
 def quaternion_multiply(p, q) -> np.ndarray:
-    """Hamilton product p q, shape (..., 4)."""
+    """Hamilton product p q, shape (..., 4).
+
+    Parameters
+    ----------
+    p, q : array_like
+        Quaternions, scalar first, plain numbers, shape (..., 4); they broadcast.
+        With rotation quaternions, p q applies q first, then p.
+
+    Returns
+    -------
+    ndarray
+        The product p q, plain numbers, shape (..., 4).
+    """
     p = np.asarray(p, dtype=float)
     q = np.asarray(q, dtype=float)
     p0, p1, p2, p3 = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
@@ -101,13 +164,36 @@ def quaternion_multiply(p, q) -> np.ndarray:
 
 
 def conjugate(q) -> np.ndarray:
-    """q* (the inverse rotation of a unit quaternion)."""
+    """q* (the inverse rotation of a unit quaternion).
+
+    Parameters
+    ----------
+    q : array_like
+        Quaternions, scalar first, plain numbers, shape (..., 4).
+
+    Returns
+    -------
+    ndarray
+        (q0, -q1, -q2, -q3), plain numbers, shape (..., 4).
+    """
     return np.asarray(q, dtype=float) * np.array([1.0, -1.0, -1.0, -1.0])
 
 
 def rotation_vector(q) -> np.ndarray:
     """Rotation vector (rad) of unit quaternions, the shorter of q and -q, shape (..., 3).
 
+    Parameters
+    ----------
+    q : array_like
+        Unit quaternions, Hamilton, scalar first, plain numbers, shape (..., 4).
+
+    Returns
+    -------
+    ndarray
+        Rotation vectors (axis times angle), rad, angle at most pi, shape (..., 3).
+
+    Examples
+    --------
     >>> rotation_vector(quaternion_from_rotation_vector([1e-9, 0.5, -2.0])).round(12)
     array([ 1.e-09,  5.e-01, -2.e+00])
     """
@@ -120,7 +206,18 @@ def rotation_vector(q) -> np.ndarray:
 
 
 def quaternion_from_rotation_vector(phi) -> np.ndarray:
-    """exp(phi / 2) for rotation vectors phi (rad), shape (..., 4)."""
+    """exp(phi / 2) for rotation vectors phi (rad), shape (..., 4).
+
+    Parameters
+    ----------
+    phi : array_like
+        Rotation vectors (axis times angle), rad, shape (..., 3).
+
+    Returns
+    -------
+    ndarray
+        Unit quaternions, Hamilton, scalar first, plain numbers, shape (..., 4).
+    """
     phi = np.asarray(phi, dtype=float)
     angle = np.linalg.norm(phi, axis=-1)
     # sin(a/2)/a = sinc(a / (2 pi)) / 2 in numpy's normalised sinc: exact at a = 0
@@ -134,6 +231,20 @@ def attitude_error(q_computed, q_true) -> np.ndarray:
     To first order C_computed = (I - [phi x]) C_true: phi is the small rotation
     of the computed attitude from the true one (spec 06's psi-angle sign).
 
+    Parameters
+    ----------
+    q_computed : array_like
+        Computed attitude q_bn, unit quaternions, scalar first, plain numbers, shape (..., 4).
+    q_true : array_like
+        True attitude q_bn, unit quaternions, scalar first, plain numbers, shape (..., 4).
+
+    Returns
+    -------
+    ndarray
+        Error rotation vector phi, rad, NED axes (north, east, down), shape (..., 3).
+
+    Examples
+    --------
     >>> q = quaternion_from_euler(0.0, 0.0, 0.3)
     >>> [round(float(x), 15) for x in attitude_error(quaternion_from_euler(0.0, 0.0, 0.3 + 1e-6), q)]
     [0.0, 0.0, -1e-06]

@@ -29,6 +29,18 @@ DISPLAY_UNITS = {"m": "m", "m_s": "m/s", "rad": "arcsec"}
 def suffix(name: str) -> str:
     """The SI suffix of a channel name: ``m``, ``m_s`` or ``rad``.
 
+    Parameters
+    ----------
+    name : str
+        Channel name, one of :data:`ERROR_CHANNELS` (or another name ending in its SI unit).
+
+    Returns
+    -------
+    str
+        The suffix, a key of :data:`DISPLAY_UNITS`.
+
+    Examples
+    --------
     >>> suffix("velocity_error_down_m_s"), suffix("roll_error_rad")
     ('m_s', 'rad')
     """
@@ -36,5 +48,17 @@ def suffix(name: str) -> str:
 
 
 def shown_channels(vertical_channel: str) -> tuple[str, ...]:
-    """The channels a run reports: all nine, or seven when the vertical channel is off."""
+    """The channels a run reports: all nine, or seven when the vertical channel is off.
+
+    Parameters
+    ----------
+    vertical_channel : {"free", "off", "baro"}
+        The run's vertical channel; ``"off"`` (height held to the truth) drops
+        the height and down-velocity errors.
+
+    Returns
+    -------
+    tuple of str
+        Channel names, in the order of :data:`ERROR_CHANNELS`.
+    """
     return tuple(c for c in ERROR_CHANNELS if vertical_channel != "off" or c not in VERTICAL_CHANNELS_OUTPUT)

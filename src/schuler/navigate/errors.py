@@ -108,7 +108,20 @@ class InitialErrors:
         return _batch_size(arrays, {name: () for name in arrays})
 
     def column(self, name: str, members: int) -> np.ndarray:
-        """A field broadcast to (members,)."""
+        """A field broadcast to (members,).
+
+        Parameters
+        ----------
+        name : str
+            Field name, e.g. ``"roll_error"``.
+        members : int
+            Batch size N, number of members.
+
+        Returns
+        -------
+        ndarray
+            The field's values, shape (members,), in the field's SI unit (m, m/s or rad).
+        """
         return np.broadcast_to(getattr(self, name), (members,))
 
     def apply_position(self, latitude, longitude, height, members: int):
@@ -117,6 +130,22 @@ class InitialErrors:
         Inverts north = dL (R_N(L_m) + h_m), east = dlambda (R_E(L_m) + h_m) cos L_m at
         the mean latitude L_m = L + dL/2 and height h_m = h + dh/2 by fixed-point
         iteration (each pass gains a factor ~ e^2 dL; four passes reach rounding).
+
+        Parameters
+        ----------
+        latitude : float
+            True geodetic latitude L, rad.
+        longitude : float
+            True longitude, rad.
+        height : float
+            True height h above the ellipsoid, m, up.
+        members : int
+            Batch size N, number of members.
+
+        Returns
+        -------
+        latitude, longitude, height : ndarray
+            Computed latitude (rad), longitude (rad) and height (m), each of shape (members,).
         """
         north = self.column("position_error_north", members)
         east = self.column("position_error_east", members)
@@ -192,7 +221,23 @@ class SensorErrors:
         return _batch_size({f.name: getattr(self, f.name) for f in fields(self)}, self._TAILS)
 
     def rows(self, sensor: str, members: int, invert: bool = False) -> np.ndarray:
-        """Kernel rows (members, 12): the matrix I + S + M (or its inverse), row-major, then the bias."""
+        """Kernel rows (members, 12): the matrix I + S + M (or its inverse), row-major, then the bias.
+
+        Parameters
+        ----------
+        sensor : {"gyro", "accel"}
+            Which sensor triad.
+        members : int
+            Batch size N, number of members.
+        invert : bool
+            Give (I + S + M)^-1 instead of I + S + M (the platform mechanization's gyros).
+
+        Returns
+        -------
+        ndarray
+            Shape (members, 12): the 3x3 matrix row-major (dimensionless), then the
+            bias in body axes (rad/s for the gyros, m/s^2 for the accelerometers).
+        """
         scale = np.broadcast_to(getattr(self, f"{sensor}_scale_factor"), (members, 3))
         forward = np.broadcast_to(getattr(self, f"{sensor}_misalignment"), (members, 3, 3)) + \
             np.eye(3) * (1.0 + scale)[:, None, :]
@@ -213,6 +258,25 @@ class SensorNoise(Protocol):
     """
 
     def increments(self, members: np.ndarray, start: int, stop: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Noise of the angle and velocity increments of IMU intervals ``start .. stop - 1``.
+
+        Parameters
+        ----------
+        members : ndarray of int
+            Global member numbers, shape (M,).
+        start : int
+            Index of the first IMU interval (global).
+        stop : int
+            Index one past the last IMU interval (global).
+        dt : float
+            IMU sample interval, s.
+
+        Returns
+        -------
+        gyro, accel : ndarray
+            Errors added to the angle increments (rad) and the velocity
+            increments (m/s), body axes x, y, z, each of shape (M, stop - start, 3).
+        """
         ...
 
 
@@ -244,6 +308,25 @@ class WhiteNoise:
                 raise InvalidParameter(name, f"must be finite and >= 0, got {value!r}")
 
     def increments(self, members, start: int, stop: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Normal increment errors of standard deviation N sqrt(dt), the :class:`SensorNoise` method.
+
+        Parameters
+        ----------
+        members : array_like of int
+            Global member numbers, shape (M,): a member's noise depends only on its number and the interval.
+        start : int
+            Index of the first IMU interval (global).
+        stop : int
+            Index one past the last IMU interval (global).
+        dt : float
+            IMU sample interval, s.
+
+        Returns
+        -------
+        gyro, accel : ndarray
+            Errors added to the angle increments (rad) and the velocity
+            increments (m/s), body axes x, y, z, each of shape (M, stop - start, 3).
+        """
         streams = RandomStreams(self.seed)
         members = np.asarray(members, dtype=np.int64)
         out = []

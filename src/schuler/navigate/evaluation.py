@@ -201,7 +201,19 @@ def _profile(text: str):
 
 
 def setup(case: Case) -> Setup:
-    """The shared part of a case (its trajectory built and checked, its error model or recording loaded)."""
+    """The shared part of a case (its trajectory built and checked, its error model or recording loaded).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case of :data:`PARAMETERS` (SI values: rad, m, m/s, s, Hz).
+
+    Returns
+    -------
+    Setup
+        The trajectory, time grid, mechanization, vertical channel and error
+        model (or recorded increments) its members share.
+    """
     if case["imu"] is not None and is_recording(case["imu"].strip()):
         recording = replay(case["imu"].strip(), case)
         return Setup(recording.trajectory, recording.duration, recording.imu_rate, case["output_step"],
@@ -235,7 +247,24 @@ def setup(case: Case) -> Setup:
 
 
 def member_errors(cases: Cases, shared: Setup, specific_force) -> tuple[InitialErrors, SensorErrors]:
-    """Each case's initial and constant sensor errors, with its random draws when ``cases.random`` is set."""
+    """Each case's initial and constant sensor errors, with its random draws when ``cases.random`` is set.
+
+    Parameters
+    ----------
+    cases : Cases
+        The batch's validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
+    shared : Setup
+        What the cases share (:func:`setup`): its error model adds its constant errors.
+    specific_force : array_like, shape (3,)
+        f0, the sensors' true specific force at the start, m/s^2, body axes (NED for the
+        platform; :func:`~schuler.navigate.imu_noise.initial_inputs`): the nominal case's
+        g-sensitivity G f0 joins the gyro bias.
+
+    Returns
+    -------
+    InitialErrors, SensorErrors
+        One entry per case (computed - true; bias = measured - true, body axes, SI).
+    """
     initial = {name: cases.float(name) for name in _INITIAL_SIGMAS}
     gyro = np.stack([cases.float(f"gyro_bias_{a}") for a in _AXES], axis=1)
     accel = np.stack([cases.float(f"accel_bias_{a}") for a in _AXES], axis=1)
@@ -264,7 +293,20 @@ def _noise_model(shared: Setup, cases: Cases) -> ErrorModel | None:
 
 
 def bytes_per_member(shared: Setup, noisy: ErrorModel | None) -> int:
-    """Memory one member of a run holds: its outputs and, with noise, its noise blocks and simulator state."""
+    """Memory one member of a run holds: its outputs and, with noise, its noise blocks and simulator state.
+
+    Parameters
+    ----------
+    shared : Setup
+        What the run's members share (its time grid sizes the outputs).
+    noisy : ErrorModel or None
+        The model whose noise the members draw (None: no noise).
+
+    Returns
+    -------
+    int
+        Memory per member, bytes.
+    """
     held = estimate_memory(2, shared.output_count, DEFAULT_CHUNK, noisy is not None) \
         - estimate_memory(1, shared.output_count, DEFAULT_CHUNK, noisy is not None)
     if noisy is not None:
@@ -283,6 +325,20 @@ def runs(cases: Cases, shared: Setup) -> Iterator[tuple[np.ndarray, NavigationRe
     """Run the cases as members of batched ``navigate`` calls, in parts that fit the memory budget.
 
     Yields (indices into ``cases``, the part's result with arrays of shape (members, outputs)).
+
+    Parameters
+    ----------
+    cases : Cases
+        Validated cases sharing ``shared`` (SI values; random terms from ``cases.random`` at ``cases.members``).
+    shared : Setup
+        What the cases share (:func:`setup`).
+
+    Yields
+    ------
+    index : ndarray of int
+        Indices into ``cases`` of the part's members.
+    result : NavigationResult
+        The part's error histories, arrays of shape (members, outputs), SI.
     """
     if shared.recorded is not None and cases.random is not None:
         _refuse_monte_carlo()
@@ -309,7 +365,18 @@ def runs(cases: Cases, shared: Setup) -> Iterator[tuple[np.ndarray, NavigationRe
 
 
 def reduce(result: NavigationResult) -> dict[str, np.ndarray]:
-    """The outputs of a batched run: each channel's final and largest absolute error per member."""
+    """The outputs of a batched run: each channel's final and largest absolute error per member.
+
+    Parameters
+    ----------
+    result : NavigationResult
+        A batched run's error histories, arrays of shape (members, outputs), SI.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Every output of :data:`OUTPUTS`, SI (m, m/s, rad), shape (members,).
+    """
     out = {}
     for channel in ERROR_CHANNELS:
         values = np.asarray(result.channel(channel))
@@ -326,6 +393,11 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
 
     Cases sharing a trajectory, time grid, mechanization and error model run as
     the members of one batched simulation.
+
+    Parameters
+    ----------
+    cases : Cases
+        A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
     """
     out = {output.name: np.full(len(cases), np.nan) for output in OUTPUTS}
     for index, group in cases.groups(*_GROUPED):
@@ -343,7 +415,15 @@ def _imu_name(case: Case, shared: Setup) -> str | None:
 
 
 def run_case(case: Case, fidelity: str | None = None) -> NavigateResult:
-    """One case in full: its outputs (as :func:`evaluate` gives them) and its error histories."""
+    """One case in full: its outputs (as :func:`evaluate` gives them) and its error histories.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    fidelity : str, optional
+        Not used: the nonlinear INS has one way of evaluating (the contract's signature).
+    """
     shared = setup(case)
     [(_, result)] = list(runs(Cases.from_case(case, 1), shared))
     name = case["trajectory"].strip()
@@ -355,7 +435,18 @@ def run_case(case: Case, fidelity: str | None = None) -> NavigateResult:
 
 
 def member_bytes(case: Case) -> int:
-    """Memory one Monte Carlo member holds while evaluated (sizes the chunks)."""
+    """Memory one Monte Carlo member holds while evaluated (sizes the chunks).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values); a recording is refused (one member, no Monte Carlo).
+
+    Returns
+    -------
+    int
+        Memory per member, bytes.
+    """
     shared = setup(case)
     if shared.recorded is not None:
         _refuse_monte_carlo()

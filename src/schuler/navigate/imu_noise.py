@@ -61,11 +61,23 @@ COARSE_BLOCK_BYTES = 65_536 * 8
 def load_error_model(text: str) -> ErrorModel:
     """The error model of ``--imu``: a grade preset or a TOML spec file (:mod:`schuler.imu.spec`).
 
+    Parameters
+    ----------
+    text : str
+        A grade name (navigation, tactical, industrial, consumer) or the path of a spec file SPEC.toml.
+
+    Returns
+    -------
+    ErrorModel
+        The model, SI.
+
     Raises
     ------
     InvalidParameter
         Naming ``imu``: neither a grade nor a readable spec file, or a figure of the file is wrong.
 
+    Examples
+    --------
     >>> load_error_model("tactical").name
     'tactical grade (ring-laser gyro IMU)'
     >>> load_error_model("tactcal")
@@ -88,7 +100,18 @@ def load_error_model(text: str) -> ErrorModel:
 
 
 def noise_model(model: ErrorModel) -> ErrorModel:
-    """The model without its constant errors b, S, M (those go to the time loops): what :class:`ImuNoise` simulates."""
+    """The model without its constant errors b, S, M (those go to the time loops): what :class:`ImuNoise` simulates.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The full error model.
+
+    Returns
+    -------
+    ErrorModel
+        A copy with zero bias, scale factors and misalignment for both triads.
+    """
     def without(errors: SensorErrors) -> SensorErrors:
         return replace(errors, bias=np.zeros(3), scale_factor=np.zeros(3), misalignment=np.zeros((3, 3)))
 
@@ -96,13 +119,32 @@ def noise_model(model: ErrorModel) -> ErrorModel:
 
 
 def has_noise(model: ErrorModel) -> bool:
-    """Whether the model has random processes or a g-sensitivity (anything :class:`ImuNoise` adds)."""
+    """Whether the model has random processes or a g-sensitivity (anything :class:`ImuNoise` adds).
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The error model.
+    """
     return any(np.any(getattr(sensor, name)) for sensor in (model.gyro, model.accel) for name in _RANDOM_TERMS) \
         or bool(np.any(model.gyro.g_sensitivity))
 
 
 def slow_processes(model: ErrorModel, interval: float) -> int:
-    """How many slow processes (Gauss-Markov, flicker terms, rate random walk) the simulator carries per member."""
+    """How many slow processes (Gauss-Markov, flicker terms, rate random walk) the simulator carries per member.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The full error model (its noise part, :func:`noise_model`, is simulated).
+    interval : float
+        IMU sample interval dt, s.
+
+    Returns
+    -------
+    int
+        Number of slow processes per member.
+    """
     return len(ImuSimulator(noise_model(model), interval).coarse_steps())
 
 
@@ -134,6 +176,20 @@ def drawn_constants(model: ErrorModel, seed: int, members) -> MemberConstants:
     """Members' constant errors b, S, M drawn as :meth:`schuler.imu.simulate.ImuSimulator.constants` draws them.
 
     G is drawn by the same streams inside :class:`ImuNoise`, which adds G f.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The error model whose 1-sigma constant errors are drawn.
+    seed : int
+        Study seed of the addressed random streams.
+    members : array_like of int
+        Global member numbers, shape (N,): the addresses of the draws.
+
+    Returns
+    -------
+    MemberConstants
+        Biases (rad/s, m/s^2), scale factors (dimensionless) and misalignments (rad), body axes, one row per member.
     """
     drawn = ImuSimulator(model, 1.0, seed=seed).constants(members)
     gyro_scale, gyro_misalignment = _split(drawn["gyro_matrix"])
@@ -154,7 +210,9 @@ def representative_constants(model: ErrorModel, members: int, specific_force) ->
     Parameters
     ----------
     model : ErrorModel
+        The error model whose 1-sigma constant errors are taken.
     members : int
+        Batch size N, number of members (all get the same errors).
     specific_force : array_like, shape (3,)
         f0, m/s^2, the sensors' true specific force: G f0 joins the gyro bias.
     """
@@ -169,6 +227,18 @@ def initial_inputs(generator: TruthGenerator, mode: str) -> tuple[np.ndarray, np
 
     Body axes for the strapdown; for the platform the NED frame's rate and the NED
     specific force (the platform is level and north-pointing to first order).
+
+    Parameters
+    ----------
+    generator : TruthGenerator
+        The run's truth (its first IMU interval is generated).
+    mode : {"strapdown", "platform"}
+        The mechanization: body axes or the NED frame.
+
+    Returns
+    -------
+    rate, specific_force : ndarray
+        True angular rate, rad/s, and specific force, m/s^2, each of shape (3,).
     """
     first = next(generator.chunks(1))
     increments = first.nav_increments[0] if mode == "platform" else first.increments[0]
@@ -209,6 +279,25 @@ class ImuNoise:
                                        workers=workers or min(4, os.cpu_count() or 1))
 
     def increments(self, members, start: int, stop: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """The errors (simulated - true) dt of the increments of IMU intervals ``start .. stop - 1``.
+
+        Parameters
+        ----------
+        members : array_like of int
+            Global member numbers, shape (M,).
+        start : int
+            Index of the first IMU interval (global); a member's windows must follow each other.
+        stop : int
+            Index one past the last IMU interval (global).
+        dt : float
+            IMU sample interval, s; must equal the ``interval`` the noise was set up for.
+
+        Returns
+        -------
+        gyro, accel : ndarray
+            Errors added to the angle increments (rad) and the velocity
+            increments (m/s), sensor axes x, y, z, each of shape (M, stop - start, 3).
+        """
         if not np.isclose(dt, self.interval, rtol=1e-12, atol=0.0):
             raise InvalidParameter("imu_rate", f"the noise was set up for {1 / self.interval:g} Hz, "
                                                f"asked for {1 / dt:g} Hz")

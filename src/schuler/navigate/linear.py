@@ -54,7 +54,19 @@ class LinearComparison:
 
 
 def psi_states(result: NavigationResult) -> np.ndarray:
-    """A run's errors as psi-angle states (conversion in the module docstring), shape ([N,] n_out, 7 or 9)."""
+    """A run's errors as psi-angle states (conversion in the module docstring), shape ([N,] n_out, 7 or 9).
+
+    Parameters
+    ----------
+    result : NavigationResult
+        A run of :func:`~schuler.navigate.mechanization.navigate` (its truth gives L, h and v).
+
+    Returns
+    -------
+    ndarray
+        Per output time: delta_r north, east (and down with the vertical channel
+        ``free``), m; delta_v north, east (and down), m/s; psi north, east, down, rad.
+    """
     truth = result.truth
     L, h, v = truth.latitude_rad, truth.height_m, truth.velocity_ned_m_s
     R_N, R_E = radii_of_curvature(L)

@@ -78,6 +78,26 @@ NOISE_BLOCK_BYTES = 64 * 1024**2
 def output_interval(output_step: float, imu_rate: float) -> int:
     """IMU samples per output step; the step must be a whole number of IMU intervals.
 
+    Parameters
+    ----------
+    output_step : float
+        Time between outputs, s (> 0).
+    imu_rate : float
+        IMU sample rate, Hz (> 0).
+
+    Returns
+    -------
+    int
+        IMU intervals per output step, number of (>= 1).
+
+    Raises
+    ------
+    InvalidParameter
+        Naming ``output_step`` when it is not finite and positive or not a whole
+        number of IMU intervals (to 1e-6 of the count).
+
+    Examples
+    --------
     >>> output_interval(10.0, 100.0)
     1000
     """
@@ -114,6 +134,24 @@ def _members(initial_errors: InitialErrors, sensor_errors: SensorErrors, member_
 def estimate_memory(members: int, n_outputs: int, chunk: int, with_noise: bool) -> int:
     """Bytes a run holds at once: outputs and errors per member, one block of truth and noise.
 
+    Parameters
+    ----------
+    members : int
+        Batch size N, number of members.
+    n_outputs : int
+        Output times per member, number of (the start included).
+    chunk : int
+        IMU samples per streamed block of truth (and noise), number of.
+    with_noise : bool
+        Whether the members carry sensor noise (one block of gyro and accelerometer noise each).
+
+    Returns
+    -------
+    int
+        Memory, bytes.
+
+    Examples
+    --------
     >>> estimate_memory(1000, 1081, 65536, False) // 2**20
     210
     """

@@ -75,7 +75,18 @@ def plot_errors(result, channels=None, hours: bool = True):
 
 
 def plot_final_errors(horizontal_m):
-    """Histogram of the Monte Carlo members' final horizontal position errors (m)."""
+    """Histogram of the Monte Carlo members' final horizontal position errors (m).
+
+    Parameters
+    ----------
+    horizontal_m : array_like
+        Final horizontal position error of each member, m, shape (N,).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The histogram, with the rms marked.
+    """
     fig, axis = _figure(figsize=(WIDTH, 4.0))
     values = np.asarray(horizontal_m, dtype=float)
     axis.hist(values, bins=min(60, max(10, values.size // 20)), color="C0", alpha=0.8)
@@ -92,6 +103,16 @@ def plot_bollay(comparison):
     """Bollay's (1966) five error sources: nonlinear WGS-84 beside the closed forms.
 
     ``comparison`` is :func:`~schuler.navigate.seeds.bollay_error_sources`'s.
+
+    Parameters
+    ----------
+    comparison : BollayComparison
+        The five sources' errors (m, SI), drawn in km against hours.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per error source.
     """
     fig, axes = _figure(3, 2, figsize=(WIDTH, 8.5), sharex=True)
     hours = comparison.t_s / 3600.0
@@ -114,7 +135,18 @@ def plot_bollay(comparison):
 
 
 def plot_drozdovich(comparison):
-    """The worked example of Drozdovich (1959) on the nonlinear platform: velocity error along track beside (29)."""
+    """The worked example of Drozdovich (1959) on the nonlinear platform: velocity error along track beside (29).
+
+    Parameters
+    ----------
+    comparison : DrozdovichComparison
+        :func:`~schuler.navigate.seeds.drozdovich_worked_example`'s (velocity errors in m/s, times in s).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The velocity errors along and across track against hours.
+    """
     fig, axis = _figure(figsize=(WIDTH, 5.2))
     hours = comparison.t_s / 3600.0
     axis.plot(hours, comparison.nonlinear_dv_along_m_s, color="C0", lw=0.9, label="nonlinear platform, along track")
@@ -131,7 +163,19 @@ def plot_drozdovich(comparison):
 
 
 def plot_gyrocompassing(comparison):
-    """KPI gyrocompassing: azimuth transients and the departures of steady state and settling time."""
+    """KPI gyrocompassing: azimuth transients and the departures of steady state and settling time.
+
+    Parameters
+    ----------
+    comparison : GyrocompassingComparison
+        :func:`~schuler.navigate.alignment.kpi_gyrocompassing`'s (angles in rad, times in s), drawn
+        with the initial azimuth errors in arcmin and the departures in percent.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Normalised azimuth transients (top) and the nonlinear - linear departures (bottom).
+    """
     fig, (transients, departures) = _figure(2, 1, figsize=(WIDTH, 8.0))
     arcmin = 180.0 * 60.0 / np.pi
     t = comparison.t_s

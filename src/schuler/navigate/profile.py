@@ -90,6 +90,17 @@ def _values(table: dict, keys: dict, where: str) -> dict[str, float]:
 def parse_profile(data: dict) -> WaypointProfile:
     """Build a :class:`WaypointProfile` from parsed TOML data (format in the module docstring).
 
+    Parameters
+    ----------
+    data : dict
+        The profile's tables as :mod:`tomllib` reads them: values are numbers in the
+        display units of the format (deg, m, s, m/s) or quantity strings with their own unit.
+
+    Returns
+    -------
+    WaypointProfile
+        The trajectory, SI (rad, m, s, m/s).
+
     Raises
     ------
     InvalidParameter
@@ -131,6 +142,16 @@ def parse_profile(data: dict) -> WaypointProfile:
 
 def load_profile(path) -> WaypointProfile:
     """Read a waypoint profile from a TOML file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The profile file, TOML (format in the module docstring).
+
+    Returns
+    -------
+    WaypointProfile
+        The trajectory, SI (rad, m, s, m/s).
 
     Raises
     ------

@@ -69,13 +69,30 @@ class Replay:
 
 
 def is_recording(text: str) -> bool:
-    """Whether ``--imu`` names a recorded IMU file (an existing file that is neither a grade nor SPEC.toml)."""
+    """Whether ``--imu`` names a recorded IMU file (an existing file that is neither a grade nor SPEC.toml).
+
+    Parameters
+    ----------
+    text : str
+        The value of ``--imu``: a grade, a spec file or a recording's path.
+    """
     path = Path(text)
     return text not in GRADES and path.suffix.lower() != ".toml" and path.is_file()
 
 
 def read_recording(text: str) -> ImuRecord:
-    """The record of ``--imu FILE``, in memory within the run's budget; errors name ``imu``."""
+    """The record of ``--imu FILE``, in memory within the run's budget; errors name ``imu``.
+
+    Parameters
+    ----------
+    text : str
+        Path of the recorded IMU file (CSV, PSINS ``.imu`` or Parquet).
+
+    Returns
+    -------
+    ImuRecord
+        The record, SI.
+    """
     try:
         return read_record(text, max_memory_bytes=budget() // 4)
     except SchulerError as error:
@@ -83,7 +100,13 @@ def read_recording(text: str) -> ImuRecord:
 
 
 def increments(record: ImuRecord) -> np.ndarray:
-    """The record's (dtheta, dv) per interval, shape (n, 6), rad and m/s, body x forward, y right, z down."""
+    """The record's (dtheta, dv) per interval, shape (n, 6), rad and m/s, body x forward, y right, z down.
+
+    Parameters
+    ----------
+    record : ImuRecord
+        A recorded IMU file in memory (SI increments).
+    """
     return np.concatenate([record.gyro_increment_rad, record.accel_increment_m_s], axis=1)
 
 
@@ -109,6 +132,20 @@ def _site(record: ImuRecord, case) -> Stationary:
 
 def replay(text: str, case) -> Replay:
     """The recording ``--imu text`` with the options of ``case`` applied and checked.
+
+    Parameters
+    ----------
+    text : str
+        Path of the recorded IMU file.
+    case : Case
+        A validated case of the ``navigate`` parameters (SI values): its
+        ``latitude``, ``longitude``, ``height`` and ``heading`` override the record's,
+        its ``duration`` shortens it, its ``output_step`` cuts it to whole steps.
+
+    Returns
+    -------
+    Replay
+        The stationary truth, the duration (s), the record's rate (Hz) and its increments.
 
     Raises
     ------

@@ -87,6 +87,18 @@ def bollay_rows(rotating: BollayComparison, still: BollayComparison) -> list[Rep
 
     ``rotating`` flies on the rotating Earth, ``still`` with Omega = 0 (Bollay's own
     assumption): the azimuth source is held against his forms on the latter.
+
+    Parameters
+    ----------
+    rotating : BollayComparison
+        :func:`~schuler.navigate.seeds.bollay_error_sources` on the rotating Earth (errors in m).
+    still : BollayComparison
+        The same flight with ``earth_rate=0`` (errors in m).
+
+    Returns
+    -------
+    list of ReproductionRow
+        Printed (ft) and closed-form (m) values beside the nonlinear ones, with verdicts.
     """
     rows = []
     period = rotating.local_schuler_period_s
@@ -123,7 +135,18 @@ def bollay_rows(rotating: BollayComparison, still: BollayComparison) -> list[Rep
 
 
 def drozdovich_rows(example: DrozdovichComparison) -> list[ReproductionRow]:
-    """The worked example on the nonlinear platform beside (29) and its forced solution (26)."""
+    """The worked example on the nonlinear platform beside (29) and its forced solution (26).
+
+    Parameters
+    ----------
+    example : DrozdovichComparison
+        :func:`~schuler.navigate.seeds.drozdovich_worked_example`'s (velocity errors in m/s).
+
+    Returns
+    -------
+    list of ReproductionRow
+        The mean velocity errors (m/s) beside the printed value and (26)/(29), with verdicts.
+    """
     where = "worked example after (29)"
     along, forced = example.nonlinear_dv_along_mean_m_s, example.quasi_steady_dv_along_mean_m_s
     across, forced_across = example.nonlinear_dv_across_mean_m_s, example.quasi_steady_dv_across_mean_m_s
@@ -150,7 +173,19 @@ def drozdovich_rows(example: DrozdovichComparison) -> list[ReproductionRow]:
 
 
 def kpi_table(comparison: GyrocompassingComparison) -> list[dict]:
-    """One row per initial azimuth error: nonlinear and linear steady states (rad) and times (s), departures."""
+    """One row per initial azimuth error: nonlinear and linear steady states (rad) and times (s), departures.
+
+    Parameters
+    ----------
+    comparison : GyrocompassingComparison
+        :func:`~schuler.navigate.alignment.kpi_gyrocompassing`'s (angles in rad, times in s).
+
+    Returns
+    -------
+    list of dict
+        Keys ending in ``_rad`` (rad) and ``_s`` (s); the ``*_departure_*`` values are
+        ratios ``(nonlinear - linear) / abs(linear)``, dimensionless.
+    """
     rows = []
     for i, delta0 in enumerate(comparison.initial_azimuth_errors_rad):
         rows.append({
@@ -173,7 +208,19 @@ def kpi_table(comparison: GyrocompassingComparison) -> list[dict]:
 
 
 def kpi_rows(comparison: GyrocompassingComparison) -> list[ReproductionRow]:
-    """The KPI models (1.17)/(1.19) beside the nonlinear platform at three initial azimuth errors."""
+    """The KPI models (1.17)/(1.19) beside the nonlinear platform at three initial azimuth errors.
+
+    Parameters
+    ----------
+    comparison : GyrocompassingComparison
+        :func:`~schuler.navigate.alignment.kpi_gyrocompassing`'s (angles in rad, times in s).
+
+    Returns
+    -------
+    list of ReproductionRow
+        Steady azimuth errors (arcmin), settling and decay times (s) against (1.17), (1.19),
+        (1.21) and 5/h, with verdicts.
+    """
     rows = []
     where = "Sec. 2, (1.17)"
     steady_nl = to_unit(comparison.steady_nonlinear_rad, "arcmin")
@@ -262,7 +309,18 @@ def reproduce() -> Reproduction:
 
 
 def report(outdir: Path) -> ReportSection:
-    """Write this system's figures into ``outdir`` and describe them (a few seconds)."""
+    """Write this system's figures into ``outdir`` and describe them (a few seconds).
+
+    Parameters
+    ----------
+    outdir : Path
+        The report's figure folder.
+
+    Returns
+    -------
+    ReportSection
+        The section: the reproduction's rows, the figures with captions, commands to try.
+    """
     from schuler.io import save_figure_formats
 
     outdir = Path(outdir)

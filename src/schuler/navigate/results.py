@@ -92,7 +92,23 @@ class NavigationResult(Result):
         return data
 
     def channel(self, name: str) -> np.ndarray:
-        """An error history by name (one of :data:`ERROR_CHANNELS`)."""
+        """An error history by name (one of :data:`ERROR_CHANNELS`).
+
+        Parameters
+        ----------
+        name : str
+            Channel name, e.g. ``"heading_error_rad"`` (SI unit in the name).
+
+        Returns
+        -------
+        ndarray
+            The history in the channel's SI unit (m, m/s or rad), shape (n_out,) or (N, n_out).
+
+        Raises
+        ------
+        KeyError
+            For a name that is not a channel.
+        """
         if name not in ERROR_CHANNELS:
             raise KeyError(f"no channel {name!r}; channels are {ERROR_CHANNELS}")
         return getattr(self, name)
@@ -153,7 +169,18 @@ class NavigateResult(RunResult):
     units: ClassVar[dict[str, str]] = {"imu_rate_hz": "Hz"}
 
     def history(self, name: str) -> np.ndarray:
-        """A channel's error history, SI, shape (n_out,)."""
+        """A channel's error history, SI, shape (n_out,).
+
+        Parameters
+        ----------
+        name : str
+            Channel name, one of :data:`~schuler.navigate.channels.ERROR_CHANNELS` (SI unit in the name).
+
+        Returns
+        -------
+        ndarray
+            The history in the channel's SI unit (m, m/s or rad), shape (n_out,).
+        """
         return np.asarray(self.navigation.channel(name))[0]
 
     def to_dict(self) -> dict[str, Any]:
@@ -197,6 +224,24 @@ def write_files(result: Result, out_dir: Path) -> list[Path]:
     time of the nonlinear platform against the KPI models, by initial azimuth
     error) with its table ``navigate_gyrocompassing.csv``, ``navigate_bollay``
     with ``navigate_bollay.csv``, and ``navigate_drozdovich``.
+
+    Parameters
+    ----------
+    result : Result
+        What ``run`` (a :class:`NavigateResult`) or ``reproduce`` (a
+        :class:`~schuler.reproduction.Reproduction`) returned.
+    out_dir : Path
+        Folder for the figures (PNG, SVG) and data files (CSV).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+
+    Raises
+    ------
+    TypeError
+        For any other result type.
     """
     import pandas as pd
 

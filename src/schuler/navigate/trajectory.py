@@ -110,7 +110,21 @@ class Stationary:
             _finite(name, getattr(self, name))
 
     def kinematics(self, t):
-        """Velocity (n, 3) m/s NED (zero) and attitude q_bn (n, 4) at times t (s)."""
+        """Velocity (n, 3) m/s NED (zero) and attitude q_bn (n, 4) at times t (s).
+
+        Parameters
+        ----------
+        t : float or array_like
+            Times since the start, s, shape (n,) (a scalar is one time).
+
+        Returns
+        -------
+        velocity : ndarray
+            Ground velocity, m/s, NED (zero), shape (n, 3).
+        quaternion : ndarray
+            Attitude q_bn (body x forward, y right, z down to NED), unit quaternions, scalar first,
+            plain numbers, shape (n, 4).
+        """
         n = _times(t).size
         return np.zeros((n, 3)), np.tile(quaternion_from_euler(self.roll, self.pitch, self.heading), (n, 1))
 
@@ -176,7 +190,22 @@ class GreatCircle:
         object.__setattr__(self, "_solution", solution.sol)
 
     def kinematics(self, t):
-        """Velocity (n, 3) m/s NED and attitude q_bn (n, 4) at times t in [0, duration] s."""
+        """Velocity (n, 3) m/s NED and attitude q_bn (n, 4) at times t in [0, duration] s.
+
+        Parameters
+        ----------
+        t : float or array_like
+            Times since the start, s, shape (n,) (a scalar is one time); times outside
+            [0, duration] take the heading at the nearer end.
+
+        Returns
+        -------
+        velocity : ndarray
+            Ground velocity, m/s, NED, shape (n, 3).
+        quaternion : ndarray
+            Attitude q_bn (body x forward, y right, z down to NED), unit quaternions, scalar first,
+            plain numbers, shape (n, 4).
+        """
         t = _times(t)
         psi = self._solution(np.clip(t, 0.0, self.duration))[1]
         # level at heading psi: q = (cos psi/2, 0, 0, sin psi/2); the velocity by double angles
@@ -190,6 +219,18 @@ class GreatCircle:
 def smoothstep(x):
     """Quintic smoothstep s = 10 x^3 - 15 x^4 + 6 x^5 on [0, 1] and its first two derivatives.
 
+    Parameters
+    ----------
+    x : float or array_like
+        Normalised time in [0, 1], dimensionless (clipped to it).
+
+    Returns
+    -------
+    value, first, second : ndarray
+        s(x), ds/dx and d^2s/dx^2, dimensionless, each of the shape of ``x``.
+
+    Examples
+    --------
     >>> [float(v) for v in smoothstep(np.array([0.5]))[0]]
     [0.5]
     """
@@ -277,7 +318,22 @@ class WaypointProfile:
         return values[index] + step * s, step * ds / span, step * dds / span**2
 
     def kinematics(self, t):
-        """Velocity (n, 3) m/s NED and attitude q_bn (n, 4) at times t (s)."""
+        """Velocity (n, 3) m/s NED and attitude q_bn (n, 4) at times t (s).
+
+        Parameters
+        ----------
+        t : float or array_like
+            Times since the start, s, shape (n,) (a scalar is one time); before the first
+            and after the last waypoint the values hold.
+
+        Returns
+        -------
+        velocity : ndarray
+            Ground velocity, m/s, NED, shape (n, 3).
+        quaternion : ndarray
+            Attitude q_bn (body x forward, y right, z down to NED), unit quaternions, scalar first,
+            plain numbers, shape (n, 4).
+        """
         t = _times(t)
         speed, _, _ = self._blend(self.speeds, t)
         psi, psi_rate, _ = self._blend(self.headings, t)

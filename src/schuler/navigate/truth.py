@@ -40,6 +40,25 @@ DEFAULT_CHUNK = 65_536
 def sample_count(duration: float, imu_rate: float) -> int:
     """Number of IMU intervals in ``duration`` at ``imu_rate``; refuses a non-integer count.
 
+    Parameters
+    ----------
+    duration : float
+        Simulated time, s (> 0), a whole number of IMU intervals (to 1e-6 of the count).
+    imu_rate : float
+        IMU sample rate, Hz, in (0, 100000].
+
+    Returns
+    -------
+    int
+        Number of IMU intervals.
+
+    Raises
+    ------
+    InvalidParameter
+        Naming ``imu_rate`` or ``duration`` when out of range or not a whole number of intervals.
+
+    Examples
+    --------
     >>> sample_count(3600.0, 100.0)
     360000
     """
@@ -123,7 +142,18 @@ class TruthGenerator:
         return state
 
     def chunks(self, chunk_size: int = DEFAULT_CHUNK) -> Iterator[TruthChunk]:
-        """Consecutive blocks of at most ``chunk_size`` intervals covering the whole duration."""
+        """Consecutive blocks of at most ``chunk_size`` intervals covering the whole duration.
+
+        Parameters
+        ----------
+        chunk_size : int
+            Largest number of IMU intervals per block (>= 1): it bounds the memory held at once.
+
+        Yields
+        ------
+        TruthChunk
+            The truth and ideal increments of the next block, SI.
+        """
         state = self.initial_state()
         for start in range(0, self.n_samples, chunk_size):
             stop = min(start + chunk_size, self.n_samples)
