@@ -177,7 +177,7 @@ def evaluate_with(parameters: ParameterSet, evaluate: Callable, common: dict, va
     varying : dict of str to array_like, optional
         Parameter name -> one value per case, SI; all of the same length (the number of cases).
     members : int
-        Monte Carlo members of the one case when ``varying`` is not given, number of (0: one case, no draws).
+        Number of Monte Carlo members of the one case (without ``varying``); 0: one nominal case, no draws.
     seed : int
         Seed of the members' random streams (used only with ``members``).
 
