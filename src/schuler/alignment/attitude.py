@@ -46,7 +46,18 @@ def dcm_from_euler(roll, pitch, heading) -> np.ndarray:
 
 
 def euler_from_dcm(C) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Roll, pitch, heading (rad) of C_b^n; heading in (-pi, pi], pitch in [-pi/2, pi/2]."""
+    """Roll, pitch, heading (rad) of C_b^n; heading in (-pi, pi], pitch in [-pi/2, pi/2].
+
+    Parameters
+    ----------
+    C : array_like of shape (..., 3, 3)
+        Direction cosine matrix C_b^n (body x fwd/y right/z down to NED), plain numbers.
+
+    Returns
+    -------
+    roll, pitch, heading : ndarray of shape (...)
+        Aerospace angles, rad.
+    """
     C = np.asarray(C, dtype=float)
     roll = np.arctan2(C[..., 2, 1], C[..., 2, 2])
     pitch = -np.arcsin(np.clip(C[..., 2, 0], -1.0, 1.0))
@@ -55,12 +66,34 @@ def euler_from_dcm(C) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def wrap_angle(angle):
-    """An angle (or angle difference) wrapped to (-pi, pi]."""
+    """An angle (or angle difference) wrapped to (-pi, pi].
+
+    Parameters
+    ----------
+    angle : float or array_like
+        Angle, rad (any shape).
+
+    Returns
+    -------
+    ndarray
+        The same angle in (-pi, pi], rad, same shape.
+    """
     return -np.remainder(-np.asarray(angle, dtype=float) + math.pi, 2.0 * math.pi) + math.pi
 
 
 def earth_rate_ned(latitude) -> np.ndarray:
-    """omega_ie^n = Omega [cos L, 0, -sin L], rad/s, shape (..., 3)."""
+    """omega_ie^n = Omega [cos L, 0, -sin L], rad/s, shape (..., 3).
+
+    Parameters
+    ----------
+    latitude : float or array_like
+        Latitude L, rad (any shape).
+
+    Returns
+    -------
+    ndarray of shape (..., 3)
+        Earth rate in NED, rad/s.
+    """
     latitude = np.asarray(latitude, dtype=float)
     out = np.zeros(latitude.shape + (3,))
     out[..., 0] = EARTH_RATE * np.cos(latitude)
@@ -69,7 +102,18 @@ def earth_rate_ned(latitude) -> np.ndarray:
 
 
 def skew_batch(vector) -> np.ndarray:
-    """[a x] for vectors of shape (..., 3): shape (..., 3, 3)."""
+    """[a x] for vectors of shape (..., 3): shape (..., 3, 3).
+
+    Parameters
+    ----------
+    vector : array_like of shape (..., 3)
+        Vector a in any unit (the matrix carries the same unit).
+
+    Returns
+    -------
+    ndarray of shape (..., 3, 3)
+        Skew-symmetric cross-product matrix, [a x] b = a x b.
+    """
     a = np.asarray(vector, dtype=float)
     out = np.zeros(a.shape + (3,))
     out[..., 0, 1], out[..., 0, 2] = -a[..., 2], a[..., 1]
@@ -79,7 +123,18 @@ def skew_batch(vector) -> np.ndarray:
 
 
 def rotation_matrix(rotation_vector) -> np.ndarray:
-    """exp([phi x]) for rotation vectors phi (..., 3), rad (Rodrigues; exact for any angle)."""
+    """exp([phi x]) for rotation vectors phi (..., 3), rad (Rodrigues; exact for any angle).
+
+    Parameters
+    ----------
+    rotation_vector : array_like of shape (..., 3)
+        Rotation vector phi (axis times angle), rad.
+
+    Returns
+    -------
+    ndarray of shape (..., 3, 3)
+        The rotation matrix exp([phi x]), plain numbers.
+    """
     phi = np.asarray(rotation_vector, dtype=float)
     angle = np.linalg.norm(phi, axis=-1)[..., None, None]
     small = angle < 1e-8
@@ -91,7 +146,18 @@ def rotation_matrix(rotation_vector) -> np.ndarray:
 
 
 def orthonormalise(C) -> np.ndarray:
-    """The rotation closest to C (polar factor by SVD), shape (..., 3, 3)."""
+    """The rotation closest to C (polar factor by SVD), shape (..., 3, 3).
+
+    Parameters
+    ----------
+    C : array_like of shape (..., 3, 3)
+        Nearly orthonormal direction cosine matrix, plain numbers.
+
+    Returns
+    -------
+    ndarray of shape (..., 3, 3)
+        The orthonormal matrix closest to C in the Frobenius norm, plain numbers.
+    """
     u, _, vt = np.linalg.svd(np.asarray(C, dtype=float))
     return u @ vt
 
@@ -102,9 +168,10 @@ def triad(primary_body, secondary_body, primary_nav, secondary_nav) -> np.ndarra
     Parameters
     ----------
     primary_body, secondary_body : ndarray (..., 3)
-        The two vectors measured in the body frame.
+        The two vectors measured in the body frame (x fwd, y right, z down), any unit (only their
+        directions are used; e.g. specific force in m/s^2 and Earth rate in rad/s).
     primary_nav, secondary_nav : ndarray (..., 3)
-        The same vectors known in the navigation frame.
+        The same vectors known in the navigation frame (NED), any unit (directions only).
 
     Returns
     -------

@@ -39,7 +39,18 @@ BYTES_PER_SAMPLE = 400
 
 
 def calibration_model(grade: str) -> ErrorModel:
-    """The grade's constant errors and white noise (slow terms and g-sensitivity left out, see module notes)."""
+    """The grade's constant errors and white noise (slow terms and g-sensitivity left out, see module notes).
+
+    Parameters
+    ----------
+    grade : {"navigation", "tactical", "industrial", "consumer"}
+        IMU preset (:func:`schuler.imu.spec.preset`).
+
+    Returns
+    -------
+    ErrorModel
+        The preset with bias instability, Gauss-Markov, rate random walk and g-sensitivity set to zero.
+    """
     model = preset(grade)
 
     def constant(errors):

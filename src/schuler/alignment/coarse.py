@@ -41,6 +41,20 @@ def coarse_dcm(specific_force, angular_rate, latitude) -> np.ndarray:
 
     The primary pair is gravity's direction (-f in the body, down in NED), the
     secondary the Earth rate (``angular_rate`` in the body, Omega (cos L, 0, -sin L) in NED).
+
+    Parameters
+    ----------
+    specific_force : array_like of shape (..., 3)
+        Mean specific force f, m/s^2, body axes x fwd, y right, z down (about (0, 0, -g) when level).
+    angular_rate : array_like of shape (..., 3)
+        Mean angular rate, rad/s, body axes x, y, z.
+    latitude : float or array_like
+        Latitude L, rad (broadcast against the leading dimensions).
+
+    Returns
+    -------
+    ndarray of shape (..., 3, 3)
+        C_b^n (body to NED), plain numbers.
     """
     specific_force = np.asarray(specific_force, dtype=float)
     omega_n = np.broadcast_to(earth_rate_ned(latitude), specific_force.shape)
@@ -48,7 +62,22 @@ def coarse_dcm(specific_force, angular_rate, latitude) -> np.ndarray:
 
 
 def coarse_attitude(specific_force, angular_rate, latitude):
-    """Roll, pitch, heading (rad) by :func:`coarse_dcm`."""
+    """Roll, pitch, heading (rad) by :func:`coarse_dcm`.
+
+    Parameters
+    ----------
+    specific_force : array_like of shape (..., 3)
+        Mean specific force f, m/s^2, body axes x fwd, y right, z down.
+    angular_rate : array_like of shape (..., 3)
+        Mean angular rate, rad/s, body axes x, y, z.
+    latitude : float or array_like
+        Latitude L, rad.
+
+    Returns
+    -------
+    roll, pitch, heading : ndarray of shape (...)
+        Aerospace angles of C_b^n, rad; heading clockwise from north in (-pi, pi].
+    """
     return euler_from_dcm(coarse_dcm(specific_force, angular_rate, latitude))
 
 

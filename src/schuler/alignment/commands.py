@@ -115,6 +115,19 @@ def _settings(case) -> AlignmentSettings:
 def align_compare(**values) -> AlignmentComparison:
     """Every self-alignment method on one record or one simulated record (``align compare``), SI keywords.
 
+    Parameters
+    ----------
+    **values
+        Options of :data:`ALIGN_COMPARE_PARAMETERS` by name, in SI: ``latitude`` and ``heading`` rad;
+        ``start``, ``duration``, ``time_constant``, ``update_interval`` and ``initial_window`` s; ``imu_rate`` Hz;
+        ``velocity_noise`` m/s; ``damping`` plain number; ``seed`` an integer; ``record`` a file path;
+        ``imu`` a grade. Missing ones take their defaults.
+
+    Returns
+    -------
+    AlignmentComparison
+        Every method's attitude, 1-sigma, convergence time and accuracy limit.
+
     Raises
     ------
     InvalidParameter
@@ -151,7 +164,28 @@ def align_compare(**values) -> AlignmentComparison:
 def evaluate_with(parameters: ParameterSet, evaluate: Callable, common: dict, varying: dict | None = None, *,
                   members: int = 0, seed: int = 0) -> dict[str, np.ndarray]:
     """A system's ``evaluate`` on cases sharing ``common`` SI values, ``varying`` ones per case, or ``members``
-    Monte Carlo members of one case (draws addressed by ``seed`` and member number)."""
+    Monte Carlo members of one case (draws addressed by ``seed`` and member number).
+
+    Parameters
+    ----------
+    parameters : ParameterSet
+        The system's parameters: every case is validated by their rules.
+    evaluate : callable
+        The system's ``evaluate(cases) -> dict of str to ndarray``.
+    common : dict of str to float
+        Parameter name -> value shared by every case, SI (the parameter's SI unit).
+    varying : dict of str to array_like, optional
+        Parameter name -> one value per case, SI; all of the same length (the number of cases).
+    members : int
+        Number of Monte Carlo members of the one case (without ``varying``); 0: one nominal case, no draws.
+    seed : int
+        Seed of the members' random streams (used only with ``members``).
+
+    Returns
+    -------
+    dict of str to ndarray
+        The system's outputs, one value per case or member, in their SI units.
+    """
     varying = {name: np.atleast_1d(np.asarray(value, dtype=float)) for name, value in (varying or {}).items()}
     count = len(next(iter(varying.values()))) if varying else max(1, members)
     checked = [parameters.case({**common, **{name: float(value[i]) for name, value in varying.items()}})
@@ -164,7 +198,20 @@ def evaluate_with(parameters: ParameterSet, evaluate: Callable, common: dict, va
 
 
 def north_compare_action(parameters: ParameterSet, evaluate: Callable) -> Action:
-    """``north compare``, with system 5 (its ``parameters`` and ``evaluate``) as the ground gyrocompass."""
+    """``north compare``, with system 5 (its ``parameters`` and ``evaluate``) as the ground gyrocompass.
+
+    Parameters
+    ----------
+    parameters : ParameterSet
+        System 5's parameters (``readout_noise``, ``latitude``, ``duration`` among them).
+    evaluate : callable
+        System 5's ``evaluate(cases)``; its ``north_std_predicted_rad`` output is used.
+
+    Returns
+    -------
+    Action
+        The ``compare`` action with :data:`NORTH_COMPARE_PARAMETERS`.
+    """
 
     def ground_gyrocompass(durations, noise, latitude):
         outputs = evaluate_with(parameters, evaluate, {"readout_noise": noise, "latitude": latitude},
@@ -187,7 +234,21 @@ def north_compare_action(parameters: ParameterSet, evaluate: Callable) -> Action
 
 
 def calibrate_compare_action(parameters: ParameterSet, evaluate: Callable) -> Action:
-    """``calibrate compare``, with system 3 (its ``parameters`` and ``evaluate``) as the pulse method."""
+    """``calibrate compare``, with system 3 (its ``parameters`` and ``evaluate``) as the pulse method.
+
+    Parameters
+    ----------
+    parameters : ParameterSet
+        System 3's parameters (``angle_random_walk``, ``drift_x``, ``latitude`` among them).
+    evaluate : callable
+        System 3's ``evaluate(cases)``; its ``drift_x_error_rad_s``, ``azimuth_error_rad`` and
+        ``procedure_time_s`` outputs are used.
+
+    Returns
+    -------
+    Action
+        The ``compare`` action with :data:`CALIBRATE_COMPARE_PARAMETERS`.
+    """
 
     def pulse_method(random_walk, drift, latitude, members, seed):
         outputs = evaluate_with(parameters, evaluate, {"angle_random_walk": random_walk, "drift_x": drift,

@@ -69,7 +69,22 @@ class AlignmentSettings:
 
 
 def run_methods(batch: StaticBatch, model: ErrorModel, settings: AlignmentSettings) -> dict[str, MethodEstimate]:
-    """The four methods on every record of ``batch`` (batched where each allows)."""
+    """The four methods on every record of ``batch`` (batched where each allows).
+
+    Parameters
+    ----------
+    batch : StaticBatch
+        The static records (angle and velocity increments, body axes) at one site.
+    model : ErrorModel
+        The sensors' errors: the Kalman filter's tuning.
+    settings : AlignmentSettings
+        How the methods are run (loop design, Kalman noise and update interval, windows; SI).
+
+    Returns
+    -------
+    dict of str to MethodEstimate
+        ``coarse``, ``inertial_frame``, ``kalman``, ``gyrocompass`` -> that method's attitude for every record.
+    """
     return {
         "coarse": align_coarse(batch, settings.history_step_s),
         "inertial_frame": align_inertial(batch, settings.history_step_s),
@@ -83,7 +98,24 @@ def run_methods(batch: StaticBatch, model: ErrorModel, settings: AlignmentSettin
 
 
 def method_limits(model: ErrorModel, batch: StaticBatch, heading: float, settings: AlignmentSettings):
-    """Each method's :class:`~schuler.alignment.limits.AccuracyLimit` for this model, site and window."""
+    """Each method's :class:`~schuler.alignment.limits.AccuracyLimit` for this model, site and window.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The sensors' errors the limits come from.
+    batch : StaticBatch
+        The window: its latitude, duration and gravity are used.
+    heading : float
+        Heading of the body x axis, rad, clockwise from north.
+    settings : AlignmentSettings
+        The gyrocompass loop's design and the Kalman filter's noise and update interval (SI).
+
+    Returns
+    -------
+    dict of str to AccuracyLimit
+        Method name (:data:`~schuler.alignment.limits.METHODS`) -> its 1-sigma limits, rad.
+    """
     c_gamma, c_a = loop_gains(batch.latitude_rad, settings.time_constant_s, settings.damping)
     return {method: accuracy_limit(method, model, latitude=batch.latitude_rad, heading=heading,
                                    duration=batch.duration_s, gravity=batch.gravity, c_gamma=c_gamma, c_a=c_a,
@@ -252,6 +284,37 @@ def simulated_batch(model: ErrorModel, *, latitude_rad: float, heading_rad: floa
     """Records of ``model`` at rest, level, at ``heading_rad``: (batch, constants) with each member's true errors.
 
     ``members`` is a count or a sequence of member numbers (the addresses of the draws).
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The simulated sensors' errors.
+    latitude_rad : float
+        Site latitude L, rad.
+    heading_rad : float
+        True heading of the body x axis, rad, clockwise from north (roll and pitch zero).
+    duration_s : float
+        Length of each record, s.
+    sample_interval_s : float
+        Sample interval dt, s.
+    members : int or array_like of int
+        Number of members (numbered 0, 1, ...), or the member numbers themselves.
+    seed : int
+        Seed of the addressed random streams.
+
+    Returns
+    -------
+    batch : StaticBatch
+        One record per member, gravity the simulated (normal gravity at L), m/s^2.
+    constants : dict of str to ndarray
+        Each member's constant errors (:meth:`~schuler.imu.simulate.ImuSimulator.constants`): ``gyro_bias``
+        (m, 3) rad/s, ``accel_bias`` (m, 3) m/s^2 (measured - true, body axes), ``gyro_matrix`` and
+        ``accel_matrix`` (m, 3, 3) plain numbers, ``gyro_g`` (m, 3, 3) rad/s per m/s^2.
+
+    Raises
+    ------
+    MemoryBudgetExceeded
+        The records would exceed the memory budget (:func:`schuler.memory.require`).
     """
     ids = np.arange(members) if np.ndim(members) == 0 else np.asarray(members, dtype=np.int64)
     samples = int(round(duration_s / sample_interval_s))
@@ -268,7 +331,22 @@ def simulated_batch(model: ErrorModel, *, latitude_rad: float, heading_rad: floa
 
 
 def window_record(record: ImuRecord, start_s: float, duration_s: float | None) -> ImuRecord:
-    """The samples of [start, start + duration) of a record, as a record."""
+    """The samples of [start, start + duration) of a record, as a record.
+
+    Parameters
+    ----------
+    record : ImuRecord
+        The recording.
+    start_s : float
+        Start of the window, s from the record's first sample.
+    duration_s : float or None
+        Length of the window, s (None: to the record's end).
+
+    Returns
+    -------
+    ImuRecord
+        The same record restricted to the window.
+    """
     first, stop = window_indices(record.samples, record.sample_interval_s, start_s, duration_s)
     return replace(record, time_s=record.time_s[first:stop], gyro=record.gyro[first:stop],
                    accel=record.accel[first:stop])
@@ -281,6 +359,20 @@ def record_model(record: ImuRecord, grade: str | None) -> tuple[ErrorModel, str]
     them. At short tau a vehicle's vibration looks like large white noise, yet it
     averages away; what the body's sway and settling do to each method is reported
     beside the limits instead (:func:`compare_alignment`).
+
+    Parameters
+    ----------
+    record : ImuRecord
+        The recording (its Allan deviation is analysed when no grade is given).
+    grade : {"navigation", "tactical", "industrial", "consumer"} or None
+        The IMU grade given by the user (None: found from the record).
+
+    Returns
+    -------
+    model : ErrorModel
+        The grade's preset.
+    source : str
+        How it was chosen, for the table.
     """
     if grade is not None:
         return preset(grade), "grade given"

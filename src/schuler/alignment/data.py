@@ -85,6 +85,22 @@ class StaticBatch:
                     duration_s: float | None = None) -> StaticBatch:
         """The window [start, start + duration) of a record as a batch of one.
 
+        Parameters
+        ----------
+        record : ImuRecord
+            The recording at rest (increments, body axes).
+        latitude_rad : float, optional
+            Site latitude L, rad (default: the record's).
+        start_s : float
+            Start of the window, s from the record's first sample.
+        duration_s : float, optional
+            Length of the window, s (default: to the record's end).
+
+        Returns
+        -------
+        StaticBatch
+            One member; gravity the record's, if it states one.
+
         Raises
         ------
         InvalidParameter
@@ -115,13 +131,35 @@ class StaticBatch:
         return round(self.samples * self.sample_interval_s, 12)
 
     def head(self, duration_s: float) -> StaticBatch:
-        """The first ``duration_s`` seconds (at least 2 samples, at most all), as a batch (views, no copy)."""
+        """The first ``duration_s`` seconds (at least 2 samples, at most all), as a batch (views, no copy).
+
+        Parameters
+        ----------
+        duration_s : float
+            Length kept from the start, s (rounded to whole samples).
+
+        Returns
+        -------
+        StaticBatch
+            The same members, site and sample interval.
+        """
         samples = max(2, min(self.samples, int(round(duration_s / self.sample_interval_s))))
         return StaticBatch(self.gyro_increment[:, :samples], self.accel_increment[:, :samples],
                            self.sample_interval_s, self.latitude_rad, self.gravity_m_s2)
 
     def history_indices(self, step_s: float) -> np.ndarray:
-        """Sample counts (1-based ends) at which histories are reported: every ``step_s``, and the last sample."""
+        """Sample counts (1-based ends) at which histories are reported: every ``step_s``, and the last sample.
+
+        Parameters
+        ----------
+        step_s : float
+            Step of the histories, s (rounded to whole samples, at least one).
+
+        Returns
+        -------
+        ndarray of int, shape (K,)
+            Number of samples up to each reported time, increasing, ending with :attr:`samples`.
+        """
         stride = max(1, int(round(step_s / self.sample_interval_s)))
         ends = np.arange(stride, self.samples + 1, stride)
         if ends.size == 0 or ends[-1] != self.samples:
@@ -129,14 +167,49 @@ class StaticBatch:
         return ends
 
     def mean_rates(self, stop: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Mean angular rate (rad/s) and specific force (m/s^2) over samples [0, stop), each (m, 3)."""
+        """Mean angular rate (rad/s) and specific force (m/s^2) over samples [0, stop), each (m, 3).
+
+        Parameters
+        ----------
+        stop : int, optional
+            Number of samples averaged from the start (default: all).
+
+        Returns
+        -------
+        angular_rate : ndarray of shape (m, 3)
+            Mean angular rate, rad/s, body axes.
+        specific_force : ndarray of shape (m, 3)
+            Mean specific force, m/s^2, body axes.
+        """
         stop = self.samples if stop is None else int(stop)
         span = stop * self.sample_interval_s
         return self.gyro_increment[:, :stop].sum(axis=1) / span, self.accel_increment[:, :stop].sum(axis=1) / span
 
 
 def window_indices(samples: int, dt: float, start_s: float, duration_s: float | None) -> tuple[int, int]:
-    """Sample range [first, stop) of the window [start, start + duration) of a record of ``samples`` samples."""
+    """Sample range [first, stop) of the window [start, start + duration) of a record of ``samples`` samples.
+
+    Parameters
+    ----------
+    samples : int
+        Number of samples in the record.
+    dt : float
+        Sample interval, s.
+    start_s : float
+        Start of the window, s from the record's first sample (rounded to a whole sample).
+    duration_s : float or None
+        Length of the window, s (None: to the record's end).
+
+    Returns
+    -------
+    first, stop : int
+        Index of the window's first sample and one past its last.
+
+    Raises
+    ------
+    InvalidParameter
+        A start outside the record, a window past its end or one of fewer than 2 samples.
+    """
     total = samples * dt
     if not (math.isfinite(start_s) and 0 <= start_s < total):
         raise InvalidParameter("start", f"{start_s:g} s must be within the record's [0, {total:g}) s")
@@ -192,11 +265,18 @@ def convergence_time(time_s, history, final, band) -> np.ndarray:
     Parameters
     ----------
     time_s : ndarray (K,)
+        Times of the history, s.
     history : ndarray (m, K)
         Angles, rad (differences are wrapped).
     final : ndarray (m,)
+        Final angle of each record, rad.
     band : float or ndarray (m,)
         Half-width, rad.
+
+    Returns
+    -------
+    ndarray (m,)
+        Convergence time of each record, s (the last time when the history never settles).
     """
     outside = np.abs(wrap_angle(np.asarray(history) - np.asarray(final)[:, None])) > np.asarray(band).reshape(-1, 1)
     last = np.where(outside.any(axis=1), outside.shape[1] - 1 - np.argmax(outside[:, ::-1], axis=1), -1)

@@ -57,6 +57,20 @@ SETTLING_DECREMENTS = 5.0
 def loop_gains(latitude: float, time_constant: float, damping: float) -> tuple[float, float]:
     """(c_gamma, c_a), 1/s, from T (s) and zeta: c_a = 1 / (T^2 Omega cos L), c_gamma = 2 zeta / T.
 
+    Parameters
+    ----------
+    latitude : float
+        Latitude L, rad.
+    time_constant : float
+        Time constant T of the azimuth loop, s.
+    damping : float
+        Damping zeta of the azimuth loop, plain number.
+
+    Returns
+    -------
+    c_gamma, c_a : float
+        Gains of the levelling and azimuth channels (KPI manual (1.6)), 1/s.
+
     Raises
     ------
     InvalidParameter
@@ -73,7 +87,20 @@ def loop_gains(latitude: float, time_constant: float, damping: float) -> tuple[f
 
 
 def settling_time(time_constant: float, damping: float) -> float:
-    """5 / h = 5 T / zeta, s (the manual's settling time of the oscillatory loop; zeta <= 1)."""
+    """5 / h = 5 T / zeta, s (the manual's settling time of the oscillatory loop; zeta <= 1).
+
+    Parameters
+    ----------
+    time_constant : float
+        Time constant T of the azimuth loop, s.
+    damping : float
+        Damping zeta of the azimuth loop, plain number.
+
+    Returns
+    -------
+    float
+        Settling time, s.
+    """
     return SETTLING_DECREMENTS * time_constant / damping
 
 

@@ -43,7 +43,22 @@ from schuler.alignment.data import MethodEstimate, StaticBatch
 
 
 def navigation_velocity(times, latitude, gravity) -> np.ndarray:
-    """v^{n0}(t) = int_0^t C_n^{n0} f^n dt at rest (module notes), m/s, shape (K, 3)."""
+    """v^{n0}(t) = int_0^t C_n^{n0} f^n dt at rest (module notes), m/s, shape (K, 3).
+
+    Parameters
+    ----------
+    times : array_like of shape (K,)
+        Times t from the window's start, s.
+    latitude : float
+        Latitude L, rad.
+    gravity : float
+        Gravity g at the site, m/s^2 (f^n = (0, 0, -g)).
+
+    Returns
+    -------
+    ndarray of shape (K, 3)
+        Integrated specific force in the n0 frame (NED at the start), m/s.
+    """
     omega = earth_rate_ned(latitude)
     rate = float(np.linalg.norm(omega))
     t = np.asarray(times, dtype=float)[:, None, None]
@@ -69,6 +84,16 @@ def net_rotation(batch: StaticBatch) -> np.ndarray:
     at rest, the net turn of a disturbed one (a vehicle settling, people boarding). Its mean rate
     over the window is what coarse alignment takes for Earth rate: about east, it moves coarse
     alignment's heading by -(rotation_E / T) / (Omega cos L).
+
+    Parameters
+    ----------
+    batch : StaticBatch
+        The records (angle and velocity increments, body axes) and their site.
+
+    Returns
+    -------
+    ndarray of shape (m, 3)
+        Net rotation vector of each record over the window, rad, NED axes.
     """
     from scipy.spatial.transform import Rotation
 
@@ -83,6 +108,16 @@ def start_attitude(batch: StaticBatch) -> np.ndarray:
 
     What the Kalman filter and the gyrocompass start from: unlike coarse alignment it
     keeps its heading when the body is disturbed.
+
+    Parameters
+    ----------
+    batch : StaticBatch
+        The records whose window gives the start (typically its first seconds, :meth:`StaticBatch.head`).
+
+    Returns
+    -------
+    ndarray of shape (m, 3, 3)
+        C_b^n (body to NED) of each record at the window's start, plain numbers.
     """
     return _start_and_end(batch)[0]
 

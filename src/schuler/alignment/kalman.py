@@ -98,7 +98,29 @@ class KalmanTuning:
                    gravity: float = STANDARD_GRAVITY) -> KalmanTuning:
         """From an :class:`~schuler.imu.error_model.ErrorModel`: N, the constant error at rest
         (:func:`~schuler.alignment.limits.effective_bias_sigma`), and a bias walk that lets the bias
-        instability B build up over ``window_s`` (q = B^2 / window)."""
+        instability B build up over ``window_s`` (q = B^2 / window).
+
+        Parameters
+        ----------
+        model : ErrorModel
+            The sensors' per-axis 1-sigma errors, SI, body axes.
+        velocity_noise : float
+            1-sigma of the zero-velocity measurement, m/s (> 0).
+        window_s : float
+            Time over which the bias instability builds up in the bias walk, s.
+        gravity : float
+            g at the site, m/s^2 (for the g-dependent constant errors).
+
+        Returns
+        -------
+        KalmanTuning
+            The filter's noise model (body axes, SI).
+
+        Raises
+        ------
+        InvalidParameter
+            ``velocity_noise`` not finite and positive.
+        """
         if not (math.isfinite(velocity_noise) and velocity_noise > 0):
             raise InvalidParameter("velocity_noise", f"must be finite and > 0 m/s, got {velocity_noise!r}")
         gyro, accel = model.gyro, model.accel
@@ -115,6 +137,19 @@ def coarse_error_map(latitude: float, gravity: float) -> np.ndarray:
     computed frame: g phi_E + b_aN = 0, -g phi_N + b_aE = 0 and
     Omega cos L phi_D + Omega sin L phi_N = b_gE, so phi_N = b_aE / g, phi_E = -b_aN / g,
     phi_D = b_gE / (Omega cos L) - tan(L) b_aE / g (the static limits of :mod:`.limits`).
+
+    Parameters
+    ----------
+    latitude : float
+        Latitude L, rad.
+    gravity : float
+        Gravity g at the site, m/s^2.
+
+    Returns
+    -------
+    ndarray of shape (3, 6)
+        M with phi = M (b_gN, b_gE, b_gD, b_aN, b_aE, b_aD): phi in rad (NED), columns 0-2 in s
+        (rad per rad/s of gyro bias), columns 3-5 in s^2/m (rad per m/s^2 of accelerometer bias).
     """
     rate = EARTH_RATE * math.cos(latitude)
     M = np.zeros((3, 6))
@@ -186,6 +221,18 @@ def attitude_sigma(P: np.ndarray, heading: np.ndarray) -> np.ndarray:
 
     roll error = -(cos psi phi_N + sin psi phi_E), pitch error = sin psi phi_N - cos psi phi_E,
     heading error = -phi_D (level body).
+
+    Parameters
+    ----------
+    P : ndarray of shape (m, >=3, >=3)
+        State covariance whose leading 3 x 3 block is that of phi (NED), rad^2.
+    heading : ndarray of shape (m,)
+        Heading psi of each level body, rad.
+
+    Returns
+    -------
+    ndarray of shape (m, 3)
+        1-sigma of roll, pitch and heading errors, rad.
     """
     c, s = np.cos(heading), np.sin(heading)
     J = np.zeros(heading.shape + (3, 3))

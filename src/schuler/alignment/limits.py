@@ -64,7 +64,23 @@ MAX_LATITUDE = math.radians(89.0)
 
 
 def horizontal_rate(latitude) -> np.ndarray:
-    """Omega cos L, rad/s; refuses latitudes beyond :data:`MAX_LATITUDE` (azimuth unobservable)."""
+    """Omega cos L, rad/s; refuses latitudes beyond :data:`MAX_LATITUDE` (azimuth unobservable).
+
+    Parameters
+    ----------
+    latitude : float or array_like
+        Latitude L, rad (any shape).
+
+    Returns
+    -------
+    ndarray
+        Horizontal Earth rate, rad/s, same shape.
+
+    Raises
+    ------
+    NotObservable
+        A latitude not finite or beyond +/- :data:`MAX_LATITUDE`.
+    """
     latitude = np.asarray(latitude, dtype=float)
     if np.any(~np.isfinite(latitude)) or np.any(np.abs(latitude) > MAX_LATITUDE):
         raise NotObservable(f"latitude: {np.degrees(np.max(np.abs(latitude))):g} deg is beyond +/-"
@@ -73,14 +89,40 @@ def horizontal_rate(latitude) -> np.ndarray:
 
 
 def east_component(heading, body_vector) -> np.ndarray:
-    """b_E = sin(psi) b_x + cos(psi) b_y of body vectors (..., 3) of a level body at heading psi."""
+    """b_E = sin(psi) b_x + cos(psi) b_y of body vectors (..., 3) of a level body at heading psi.
+
+    Parameters
+    ----------
+    heading : float or array_like
+        Heading psi of the level body, rad (broadcast against the leading dimensions).
+    body_vector : array_like of shape (..., 3)
+        Vector in body axes x fwd, y right, z down, any unit (e.g. a gyro bias in rad/s).
+
+    Returns
+    -------
+    ndarray of shape (...)
+        Its east component, in the vector's unit.
+    """
     b = np.asarray(body_vector, dtype=float)
     heading = np.asarray(heading, dtype=float)
     return np.sin(heading) * b[..., 0] + np.cos(heading) * b[..., 1]
 
 
 def north_component(heading, body_vector) -> np.ndarray:
-    """b_N = cos(psi) b_x - sin(psi) b_y of body vectors (..., 3) of a level body at heading psi."""
+    """b_N = cos(psi) b_x - sin(psi) b_y of body vectors (..., 3) of a level body at heading psi.
+
+    Parameters
+    ----------
+    heading : float or array_like
+        Heading psi of the level body, rad (broadcast against the leading dimensions).
+    body_vector : array_like of shape (..., 3)
+        Vector in body axes x fwd, y right, z down, any unit (e.g. a gyro bias in rad/s).
+
+    Returns
+    -------
+    ndarray of shape (...)
+        Its north component, in the vector's unit.
+    """
     b = np.asarray(body_vector, dtype=float)
     heading = np.asarray(heading, dtype=float)
     return np.cos(heading) * b[..., 0] - np.sin(heading) * b[..., 1]
@@ -142,6 +184,21 @@ def heading_random_walk(latitude, gyro_random_walk_east, duration) -> np.ndarray
 
 def random_walk_factor(method: str) -> float:
     """k of the random-walk limit for ``method`` (coarse, inertial_frame, kalman).
+
+    Parameters
+    ----------
+    method : {"coarse", "inertial_frame", "kalman"}
+        The alignment method.
+
+    Returns
+    -------
+    float
+        k, plain number.
+
+    Raises
+    ------
+    InvalidParameter
+        A method without a random-walk factor (the gyrocompass: :func:`gyrocompass_noise`).
 
     Notes
     -----
@@ -246,6 +303,24 @@ def gyrocompass_steady_state(latitude, c_gamma, c_a, gyro_bias_ned, accel_bias_n
     To first order the heading error is -b_gE / (Omega cos L) + c_gamma b_gD / (c_a Omega cos L)
     + tan(L) (b_aE / g - b_gN / c_gamma): the static limit plus the loop's own terms, the
     KPI manual's (1.21) and the alpha U_z coupling of its full model (1.18).
+
+    Parameters
+    ----------
+    latitude : float
+        Latitude L, rad.
+    c_gamma, c_a : float
+        Level and azimuth gains, 1/s.
+    gyro_bias_ned : array_like (3,)
+        C_b^n b_g, gyro bias (measured - true) resolved north, east, down, rad/s.
+    accel_bias_ned : array_like (3,)
+        C_b^n b_a, accelerometer bias (measured - true) resolved north, east, down, m/s^2.
+    gravity : float
+        g, m/s^2.
+
+    Returns
+    -------
+    ndarray (3,)
+        Steady phi = (phi_N, phi_E, phi_D), rad (heading error = -phi_D).
     """
     A, B = gyrocompass_error_model(latitude, c_gamma, c_a, gravity)
     u = np.concatenate([np.asarray(gyro_bias_ned, dtype=float), np.asarray(accel_bias_ned, dtype=float)])
@@ -259,6 +334,8 @@ def kpi_equivalent_inputs(gyro_bias_ned, accel_bias_ned, gravity=STANDARD_GRAVIT
     ----------
     gyro_bias_ned, accel_bias_ned : array_like (3,)
         C_b^n b_g (rad/s) and C_b^n b_a (m/s^2), measured - true.
+    gravity : float
+        g, m/s^2.
 
     Returns
     -------

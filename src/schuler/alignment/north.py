@@ -79,6 +79,27 @@ def schedule(method: str, *, samples: int, sample_interval_s: float,
     """Turntable angle at the start and the end of each sample interval, rad (each shape (samples,)).
 
     The turns between positions are taken as instantaneous (an ideal table).
+
+    Parameters
+    ----------
+    method : {"two_position", "four_position", "carousel"}
+        The north-finding schedule.
+    samples : int
+        Number of samples (at least 4); the positions get equal shares of them.
+    sample_interval_s : float
+        Sample interval dt, s.
+    carousel_period_s : float
+        One turn of the carousel, s (``carousel`` only).
+
+    Returns
+    -------
+    start, end : ndarray of shape (samples,)
+        Table angle theta at the start and the end of each interval, rad (clockwise seen from above).
+
+    Raises
+    ------
+    InvalidParameter
+        An unknown method, fewer than 4 samples or a carousel period not finite and positive.
     """
     if method not in NORTH_METHODS:
         raise InvalidParameter("method", f"{method!r} is not one of {', '.join(NORTH_METHODS)}")

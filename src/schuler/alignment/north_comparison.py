@@ -47,6 +47,18 @@ def readout_noise(model: ErrorModel, step_s: float = READOUT_STEP_S) -> float:
 
     The mapping of :func:`schuler.imu.system_inputs.north_inputs`: the azimuth angle
     integrated over h carries the angle random walk N sqrt(h) and the quantisation Q.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The grade's errors: the z gyro's quantisation Q (rad) and angle random walk N (rad/sqrt(s)).
+    step_s : float
+        Read-out step h, s.
+
+    Returns
+    -------
+    float
+        1-sigma of the angle read-out, rad.
     """
     q, n = model.gyro.quantization[2], model.gyro.random_walk[2]
     return float(math.sqrt(q**2 + n**2 * step_s))
@@ -55,7 +67,43 @@ def readout_noise(model: ErrorModel, step_s: float = READOUT_STEP_S) -> float:
 def simulate_turntable(model: ErrorModel, method: str, *, latitude_rad: float, heading_rad: float, samples: int,
                        sample_interval_s: float, members, seed: int, axes: str,
                        carousel_period_s: float = DEFAULT_CAROUSEL_PERIOD):
-    """Gyro records of a level IMU on the method's schedule: (rates (m, n, k), start, end)."""
+    """Gyro records of a level IMU on the method's schedule: (rates (m, n, k), start, end).
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The simulated sensors' errors.
+    method : {"two_position", "four_position", "carousel"}
+        The turntable schedule (:func:`~schuler.alignment.north.schedule`).
+    latitude_rad : float
+        Site latitude L, rad.
+    heading_rad : float
+        True azimuth psi of the x axis at table angle 0, rad, clockwise from north.
+    samples : int
+        Number of samples n per record.
+    sample_interval_s : float
+        Sample interval dt, s.
+    members : int or array_like of int
+        Number of members m (numbered 0, 1, ...), or the member numbers themselves.
+    seed : int
+        Seed of the addressed random streams.
+    axes : {"x", "xy"}
+        The x gyro alone or both horizontal gyros (k = 1 or 2).
+    carousel_period_s : float
+        One turn of the carousel, s (``carousel`` only).
+
+    Returns
+    -------
+    rates : ndarray of shape (m, n, k)
+        Mean measured angular rate over each sample interval, rad/s, body x (and y).
+    start, end : ndarray of shape (n,)
+        Table angle at the start and the end of each interval, rad.
+
+    Raises
+    ------
+    MemoryBudgetExceeded
+        The records would exceed the memory budget (:func:`schuler.memory.require`).
+    """
     start, end = schedule(method, samples=samples, sample_interval_s=sample_interval_s,
                           carousel_period_s=carousel_period_s)
     truth = turntable_rates(latitude_rad, heading_rad, start, end, sample_interval_s)

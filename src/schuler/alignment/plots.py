@@ -37,7 +37,18 @@ def _pyplot():
 
 
 def heading_figure(result: AlignmentComparison):
-    """Heading of every method against time: error (arcmin) when the truth is known, else relative to Kalman."""
+    """Heading of every method against time: error (arcmin) when the truth is known, else relative to Kalman.
+
+    Parameters
+    ----------
+    result : AlignmentComparison
+        The comparison with its histories (member 0 drawn).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes, heading in arcmin against time in s, the Kalman filter's 1-sigma band and limit.
+    """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(WIDTH_IN, 4.2), dpi=DPI)
     truth = result.true_attitude_rad
@@ -64,7 +75,18 @@ def heading_figure(result: AlignmentComparison):
 
 
 def north_figure(result: NorthComparison):
-    """1-sigma of north against time (each method analytic, Monte Carlo at the chosen time; system 5) and per grade."""
+    """1-sigma of north against time (each method analytic, Monte Carlo at the chosen time; system 5) and per grade.
+
+    Parameters
+    ----------
+    result : NorthComparison
+        The north-finding comparison (its ``versus_time`` and ``versus_grade`` curves).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two axes: 1-sigma in arcmin against observation time in s, and per grade.
+    """
     plt = _pyplot()
     fig, (left, right) = plt.subplots(1, 2, figsize=(WIDTH_IN, 3.8), dpi=DPI, width_ratios=(3, 2))
     times = np.asarray(result.versus_time["duration_s"])
@@ -97,7 +119,18 @@ def north_figure(result: NorthComparison):
 
 
 def calibration_figure(result: CalibrationComparison):
-    """Normalised errors (estimate - true) / predicted 1-sigma of every estimated quantity, per procedure."""
+    """Normalised errors (estimate - true) / predicted 1-sigma of every estimated quantity, per procedure.
+
+    Parameters
+    ----------
+    result : CalibrationComparison
+        The calibration comparison (its six-position and multi-static entries).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes of the normalised errors z (plain numbers) with the +/-3 lines.
+    """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(WIDTH_IN, 4.0), dpi=DPI)
     labels, offset = [], 0
@@ -124,7 +157,25 @@ def calibration_figure(result: CalibrationComparison):
 
 
 def write_files(result, out_dir) -> list[Path]:
-    """Figures (PNG and SVG) and CSV data of an alignment, north-finding or calibration comparison."""
+    """Figures (PNG and SVG) and CSV data of an alignment, north-finding or calibration comparison.
+
+    Parameters
+    ----------
+    result : AlignmentComparison or NorthComparison or CalibrationComparison
+        The comparison to write.
+    out_dir : str or Path
+        Folder the files are written into.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+
+    Raises
+    ------
+    TypeError
+        ``result`` is none of the three comparisons.
+    """
     import pandas as pd
 
     out_dir = Path(out_dir)

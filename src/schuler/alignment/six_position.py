@@ -160,6 +160,32 @@ def fit_triad(inputs: np.ndarray, outputs: np.ndarray, noise: np.ndarray | None 
     """Least squares of Y = [K b] [U; 1]: inputs U (p, 3), outputs Y (p, 3) -> K, b and their 1-sigma.
 
     ``noise`` (p, 3) gives the 1-sigma of each mean (else the residuals' spread is used).
+
+    Parameters
+    ----------
+    inputs : ndarray of shape (p, 3)
+        True input U of each position, body axes: angular rate in rad/s (gyros) or specific force in
+        m/s^2 (accelerometers).
+    outputs : ndarray of shape (p, 3)
+        Measured mean Y of each position, in the same unit and axes.
+    noise : ndarray of shape (p, 3), optional
+        1-sigma of each measured mean, same unit (its mean square over the positions is used per axis).
+
+    Returns
+    -------
+    K : ndarray of shape (3, 3)
+        Scale factor and misalignment matrix, plain numbers.
+    b : ndarray of shape (3,)
+        Bias (measured - true), in the outputs' unit.
+    K_sigma : ndarray of shape (3, 3)
+        1-sigma of each entry of K, plain numbers.
+    b_sigma : ndarray of shape (3,)
+        1-sigma of b, in the outputs' unit.
+
+    Raises
+    ------
+    InvalidParameter
+        The inputs do not span three axes and a constant (rank below 4).
     """
     design = np.hstack([inputs, np.ones((inputs.shape[0], 1))])
     solution, _, rank, _ = np.linalg.lstsq(design, outputs, rcond=None)

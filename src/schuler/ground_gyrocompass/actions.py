@@ -55,6 +55,20 @@ HELD_BYTES_PER_LINE = 80
 def identify_record(record: Path, **values) -> NorthIdentification:
     """Identify north from a CSV record (``north identify RECORD``), SI keywords of :data:`IDENTIFY_PARAMETERS`.
 
+    Parameters
+    ----------
+    record : Path
+        CSV file with columns ``t_s`` (s since release) and ``alpha_rad`` (observed coordinate, rad).
+    **values
+        Options of :data:`IDENTIFY_PARAMETERS` by name, in SI: ``decay_rate`` 1/s, ``hm`` N m s, ``inertia``
+        kg m^2, ``latitude`` rad or ``omega_h`` rad/s; ``reading``, ``unknowns`` and ``method`` as choices.
+        Missing ones take their defaults.
+
+    Returns
+    -------
+    NorthIdentification
+        The identified north and the other parameters with their standard errors.
+
     Raises
     ------
     InvalidParameter
@@ -83,6 +97,21 @@ def simulate_record(output: Path, **values) -> ObservationRecord:
     The record is made as ``north run`` makes it (closed form (9), read-out noise
     and quantisation); its noise is that of member 0 of a Monte Carlo with the same
     seed. SI keywords of :data:`SIMULATE_PARAMETERS`.
+
+    Parameters
+    ----------
+    output : Path
+        CSV file to write (columns ``t_s`` and ``alpha_rad``).
+    **values
+        Options of :data:`SIMULATE_PARAMETERS` by name, in SI: ``alpha0`` rad, ``alpha0_dot`` rad/s,
+        ``torque`` N m, ``decay_rate`` 1/s, ``hm`` N m s, ``inertia`` kg m^2, ``latitude`` rad or ``omega_h``
+        rad/s, ``duration`` and ``output_step`` s, ``readout_noise``, ``quantisation`` and ``offset`` rad;
+        ``reading`` a choice, ``seed`` an integer. Missing ones take their defaults.
+
+    Returns
+    -------
+    ObservationRecord
+        The record written (times, observed coordinate) and the truth it was made from.
 
     Raises
     ------

@@ -144,6 +144,18 @@ def fit_bytes_per_sample(method: str, unknowns: int) -> int:
 
     The grid evaluates the basis on every (lambda, B) pair of a stage at once,
     16 columns each (measured: 210 bytes for 2 unknowns, 26 kB for 4, 47 kB for 5).
+
+    Parameters
+    ----------
+    method : {"lsq", "grid"}
+        The estimator: variable-projection least squares or the source's grid.
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified.
+
+    Returns
+    -------
+    int
+        Bytes per sample of the record.
     """
     if method == "grid":
         return 8 * (30 + 16 * GRID_PAIRS[unknowns])
@@ -155,12 +167,40 @@ BATCH_BYTES = 64 * 2**20
 
 
 def sample_count(duration: float, step: float) -> float:
-    """Samples of a record of ``duration`` every ``step`` (the rule of :func:`~schuler.core.geometry.time_grid`)."""
+    """Samples of a record of ``duration`` every ``step`` (the rule of :func:`~schuler.core.geometry.time_grid`).
+
+    Parameters
+    ----------
+    duration : float
+        Observation window from the release, s.
+    step : float
+        Sampling step, s.
+
+    Returns
+    -------
+    float
+        Number of samples (a float: a huge request can be sized, then refused).
+    """
     return grid_points(duration, step, names=("duration", "output_step"))
 
 
 def fit_bytes(samples: int, method: str, unknowns: int) -> int:
-    """Memory one identification of a record of ``samples`` holds at its peak, bytes."""
+    """Memory one identification of a record of ``samples`` holds at its peak, bytes.
+
+    Parameters
+    ----------
+    samples : int
+        Number of samples in the record.
+    method : {"lsq", "grid"}
+        The estimator: variable-projection least squares or the source's grid.
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified.
+
+    Returns
+    -------
+    int
+        Bytes (making the record and fitting it).
+    """
     return samples * (RECORD_BYTES_PER_SAMPLE + fit_bytes_per_sample(method, unknowns))
 
 
@@ -181,6 +221,16 @@ def omega_h_of(cases: Cases) -> np.ndarray:
     Omega cos(latitude) where the latitude is set, ``omega_h`` where that is set,
     otherwise the source's 3.65e-5 rad/s (Fedorov et al. (2020), before Table 1).
 
+    Parameters
+    ----------
+    cases : Cases
+        The cases (validated SI arrays): ``latitude`` (rad) and ``omega_h`` (rad/s) where set.
+
+    Returns
+    -------
+    ndarray (n,)
+        Omega_h of each case, rad/s.
+
     Raises
     ------
     InvalidParameter
@@ -199,6 +249,12 @@ def omega_h_of(cases: Cases) -> np.ndarray:
 
 def truth_of(cases: Cases) -> dict[str, np.ndarray]:
     """The true motion's parameters of each case, named as the estimator names them.
+
+    Parameters
+    ----------
+    cases : Cases
+        The cases (validated SI arrays of :data:`PARAMETERS`: ``alpha0`` rad, ``alpha0_dot`` rad/s,
+        ``decay_rate`` 1/s, ``hm`` N m s, ``inertia`` kg m^2, ``torque`` N m, ``offset`` rad, and the site).
 
     Returns
     -------
@@ -225,6 +281,23 @@ def record_window(cases: Cases, bytes_per_sample: int) -> np.ndarray:
 
     Refuses (:func:`~schuler.memory.require`) before allocating when a record of
     ``bytes_per_sample`` per sample would exceed the memory budget.
+
+    Parameters
+    ----------
+    cases : Cases
+        Cases of one ``duration`` and ``output_step`` (s; the first case's are used).
+    bytes_per_sample : int
+        Memory held per sample of the record while it is made and fitted, bytes.
+
+    Returns
+    -------
+    ndarray (samples,)
+        Sample times from the release, s (:func:`~schuler.core.geometry.time_grid`).
+
+    Raises
+    ------
+    InvalidParameter
+        An output step longer than the duration (MemoryBudgetExceeded: a record over the budget).
     """
     duration, step = float(cases.float("duration")[0]), float(cases.float("output_step")[0])
     if step > duration:
@@ -234,7 +307,28 @@ def record_window(cases: Cases, bytes_per_sample: int) -> np.ndarray:
 
 
 def true_motion(time: np.ndarray, truth: dict[str, np.ndarray], fidelity: str) -> np.ndarray:
-    """alpha(t_k) of each case, shape (cases, samples), rad: closed form (9) or numerical integration."""
+    """alpha(t_k) of each case, shape (cases, samples), rad: closed form (9) or numerical integration.
+
+    Parameters
+    ----------
+    time : ndarray (samples,)
+        Sample times since the release, s.
+    truth : dict of str to ndarray (cases,)
+        :func:`truth_of` the cases: ``alpha0`` rad, ``alpha0_dot`` rad/s, ``decay_rate`` 1/s,
+        ``coefficient`` 1/s^2, ``specific_torque`` rad/s^2.
+    fidelity : {"closed", "simulated"}
+        Closed form (9), or numerical integration of eqs. (1)-(2).
+
+    Returns
+    -------
+    ndarray (cases, samples)
+        The true angle alpha of the rotor axis from north, rad.
+
+    Raises
+    ------
+    InvalidParameter
+        A decay too slow for the closed form's phase, or a window past the rotor's run-down.
+    """
     # the estimator fits the closed form (9), whichever way the record is made: a decay so slow that
     # its Bessel arguments lose their phase is refused
     motion.check_closed_form_reach(truth["decay_rate"], truth["coefficient"])
@@ -381,6 +475,23 @@ def identify_north(time, observed, unknowns: int, **known) -> NorthEstimate:
     basis overflows; the fit rejects such steps, so numpy's floating-point warnings
     about them are silenced here, and an estimate that is not finite raises instead.
 
+    Parameters
+    ----------
+    time : ndarray (n,)
+        Sample times since release, s.
+    observed : ndarray (n,)
+        Observed coordinate, rad (alpha - alpha0, or alpha + c for ``reading="absolute"``).
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified.
+    **known
+        The keywords of :func:`~.estimate.identify`, SI: ``decay_rate`` (1/s), ``hm`` (N m s),
+        ``inertia`` (kg m^2), ``omega_h`` (rad/s), ``reading`` and ``method``.
+
+    Returns
+    -------
+    NorthEstimate
+        The identified north with its standard errors.
+
     Raises
     ------
     IdentificationError
@@ -395,7 +506,20 @@ def identify_north(time, observed, unknowns: int, **known) -> NorthEstimate:
 
 
 def estimate_outputs(estimate: NorthEstimate) -> dict[str, float]:
-    """The outputs an estimate gives (SI), NaN where it has no value (a standard error without residual dof)."""
+    """The outputs an estimate gives (SI), NaN where it has no value (a standard error without residual dof).
+
+    Parameters
+    ----------
+    estimate : NorthEstimate
+        What the estimator identified from one record.
+
+    Returns
+    -------
+    dict of str to float
+        Output name of :data:`OUTPUTS` -> value, SI (rad, rad/s, 1/s, 1/s^2, N m s, N m, rad^2; counts
+        and ``converged`` as plain numbers); those of the truth and the case (north error, predicted
+        standard error, omega_h, samples) are not among them.
+    """
     std = estimate.alpha0_rad_std
     return {
         "north_rad": -estimate.alpha0_rad,

@@ -40,7 +40,20 @@ STEP_ALPHA0_DOT = 1e-4  # rad/s
 
 
 def axis(start: float, stop: float, step: float) -> np.ndarray:
-    """Grid values start, start + step, ..., stop (inclusive, rounded to whole steps)."""
+    """Grid values start, start + step, ..., stop (inclusive, rounded to whole steps).
+
+    Parameters
+    ----------
+    start, stop : float
+        First and last value, in the axis's SI unit (rad, rad/s, 1/s or 1/s^2).
+    step : float
+        Spacing, same unit (> 0; not checked).
+
+    Returns
+    -------
+    ndarray
+        The values, same unit.
+    """
     count = int(round((stop - start) / step)) + 1
     return start + step * np.arange(count)
 
@@ -83,7 +96,22 @@ SOURCE_STAGES = {
 
 
 def source_boxes(unknowns: int, inertia: float, omega_h: float) -> list[dict]:
-    """The source's stage boxes for 2, 3 or 4 unknowns, with H_m turned into B = H_m Omega_h / J."""
+    """The source's stage boxes for 2, 3 or 4 unknowns, with H_m turned into B = H_m Omega_h / J.
+
+    Parameters
+    ----------
+    unknowns : {2, 3, 4}
+        Number of unknowns of the source's table (Tables 1-3).
+    inertia : float
+        Moment of inertia J of the sensitive element, kg m^2.
+    omega_h : float
+        Horizontal Earth rate Omega_h, rad/s.
+
+    Returns
+    -------
+    list of dict
+        One box per stage: axis name -> (start, stop, step), SI (``coefficient`` in 1/s^2).
+    """
     boxes = []
     for box in SOURCE_STAGES[unknowns]:
         box = dict(box)
@@ -160,6 +188,10 @@ def misfit_cells_ode(time, observed, cells, reading="relative"):
 
     Parameters
     ----------
+    time : ndarray (n,)
+        Sample times since release, s.
+    observed : ndarray (n,)
+        Observed coordinate alpha - alpha0, rad.
     cells : ndarray (n_cells, 4)
         (alpha0 rad, alpha0_dot rad/s, lambda 1/s, B 1/s^2) per cell.
     reading : {"relative"}
@@ -197,7 +229,31 @@ class Stage:
 
 
 def run_stage(time, observed, box, decay_rate, coefficient, reading="relative", torque=False) -> Stage:
-    """Evaluate one stage box; axes missing from ``box`` are held at the known values."""
+    """Evaluate one stage box; axes missing from ``box`` are held at the known values.
+
+    Parameters
+    ----------
+    time : ndarray (n,)
+        Sample times since release, s.
+    observed : ndarray (n,)
+        Observed coordinate, rad (alpha - alpha0, or alpha + c with ``reading="absolute"``).
+    box : dict of str to (float, float, float)
+        Scanned axis -> (start, stop, step), SI: ``alpha0`` (rad) and ``alpha0_dot`` (rad/s) always,
+        ``decay_rate`` (1/s) and ``coefficient`` (1/s^2) when scanned.
+    decay_rate : float
+        lambda, 1/s, when not scanned.
+    coefficient : float
+        B, 1/s^2, when not scanned.
+    reading : {"relative", "absolute"}
+        With "absolute" the unknown offset is eliminated exactly in each cell.
+    torque : bool
+        Eliminate a constant harmful torque exactly in each cell (5 unknowns).
+
+    Returns
+    -------
+    Stage
+        The best cell, its misfit (rad^2) and the misfit surface over (alpha0, alpha0_dot).
+    """
     axes = {
         "alpha0": axis(*box["alpha0"]),
         "alpha0_dot": axis(*box["alpha0_dot"]),
@@ -218,7 +274,30 @@ def run_stage(time, observed, box, decay_rate, coefficient, reading="relative", 
 
 
 def refine(time, observed, stages, decay_rate, coefficient, reading="relative", torque=False) -> list[Stage]:
-    """Run a list of stage boxes in order (each is independent, as printed in the source)."""
+    """Run a list of stage boxes in order (each is independent, as printed in the source).
+
+    Parameters
+    ----------
+    time : ndarray (n,)
+        Sample times since release, s.
+    observed : ndarray (n,)
+        Observed coordinate, rad (alpha - alpha0, or alpha + c with ``reading="absolute"``).
+    stages : list of dict
+        The boxes (:func:`run_stage`; e.g. :func:`source_boxes`), SI.
+    decay_rate : float
+        lambda, 1/s, where not scanned.
+    coefficient : float
+        B, 1/s^2, where not scanned.
+    reading : {"relative", "absolute"}
+        With "absolute" the unknown offset is eliminated exactly in each cell.
+    torque : bool
+        Eliminate a constant harmful torque exactly in each cell.
+
+    Returns
+    -------
+    list of Stage
+        One per box, in order.
+    """
     return [run_stage(time, observed, box, decay_rate, coefficient, reading, torque) for box in stages]
 
 
@@ -228,6 +307,20 @@ def first_box(unknowns: int, decay_rate: float, coefficient: float) -> dict:
     alpha0 over (-9..9) pi/540 in steps of pi/540, alpha0_dot over (-6..6)e-4 rad/s in
     steps of 1e-4 (the source's box); lambda over the nominal +-50 % and B over the
     nominal +-25 % (the source's spans), 21 values each.
+
+    Parameters
+    ----------
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns: lambda is scanned from 3, B from 4.
+    decay_rate : float
+        Nominal lambda, 1/s (the box's centre).
+    coefficient : float
+        Nominal B, 1/s^2 (the box's centre).
+
+    Returns
+    -------
+    dict of str to (float, float, float)
+        Axis -> (start, stop, step), SI.
     """
     box = {"alpha0": (-9 * STEP_ALPHA0, 9 * STEP_ALPHA0, STEP_ALPHA0), "alpha0_dot": (-6e-4, 6e-4, 1e-4)}
     for name, centre, half_span in (("decay_rate", decay_rate, 0.5), ("coefficient", coefficient, 0.25)):
@@ -242,6 +335,30 @@ def refine_around(time, observed, box, decay_rate, coefficient, stages=3, readin
 
     This is the source's procedure made automatic: each later box spans one
     previous step either side of the previous optimum.
+
+    Parameters
+    ----------
+    time : ndarray (n,)
+        Sample times since release, s.
+    observed : ndarray (n,)
+        Observed coordinate, rad (alpha - alpha0, or alpha + c with ``reading="absolute"``).
+    box : dict of str to (float, float, float)
+        The first stage's box, SI (:func:`first_box`).
+    decay_rate : float
+        lambda, 1/s, where not scanned.
+    coefficient : float
+        B, 1/s^2, where not scanned.
+    stages : int
+        Number of stages, the first included.
+    reading : {"relative", "absolute"}
+        With "absolute" the unknown offset is eliminated exactly in each cell.
+    torque : bool
+        Eliminate a constant harmful torque exactly in each cell.
+
+    Returns
+    -------
+    list of Stage
+        One per stage, in order.
     """
     results = [run_stage(time, observed, box, decay_rate, coefficient, reading, torque)]
     for _ in range(1, stages):
@@ -257,6 +374,35 @@ def identify_grid(time, observed, unknowns, decay_rate, coefficient, reading="re
     Linear parameters beyond the source's (harmful torque for 5 unknowns, reading
     offset) are eliminated exactly in each cell. ``nfev`` counts grid cells.
     Standard errors are those of the Jacobian at the best cell.
+
+    Parameters
+    ----------
+    time : ndarray (n,)
+        Sample times since release, s.
+    observed : ndarray (n,)
+        Observed coordinate, rad (alpha - alpha0, or alpha + c with ``reading="absolute"``).
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns (:data:`~.problem.UNKNOWN_SETS`).
+    decay_rate : float
+        lambda, 1/s: known (2 unknowns) or the first box's centre.
+    coefficient : float
+        B, 1/s^2: known (2, 3 unknowns) or the first box's centre.
+    reading : {"relative", "absolute"}
+        What ``observed`` holds.
+    stages : int
+        Number of grid stages.
+
+    Returns
+    -------
+    Fit
+        The best cell of the last stage, the linear extras at it, and the covariance from the Jacobian there.
+
+    Raises
+    ------
+    InvalidParameter
+        A bad record (:func:`~.problem.check_record`).
+    IdentificationError
+        The unknowns are not identifiable from the record (rank-deficient Jacobian).
     """
     time, observed = check_record(time, observed, unknowns, reading)
     torque = unknowns == 5

@@ -92,13 +92,20 @@ def predicted_errors(values, duration, step, noise, quantisation=0.0, unknowns=4
         time grid (:func:`~schuler.core.geometry.time_grid`, as the records are).
     noise, quantisation : ndarray (n,)
         Read-out noise standard deviation and resolution, rad.
-    unknowns : int
-        2, 3, 4 or 5 (the same for all cases).
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (the same for all cases).
+    reading : {"relative", "absolute"}
+        The observations: alpha(t) - alpha0, or alpha(t) + c with an unknown offset c.
 
     Returns
     -------
     dict
         ``<parameter>_std`` (SI) for each identified parameter, arrays (n,).
+
+    Raises
+    ------
+    InvalidParameter
+        A case with fewer samples than unknowns.
 
     Examples
     --------
@@ -187,9 +194,17 @@ def monte_carlo(
     noises : sequence of float
         Read-out noise standard deviations, rad.
     members : int
-        Noisy records per case.
-    unknowns, step, quantisation, reading, seed
-        Fit set, sampling step (s), read-out resolution (rad), reading, random seed.
+        Number of noisy records per case (at least 2).
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns the estimator identifies.
+    step : float
+        Sampling step, s.
+    quantisation : float
+        Read-out resolution, rad (0: none).
+    reading : {"relative", "absolute"}
+        The observations: alpha(t) - alpha0, or alpha(t) + c (``truth["offset"]``).
+    seed : int
+        Seed of the noise generator (one stream drawn in order over durations, noises and records).
     nominal : dict, optional
         The instrument's nominal ``decay_rate`` (1/s) and ``coefficient`` (1/s^2)
         handed to the estimator, as ``--lambda`` and ``--hm`` are: the known values

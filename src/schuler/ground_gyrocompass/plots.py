@@ -27,7 +27,22 @@ def _pyplot():
 
 
 def plot_fit(estimate, stem, formats=("png", "svg")):
-    """Observed coordinate with the fitted model (arcmin) and the residuals (arcsec)."""
+    """Observed coordinate with the fitted model (arcmin) and the residuals (arcsec).
+
+    Parameters
+    ----------
+    estimate : NorthEstimate
+        An estimate with its record (``time`` s, ``observed`` and ``residuals`` rad).
+    stem : str or Path
+        Path of the files without suffix.
+    formats : tuple of str
+        Suffixes to write, e.g. ``("png", "svg")``.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     plt = _pyplot()
     time = estimate.time
     fitted = estimate.observed - estimate.residuals
@@ -48,7 +63,24 @@ def plot_fit(estimate, stem, formats=("png", "svg")):
 
 
 def plot_misfit_map(stage, stem, formats=("png", "svg"), title=None):
-    """log10 of the misfit over (alpha0, alpha0_dot) of a grid stage, best cell marked."""
+    """log10 of the misfit over (alpha0, alpha0_dot) of a grid stage, best cell marked.
+
+    Parameters
+    ----------
+    stage : Stage
+        A grid stage (:class:`~.grid.Stage`): its box (SI), best cell and misfit surface (rad^2).
+    stem : str or Path
+        Path of the files without suffix.
+    formats : tuple of str
+        Suffixes to write, e.g. ``("png", "svg")``.
+    title : str, optional
+        The figure's title (default: the stage's cells).
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     plt = _pyplot()
     alpha0 = axis(*stage.box["alpha0"]) * ARCMIN_PER_RAD
     rate = axis(*stage.box["alpha0_dot"]) * 1e4
@@ -70,6 +102,24 @@ def plot_error_vs_time(durations, series, stem, title, formats=("png", "svg")):
     """North standard error (arcsec) against the observation window.
 
     ``series`` is a list of (label, values in arcsec, style) drawn on a log scale.
+
+    Parameters
+    ----------
+    durations : array_like (k,)
+        Observation windows, s.
+    series : list of (str, array_like (k,), str)
+        Label, north standard error in arcsec (display unit) at each window, matplotlib format string.
+    stem : str or Path
+        Path of the files without suffix.
+    title : str
+        The figure's title.
+    formats : tuple of str
+        Suffixes to write, e.g. ``("png", "svg")``.
+
+    Returns
+    -------
+    list of Path
+        The files written.
     """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 5))
@@ -86,7 +136,22 @@ def plot_error_vs_time(durations, series, stem, title, formats=("png", "svg")):
 
 
 def plot_study(study, stem, formats=("png", "svg")):
-    """Monte Carlo scatter and predicted standard error of north against the window."""
+    """Monte Carlo scatter and predicted standard error of north against the window.
+
+    Parameters
+    ----------
+    study : NorthErrorStudy
+        A Monte Carlo study (:func:`~.monte_carlo.monte_carlo`; its errors are in arcsec, windows in s).
+    stem : str or Path
+        Path of the files without suffix.
+    formats : tuple of str
+        Suffixes to write, e.g. ``("png", "svg")``.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     series = []
     for j, noise in enumerate(study.noises_arcsec):
         series.append((f'Monte Carlo, noise {noise:g}"', study.std_error_arcsec[:, j], f"C{j}o"))
@@ -96,7 +161,26 @@ def plot_study(study, stem, formats=("png", "svg")):
 
 
 def plot_record(time, observed, stem, title, formats=("png", "svg")):
-    """An observation record: the observed coordinate (arcmin) against time."""
+    """An observation record: the observed coordinate (arcmin) against time.
+
+    Parameters
+    ----------
+    time : ndarray (n,)
+        Sample times since release, s.
+    observed : ndarray (n,)
+        Observed coordinate, rad (drawn in arcmin).
+    stem : str or Path
+        Path of the files without suffix.
+    title : str
+        The figure's title.
+    formats : tuple of str
+        Suffixes to write, e.g. ``("png", "svg")``.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 4.5))
     ax.plot(time, observed * ARCMIN_PER_RAD, ".", ms=3)
@@ -109,7 +193,26 @@ def plot_record(time, observed, stem, title, formats=("png", "svg")):
 
 
 def plot_error_histogram(errors_arcsec, predicted_std_arcsec, stem, title, formats=("png", "svg")):
-    """Histogram of Monte Carlo north errors (arcsec) with the normal density of the predicted standard error."""
+    """Histogram of Monte Carlo north errors (arcsec) with the normal density of the predicted standard error.
+
+    Parameters
+    ----------
+    errors_arcsec : array_like
+        North errors (identified - true), arcsec (display unit; non-finite ones are left out).
+    predicted_std_arcsec : float
+        Predicted standard error of north, arcsec (0: no density drawn).
+    stem : str or Path
+        Path of the files without suffix.
+    title : str
+        The figure's title.
+    formats : tuple of str
+        Suffixes to write, e.g. ``("png", "svg")``.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+    """
     plt = _pyplot()
     errors = np.asarray(errors_arcsec, dtype=float)
     errors = errors[np.isfinite(errors)]

@@ -49,6 +49,22 @@ NONLINEAR = ("decay_rate", "coefficient")
 def check_record(time, observed, unknowns: int, reading: str = "relative"):
     """Validate an observation record and the requested fit; return float arrays.
 
+    Parameters
+    ----------
+    time : array_like of shape (n,)
+        Times t_k since release, s (>= 0, strictly increasing).
+    observed : array_like of shape (n,)
+        Observed angles y_k, rad.
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+    reading : {"relative", "absolute"}
+        The observations: alpha(t) - alpha0, or alpha(t) + c with an unknown offset c.
+
+    Returns
+    -------
+    time, observed : ndarray of shape (n,)
+        The same, as float arrays (s, rad).
+
     Raises
     ------
     InvalidParameter
@@ -80,18 +96,55 @@ def check_record(time, observed, unknowns: int, reading: str = "relative"):
 
 
 def linear_names(unknowns: int, reading: str) -> list[str]:
-    """The linear parameters in column order: alpha0, alpha0_dot[, specific_torque][, offset]."""
+    """The linear parameters in column order: alpha0, alpha0_dot[, specific_torque][, offset].
+
+    Parameters
+    ----------
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+    reading : {"relative", "absolute"}
+        The observations: alpha(t) - alpha0, or alpha(t) + c with an unknown offset c.
+
+    Returns
+    -------
+    list of str
+        Their names.
+    """
     names = ["alpha0", "alpha0_dot"] + (["specific_torque"] if unknowns == 5 else [])
     return names + (["offset"] if reading == "absolute" else [])
 
 
 def nonlinear_names(unknowns: int) -> list[str]:
-    """The identified nonlinear parameters, in order: [decay_rate[, coefficient]]."""
+    """The identified nonlinear parameters, in order: [decay_rate[, coefficient]].
+
+    Parameters
+    ----------
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+
+    Returns
+    -------
+    list of str
+        Their names (empty for 2 unknowns).
+    """
     return [name for name in UNKNOWN_SETS[unknowns] if name in NONLINEAR]
 
 
 def parameter_order(unknowns: int, reading: str) -> tuple:
-    """Identified parameters in covariance order: linear ones first, then lambda, B."""
+    """Identified parameters in covariance order: linear ones first, then lambda, B.
+
+    Parameters
+    ----------
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+    reading : {"relative", "absolute"}
+        The observations: alpha(t) - alpha0, or alpha(t) + c with an unknown offset c.
+
+    Returns
+    -------
+    tuple of str
+        Their names.
+    """
     return tuple(linear_names(unknowns, reading) + nonlinear_names(unknowns))
 
 
@@ -101,6 +154,36 @@ def design(time, decay_rate, coefficient, unknowns: int, reading: str, derivativ
     Returns ``(phi, d_lam, d_b, names)``, arrays (n, p) and the linear
     parameters' names in column order (zeros for the derivatives without
     ``derivatives``).
+
+    Parameters
+    ----------
+    time : array_like of shape (n,)
+        Times since release, s.
+    decay_rate : float
+        lambda, 1/s (> 0).
+    coefficient : float
+        B = H_m Omega_h / J, 1/s^2 (> 0).
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+    reading : {"relative", "absolute"}
+        The observations: alpha(t) - alpha0, or alpha(t) + c with an unknown offset c.
+    derivatives : bool
+        Also compute the derivatives w.r.t. lambda and B.
+
+    Returns
+    -------
+    phi : ndarray of shape (n, p)
+        Model columns of the linear parameters, rad per unit of each: plain numbers for alpha0 and the
+        offset, s for alpha0_dot, s^2 for the specific torque.
+    d_lam, d_b : ndarray of shape (n, p)
+        d phi / d lambda (phi's unit times s) and d phi / d B (times s^2).
+    names : list of str
+        The linear parameters' names, in column order (:func:`linear_names`).
+
+    Raises
+    ------
+    InvalidParameter
+        lambda or B not finite and positive.
     """
     check_decay_rate(decay_rate)
     check_positive(coefficient, "B", "1/s^2")
@@ -117,6 +200,26 @@ def design_columns(time, decay_rate: float, coefficient: float, unknowns: int, r
 
     For the least-squares fit's inner loop, which validates once. Returns
     ``(phi, d_lam, d_b, names)``; ``d_lam`` and ``d_b`` are None without ``derivatives``.
+
+    Parameters
+    ----------
+    time : ndarray of shape (n,)
+        Times since release, s.
+    decay_rate : float
+        lambda, 1/s (> 0, not checked).
+    coefficient : float
+        B, 1/s^2 (> 0, not checked).
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+    reading : {"relative", "absolute"}
+        The observations: alpha(t) - alpha0, or alpha(t) + c with an unknown offset c.
+    derivatives : bool
+        Also compute the derivatives w.r.t. lambda and B.
+
+    Returns
+    -------
+    phi, d_lam, d_b, names
+        As :func:`design`.
     """
     torque = unknowns == 5
     angle, d_lam, d_b = basis_columns(time, decay_rate, coefficient, torque, derivatives)
@@ -172,6 +275,18 @@ class Fit:
 def unscaled_covariance(jacobian, unknowns: int) -> np.ndarray:
     """(J^T J)^-1 from the full Jacobian J (n, p) by a column-scaled SVD.
 
+    Parameters
+    ----------
+    jacobian : ndarray of shape (n, p)
+        d model / d parameters (:func:`full_jacobian`), rad per each parameter's SI unit.
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+
+    Returns
+    -------
+    ndarray of shape (p, p)
+        (J^T J)^-1, in the products of the parameters' SI units per rad^2.
+
     Raises
     ------
     IdentificationError
@@ -197,6 +312,20 @@ def covariance(jacobian, observed_residuals, unknowns):
 
     None when n == p (no residual degrees of freedom). Raises IdentificationError
     as :func:`unscaled_covariance`.
+
+    Parameters
+    ----------
+    jacobian : ndarray of shape (n, p)
+        d model / d parameters, rad per each parameter's SI unit.
+    observed_residuals : ndarray of shape (n,)
+        observed - model, rad.
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+
+    Returns
+    -------
+    ndarray of shape (p, p) or None
+        Covariance of the identified parameters, SI (products of their units).
     """
     n, p = jacobian.shape
     inverse = unscaled_covariance(jacobian, unknowns)
@@ -206,13 +335,48 @@ def covariance(jacobian, observed_residuals, unknowns):
 
 
 def full_jacobian(time, values, unknowns, reading):
-    """d model / d (identified parameters), shape (n, p), columns in ``names`` order."""
+    """d model / d (identified parameters), shape (n, p), columns in ``names`` order.
+
+    Parameters
+    ----------
+    time : array_like of shape (n,)
+        Times since release, s.
+    values : dict of str to float
+        Every parameter's value, SI (:class:`Fit`): ``decay_rate`` (1/s), ``coefficient`` (1/s^2) and the
+        linear ones (rad, rad/s, rad/s^2).
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+    reading : {"relative", "absolute"}
+        The observations: alpha(t) - alpha0, or alpha(t) + c with an unknown offset c.
+
+    Returns
+    -------
+    ndarray of shape (n, p)
+        Columns in :func:`parameter_order`, rad per each parameter's SI unit.
+    """
     phi, d_lam, d_b, linear = design(time, values["decay_rate"], values["coefficient"], unknowns, reading)
     return jacobian_from_design(phi, d_lam, d_b, np.array([values[name] for name in linear]), unknowns)
 
 
 def jacobian_from_design(phi, d_lam, d_b, coefficients, unknowns):
-    """Full Jacobian: the linear columns, then d model / d lambda and d model / d B if identified."""
+    """Full Jacobian: the linear columns, then d model / d lambda and d model / d B if identified.
+
+    Parameters
+    ----------
+    phi : ndarray of shape (n, q)
+        Columns of the linear parameters (:func:`design`), rad per unit of each.
+    d_lam, d_b : ndarray of shape (n, q)
+        Their derivatives w.r.t. lambda (times s) and B (times s^2).
+    coefficients : ndarray of shape (q,)
+        Values of the linear parameters, SI (rad, rad/s[, rad/s^2][, rad]).
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified (:data:`UNKNOWN_SETS`).
+
+    Returns
+    -------
+    ndarray of shape (n, p)
+        Columns in :func:`parameter_order`: d model / d lambda in rad s, d model / d B in rad s^2.
+    """
     columns = [phi[:, k] for k in range(phi.shape[1])]
     for name in nonlinear_names(unknowns):
         columns.append((d_lam if name == "decay_rate" else d_b) @ coefficients)

@@ -34,6 +34,22 @@ def accuracy_against_window(windows, noises_arcsec, members: int, unknowns: int 
     Noise level ``j`` uses seed ``j``, so the levels are independent samples (the
     windows of one level share their members' noise series, as records cut short would).
     Returns ``(monte_carlo_std, predicted_std)``, arrays indexed [window, noise].
+
+    Parameters
+    ----------
+    windows : array_like (k,)
+        Observation windows, s.
+    noises_arcsec : sequence of float
+        Read-out noise levels, arcsec (display unit: the report's).
+    members : int
+        Number of Monte Carlo records per window and noise level.
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns identified.
+
+    Returns
+    -------
+    monte_carlo_std, predicted_std : ndarray (k, len(noises_arcsec))
+        Standard deviation of the north error over the members and the one the Jacobian predicts, arcsec.
     """
     std = np.empty((len(windows), len(noises_arcsec)))
     predicted = np.empty_like(std)
@@ -47,7 +63,18 @@ def accuracy_against_window(windows, noises_arcsec, members: int, unknowns: int 
 
 
 def report(outdir: Path) -> ReportSection:
-    """Write this system's figures into ``outdir`` and describe them (a few seconds)."""
+    """Write this system's figures into ``outdir`` and describe them (a few seconds).
+
+    Parameters
+    ----------
+    outdir : Path
+        Folder the figures are written into.
+
+    Returns
+    -------
+    ReportSection
+        The section: the reproduction's rows, the figures with captions, the commands to try.
+    """
     outdir = Path(outdir)
     reproduction = reproduce(4)
     files = write_files(reproduction, outdir)

@@ -154,6 +154,21 @@ def stage_comparison(time, observed, unknowns: int) -> list[dict]:
     alpha0 in pi/540, alpha0_dot in 1e-4 rad/s, lambda in 1e-3 1/s, H_m in N m s), half
     the box's step per axis in the same units, the computed least misfit and the
     misfit at the printed cell (rad^2).
+
+    Parameters
+    ----------
+    time : ndarray (n,)
+        Sample times since release, s (the source's record: :func:`source_record`).
+    observed : ndarray (n,)
+        Observed coordinate alpha - alpha0, rad (same record).
+    unknowns : {2, 3, 4}
+        Number of unknowns of the source's table (Tables 1-3).
+
+    Returns
+    -------
+    list of dict
+        One row per stage: ``unknowns``, ``stage``, ``cells`` (counts), ``printed_best``, ``computed_best``
+        and ``half_steps`` (source units), ``computed_misfit`` and ``misfit_at_printed_best`` (rad^2).
     """
     boxes = source_boxes(unknowns, motion.SOURCE_INERTIA, motion.SOURCE_OMEGA_H)
     stages = refine(time, observed, boxes, motion.SOURCE_LAMBDA, source_b())
@@ -183,6 +198,20 @@ def honest_four_unknowns(time, observed) -> dict:
 
     Returns the misfit at the printed best cell, the real best cell and misfit,
     and where the automatic refinement (+-1 previous step, steps / 10) ends.
+
+    Parameters
+    ----------
+    time : ndarray (n,)
+        Sample times since release, s (the source's record: :func:`source_record`).
+    observed : ndarray (n,)
+        Observed coordinate alpha - alpha0, rad (same record).
+
+    Returns
+    -------
+    dict
+        ``printed_best_misfit``, ``first_stage_misfit``, ``refined_misfit`` (rad^2); ``first_stage_best``
+        and ``refined_best`` (source units: alpha0 in pi/540, alpha0_dot in 1e-4 rad/s, lambda in
+        1e-3 1/s, H_m in N m s); ``refined_alpha0_error_rad`` (computed - true, rad).
     """
     box = source_boxes(4, motion.SOURCE_INERTIA, motion.SOURCE_OMEGA_H)[0]
     stages = refine_around(time, observed, box, motion.SOURCE_LAMBDA, source_b())
@@ -215,6 +244,21 @@ def table1_analysis(time, observed) -> dict:
     Also the fit of a quadratic form to the squared table (a norm of a residual
     linear in alpha0, alpha0_dot would fit exactly) and its shape against this
     experiment's.
+
+    Parameters
+    ----------
+    time : ndarray (n,)
+        Sample times since release, s (the source's record: :func:`source_record`).
+    observed : ndarray (n,)
+        Observed coordinate alpha - alpha0, rad (same record).
+
+    Returns
+    -------
+    dict
+        ``computed_sum_of_squares`` (rad^2, on Table 1's cells), ``readings`` (one row per coordinate and
+        reading of the misfit: minimum cell (k, m), values at two cells in that reading's unit, best scale
+        factor and largest deviation as plain numbers), ``any_reading_reproduces``, and the quadratic
+        form's ``quadratic_fit_max_deviation``, ``table_shape`` and ``experiment_shape`` (plain numbers).
     """
     b = source_b()
     u = motion.basis(time, motion.SOURCE_LAMBDA, b, torque=False, derivatives=False).angle

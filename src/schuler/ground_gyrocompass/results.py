@@ -42,7 +42,18 @@ _RUN_UNITS = {"identified_decay_rate": "1/s", "identified_directive_coefficient"
 
 
 def convergence(estimate: NorthEstimate) -> str:
-    """How the estimator ended, in words (never the optimiser's own message)."""
+    """How the estimator ended, in words (never the optimiser's own message).
+
+    Parameters
+    ----------
+    estimate : NorthEstimate
+        An estimate (its method, unknowns, evaluations and convergence).
+
+    Returns
+    -------
+    str
+        One line, e.g. "variable projection converged (12 model evaluations)".
+    """
     if estimate.method == "grid":
         return f"3-stage grid refinement, {estimate.nfev} cells"
     if estimate.unknowns == 2:
@@ -205,6 +216,18 @@ class NorthIdentification(Result):
 
     @classmethod
     def from_estimate(cls, estimate: NorthEstimate) -> NorthIdentification:
+        """The result of ``north identify`` from an estimate: its values, standard errors and correlations.
+
+        Parameters
+        ----------
+        estimate : NorthEstimate
+            What the estimator identified (SI values; kept for the figures).
+
+        Returns
+        -------
+        NorthIdentification
+            North = -alpha0 and every parameter with its standard error, SI.
+        """
         names = [PARAMETER_KEYS[name] for name in estimate.correlation["parameters"]]
         return cls(
             unknowns=estimate.unknowns, method=estimate.method, reading=estimate.reading, identified=names,
@@ -315,7 +338,23 @@ def write_files(result: Result, out_dir: Path) -> list[Path]:
 
 
 def estimate_files(estimate: NorthEstimate, out_dir: Path, noise_rad: float | None = None) -> list[Path]:
-    """The fit and residuals, the misfit map around the estimate, the predicted error against the window, the CSV."""
+    """The fit and residuals, the misfit map around the estimate, the predicted error against the window, the CSV.
+
+    Parameters
+    ----------
+    estimate : NorthEstimate
+        An estimate with its record.
+    out_dir : Path
+        Folder the files are written into.
+    noise_rad : float, optional
+        Read-out noise standard deviation, rad (default: the residuals' rms, or 1 arcsec for a noise-free
+        record).
+
+    Returns
+    -------
+    list of Path
+        The figures (PNG, SVG) and ``north_record_fit.csv``.
+    """
     import pandas as pd
 
 
@@ -342,6 +381,21 @@ def error_vs_time_files(estimate: NorthEstimate, out_dir: Path, noise_rad: float
 
     ``noise_rad`` is the read-out noise (default: the residuals' rms, or 1 arcsec
     for a noise-free record).
+
+    Parameters
+    ----------
+    estimate : NorthEstimate
+        An estimate with its record: its parameters are taken as the truth, its sampling step is kept.
+    out_dir : Path
+        Folder the figure is written into.
+    noise_rad : float, optional
+        Read-out noise standard deviation, rad (default: the residuals' rms, or 1 arcsec for a noise-free
+        record).
+
+    Returns
+    -------
+    list of Path
+        The figure's files (PNG, SVG).
     """
 
     step = float(np.median(np.diff(estimate.time))) if estimate.time.size > 1 else 1.0

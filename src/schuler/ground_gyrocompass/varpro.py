@@ -86,6 +86,18 @@ def initial_estimate(time, observed):
     Returns None when the regression gives no usable values (too short or too
     noisy a record).
 
+    Parameters
+    ----------
+    time : ndarray of shape (n,)
+        Sample times since release, s (increasing, >= 0; validated by the caller).
+    observed : ndarray of shape (n,)
+        Observed coordinate, rad (relative or absolute: the polynomial terms absorb the offset).
+
+    Returns
+    -------
+    (float, float) or None
+        lambda (1/s) and B (1/s^2), or None (fewer than 12 samples, or no usable regression).
+
     Examples
     --------
     >>> from schuler.ground_gyrocompass.motion import closed_form
@@ -286,8 +298,14 @@ def fit_records(time, records, unknowns, decay_rate, coefficient,
         Sample times since release, s.
     records : ndarray (N, n)
         Observed coordinates, rad, one record per row.
-    unknowns, decay_rate, coefficient, reading
-        As in :func:`fit_least_squares` (no ``start``: the default one).
+    unknowns : {2, 3, 4, 5}
+        Number of unknowns, as in :func:`fit_least_squares` (no ``start``: the default one).
+    decay_rate : float
+        lambda, 1/s: known, or the nominal start.
+    coefficient : float
+        B, 1/s^2: known, or the nominal start.
+    reading : {"relative", "absolute"}
+        What the records hold: alpha - alpha0, or alpha + c.
 
     Returns
     -------
