@@ -7,8 +7,8 @@
 
    10,000 Monte Carlo members over 7,200 one-second steps. The engine streams
    the members through a reducer (:class:`PeakOutputs`: final state and
-   largest |state| of every member, what a Monte Carlo keeps, in one
-   compiled pass), the same for the position error alone
+   largest |state| of every member, what a Monte Carlo keeps, reduced as the
+   samples are made, no history written), the same for the position error alone
    (``outputs=["x"]``: only that channel is computed), and returns all
    histories (1.7 GB). Baselines, one member at a time, each producing the
    member's 7,201-point history and the same reduction: scipy's solve_ivp

@@ -4,6 +4,8 @@
   that changes every step, sequential by nature, for every member.
 * :func:`fill_blocks`: the samples of the block scheme, y = rows Phi^j Psi^b z0,
   which numpy would spread over many small matrix products per member.
+* :func:`final_and_peak_blocks`: the same samples reduced to each member's
+  last value and peak magnitude as they are made, never stored.
 * :func:`final_and_peak`: a reducer's single pass over the histories
   (numpy would make a temporary |y| and read each history twice).
 
@@ -82,6 +84,61 @@ def propagate_steps(Ad: np.ndarray, Bd: np.ndarray, kind: np.ndarray, x0: np.nda
 
 
 @numba.njit(cache=True)
+def _fine_rows(step: np.ndarray, rows: np.ndarray, a: int, g: int, gains: np.ndarray) -> None:
+    """``gains[p, c, j] = (rows[g] Phi^j)[p, c]`` for j < L (Phi = step[a]): the fine rows of a block."""
+    r, q, L = gains.shape
+    for p in range(r):
+        for c in range(q):
+            gains[p, c, 0] = rows[g, p, c]
+    for j in range(1, L):
+        for p in range(r):
+            for c in range(q):
+                total = 0.0
+                for k in range(q):
+                    total += gains[p, k, j - 1] * step[a, k, c]
+                gains[p, c, j] = total
+
+
+@numba.njit(cache=True)
+def _held_share(gains: np.ndarray, z: np.ndarray, n_moving: int, held: np.ndarray) -> None:
+    """``held[p, j]``: the constant entries' (z[n_moving:]) share of sample j of every block."""
+    r, q, L = gains.shape
+    for p in range(r):
+        for j in range(L):
+            held[p, j] = 0.0
+        for c in range(n_moving, q):
+            s = z[c]
+            for j in range(L):
+                held[p, j] += s * gains[p, c, j]
+
+
+@numba.njit(cache=True)
+def _block_line(gains: np.ndarray, held: np.ndarray, start: np.ndarray, n_moving: int, p: int,
+                line: np.ndarray) -> None:
+    """Row p's L samples of the block beginning at ``start``: held share plus n_moving multiply-adds each."""
+    L = line.shape[0]
+    for j in range(L):
+        line[j] = held[p, j]
+    for c in range(n_moving):
+        s = start[c]
+        for j in range(L):
+            line[j] += s * gains[p, c, j]
+
+
+@numba.njit(cache=True)
+def _next_start(block: np.ndarray, a: int, n_moving: int, start: np.ndarray, following: np.ndarray) -> None:
+    """start <- Psi start for the moving entries (the constant ones keep their value)."""
+    q = start.shape[0]
+    for c in range(n_moving):
+        total = 0.0
+        for k in range(q):
+            total += block[a, c, k] * start[k]
+        following[c] = total
+    for c in range(n_moving):
+        start[c] = following[c]
+
+
+@numba.njit(cache=True)
 def fill_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray, z0: np.ndarray, n_moving: int,
                 substeps: int, out: np.ndarray) -> None:
     """Fill ``out[i, p, b L + j] = rows[p] Phi^j Psi^b z0[i]`` (Phi = step, Psi = block, L = substeps).
@@ -113,50 +170,69 @@ def fill_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray, z0: np.nd
     """
     members, r, capacity = out.shape
     q = z0.shape[1]
-    L = substeps
-    gains = np.empty((r, q, L))
-    held = np.empty((r, L))  # the constant entries' share of sample j
+    gains = np.empty((r, q, substeps))
+    held = np.empty((r, substeps))
     start = np.empty(q)
     following = np.empty(q)
     for i in range(members):
         a = 0 if step.shape[0] == 1 else i
-        g = 0 if rows.shape[0] == 1 else i
         if i == 0 or step.shape[0] > 1 or rows.shape[0] > 1:
+            _fine_rows(step, rows, a, 0 if rows.shape[0] == 1 else i, gains)
+        _held_share(gains, z0[i], n_moving, held)
+        start[:] = z0[i]
+        for base in range(0, capacity, substeps):
             for p in range(r):
-                for c in range(q):
-                    gains[p, c, 0] = rows[g, p, c]
-            for j in range(1, L):
-                for p in range(r):
-                    for c in range(q):
-                        total = 0.0
-                        for k in range(q):
-                            total += gains[p, k, j - 1] * step[a, k, c]
-                        gains[p, c, j] = total
+                _block_line(gains, held, start, n_moving, p, out[i, p, base : base + substeps])
+            _next_start(block, a, n_moving, start, following)
+
+
+@numba.njit(cache=True, fastmath=True)
+def final_and_peak_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray, z0: np.ndarray, n_moving: int,
+                          substeps: int, n_time: int, final: np.ndarray, peak: np.ndarray) -> None:
+    """Each member's last sample and largest magnitude of the block scheme's samples, never storing a history.
+
+    The samples are those of :func:`fill_blocks`, computed a block at a time
+    into a buffer that stays in cache and reduced as they are made: nothing of
+    the N r T samples is written to memory. Fast-math lets the running maximum
+    vectorise; the inputs are finite (checked by the engine), so it changes
+    the result by rounding only.
+
+    Parameters
+    ----------
+    step, block, rows, z0, n_moving, substeps
+        As in :func:`fill_blocks`.
+    n_time : int
+        Samples per member (the last block may be partly past it).
+    final, peak : ndarray, shape (N, r)
+        Written: the sample at n_time - 1 and max over time of |sample|.
+    """
+    members, r = final.shape
+    q = z0.shape[1]
+    gains = np.empty((r, q, substeps))
+    held = np.empty((r, substeps))
+    start = np.empty(q)
+    following = np.empty(q)
+    line = np.empty(substeps)
+    for i in range(members):
+        a = 0 if step.shape[0] == 1 else i
+        if i == 0 or step.shape[0] > 1 or rows.shape[0] > 1:
+            _fine_rows(step, rows, a, 0 if rows.shape[0] == 1 else i, gains)
+        _held_share(gains, z0[i], n_moving, held)
+        start[:] = z0[i]
         for p in range(r):
-            for j in range(L):
-                held[p, j] = 0.0
-            for c in range(n_moving, q):
-                s = z0[i, c]
-                for j in range(L):
-                    held[p, j] += s * gains[p, c, j]
-        for c in range(q):
-            start[c] = z0[i, c]
-        for base in range(0, capacity, L):
+            peak[i, p] = 0.0
+        for base in range(0, n_time, substeps):
+            count = min(substeps, n_time - base)
             for p in range(r):
-                line = out[i, p, base : base + L]
-                for j in range(L):
-                    line[j] = held[p, j]
-                for c in range(n_moving):
-                    s = start[c]
-                    for j in range(L):
-                        line[j] += s * gains[p, c, j]
-            for c in range(n_moving):
-                total = 0.0
-                for k in range(q):
-                    total += block[a, c, k] * start[k]
-                following[c] = total
-            for c in range(n_moving):
-                start[c] = following[c]
+                _block_line(gains, held, start, n_moving, p, line)
+                largest = peak[i, p]
+                for j in range(count):
+                    value = abs(line[j])
+                    largest = value if value > largest else largest
+                peak[i, p] = largest
+                if base + count == n_time:
+                    final[i, p] = line[count - 1]
+            _next_start(block, a, n_moving, start, following)
 
 
 @numba.njit(cache=True)

@@ -42,7 +42,10 @@ view whose channels are each contiguous in time) and refuses a request beyond
 no history: final values (:class:`FinalOutputs`), final and peak values
 (:class:`PeakOutputs`), statistics
 (:func:`simulate_statistics`: one chunk, 4 T p floats of moments and a
-percentile reservoir of at most :data:`RESERVOIR_BYTES`) or any callable.
+percentile reservoir of at most :data:`RESERVOIR_BYTES`) or any callable. A
+reducer with a ``take_summary(final, peak, members)`` method (the first two)
+is given only those, reduced as the samples are made without writing a
+history, wherever the inputs are constant on a uniform grid.
 Measured for 1,000 members over 48 h at 10 s (17,281 points, 7 channels):
 ``simulate`` peaks at 937 MB traced (1.1 GB resident), ``simulate_statistics``
 at 91 MB (0.3 GB resident, of which 0.16 GB is the interpreter and libraries).
@@ -70,7 +73,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from schuler.core.propagation import Grid, propagate_constant_input, propagate_steps_exact, zoh_discretize
+from schuler.core.propagation import (
+    ConstantInputPropagator,
+    Grid,
+    propagate_constant_input,
+    propagate_steps_exact,
+    zoh_discretize,
+)
 from schuler.core.reducers import FinalOutputs, OutputStatistics, PeakOutputs, Reducer
 from schuler.core.response import Response
 from schuler.core.statespace import StateSpace
@@ -78,15 +87,18 @@ from schuler.core.stats import StreamingStatistics
 from schuler.exceptions import InvalidParameter
 
 __all__ = [
-    "CHUNK_BYTES", "MAX_RESULT_BYTES", "RESERVOIR_BYTES", "FinalOutputs", "OutputStatistics", "PeakOutputs",
-    "Reducer", "Response", "StateSpace", "StatisticsResponse", "simulate", "simulate_reduce", "simulate_statistics",
-    "zoh_discretize",
+    "CHUNK_BYTES", "MAX_RESULT_BYTES", "RESERVOIR_BYTES", "SUMMARY_CHUNK", "FinalOutputs", "OutputStatistics",
+    "PeakOutputs", "Reducer", "Response", "StateSpace", "StatisticsResponse", "simulate", "simulate_reduce",
+    "simulate_statistics", "zoh_discretize",
 ]
 
 MAX_RESULT_BYTES = 4 * 2**30
 """Largest history :func:`simulate` allocates (4 GiB); stream longer runs with :func:`simulate_reduce`."""
 CHUNK_BYTES = 4 * 2**20
 """Default history per chunk of :func:`simulate_reduce` (4 MiB: a chunk stays in cache while it is reduced)."""
+SUMMARY_CHUNK = 4096
+"""Default members per chunk when only final and peak values are kept (a batch of models holds a few
+matrices per member; the propagation holds no history)."""
 RESERVOIR_BYTES = 64 * 2**20
 """Default memory of the members :func:`simulate_statistics` keeps for percentiles (64 MiB)."""
 
@@ -246,6 +258,22 @@ class _Simulation:
             states = states[..., :0]
         return states, outputs
 
+    @property
+    def summarises(self) -> bool:
+        """Whether :meth:`final_and_peak` applies: inputs constant in time on a wholly uniform grid."""
+        return not self.stepped and self.grid.n_uniform == self.grid.times.size
+
+    def final_and_peak(self, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
+        """Final outputs and peak |outputs|, each (k, len(rows)), of members start:stop without histories."""
+        if self.shared is not None:
+            propagator, z0 = self.shared
+            z0 = z0[start:stop]
+        else:
+            propagator, z0 = self._constant(self.system.subset(start, stop), self.drive.part(start, stop))
+        assert isinstance(propagator, ConstantInputPropagator) and propagator.summarises
+        n_kept = self.system.n_states if self.with_states and not self.outputs_are_states else 0
+        return propagator.final_and_peak(z0, slice(n_kept, None))
+
     def _outputs(self, system: StateSpace, states: np.ndarray, u: np.ndarray) -> np.ndarray:
         C, D = _batched(system.C)[:, self.rows], _batched(system.D)[:, self.rows]
         y = np.matmul(states, np.swapaxes(C, -1, -2))
@@ -328,7 +356,11 @@ def simulate_reduce(system: StateSpace, time, initial_state=None, inputs=None, i
         Called as ``reducer(chunk, members)`` for consecutive chunks, where
         ``chunk`` is a batched :class:`Response` (k, T, .) of the members
         ``members`` (a slice of range(N)). See :class:`FinalOutputs` and
-        :class:`OutputStatistics`.
+        :class:`OutputStatistics`. A reducer that also has a method
+        ``take_summary(final, peak, members)`` (final outputs and max |output|
+        over time, each (k, p)) is called with that instead wherever the
+        engine can reduce while propagating (inputs constant in time, uniform
+        grid): no history is written.
     outputs : sequence of str, optional
         Only these outputs, and no states, are computed and passed on (default:
         all states and outputs).
@@ -352,11 +384,12 @@ def simulate_reduce(system: StateSpace, time, initial_state=None, inputs=None, i
     drive = _drive(system, t, initial_state, inputs, input_series)
     rows = _output_rows(system, outputs)
     simulation = _Simulation(system, t, drive, rows, with_states=outputs is None)
+    summarise = getattr(reducer, "take_summary", None) if simulation.summarises else None
     if chunk_size is None:
-        chunk_size = max(1, CHUNK_BYTES // (8 * simulation.floats_per_member))
+        chunk_size = SUMMARY_CHUNK if summarise else max(1, CHUNK_BYTES // (8 * simulation.floats_per_member))
     elif not (isinstance(chunk_size, (int, np.integer)) and chunk_size >= 1):
         raise InvalidParameter("chunk_size", f"must be a whole number >= 1, got {chunk_size!r}")
-    if 8 * chunk_size * simulation.floats_per_member > MAX_RESULT_BYTES:
+    if not summarise and 8 * chunk_size * simulation.floats_per_member > MAX_RESULT_BYTES:
         raise InvalidParameter("chunk_size", f"{chunk_size} member(s) x {t.size} points exceed "
                                f"{MAX_RESULT_BYTES / 2**30:.0f} GiB: use fewer members per chunk or fewer points")
     names = tuple(system.outputs[i] for i in rows)
@@ -364,6 +397,9 @@ def simulate_reduce(system: StateSpace, time, initial_state=None, inputs=None, i
     with_states = outputs is None
     for start in range(0, drive.count, chunk_size):
         stop = min(start + chunk_size, drive.count)
+        if summarise:
+            summarise(*simulation.final_and_peak(start, stop), slice(start, stop))
+            continue
         states, values = simulation.chunk(start, stop)
         chunk = Response(t, states, values, system.states if with_states else (), names,
                          system.state_units if with_states else (), units)

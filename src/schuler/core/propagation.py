@@ -57,7 +57,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from schuler.core._lti_kernels import fill_blocks, propagate_steps
+from schuler.core._lti_kernels import fill_blocks, final_and_peak_blocks, propagate_steps
 
 POINT_EXPONENTIALS = 200_000
 """Most matrix exponentials spent on the non-uniform points of one propagation (about 2 s);
@@ -270,6 +270,33 @@ class ConstantInputPropagator:
         if self.point_offsets.size:
             self._fill_points(z, out[:, :, self.n_uniform : T])
         return out[:, :, :T].transpose(0, 2, 1)
+
+    @property
+    def summarises(self) -> bool:
+        """Whether :meth:`final_and_peak` applies: a grid that is uniform throughout."""
+        return bool(self.n_uniform) and not self.point_offsets.size
+
+    def final_and_peak(self, z0: np.ndarray, rows: slice) -> tuple[np.ndarray, np.ndarray]:
+        """Each member's last value and largest magnitude over time of the rows ``rows``, without histories.
+
+        Parameters
+        ----------
+        z0 : ndarray, shape (N, q)
+            Initial vectors, SI.
+        rows : slice
+            Which of the propagator's rows (indices into its r rows).
+
+        Returns
+        -------
+        final, peak : ndarray, shape (N, r')
+            Row values at the last time and max over time of their magnitude, SI.
+        """
+        z = np.ascontiguousarray(z0 / self.scale)
+        R = np.ascontiguousarray(self.R[:, rows])
+        final, peak = np.empty((z.shape[0], R.shape[1])), np.empty((z.shape[0], R.shape[1]))
+        final_and_peak_blocks(self.step_transition, self.block_transition, R, z, self.n_moving, self.substeps,
+                              self.t.size, final, peak)
+        return final, peak
 
     def _fill_points(self, z: np.ndarray, out: np.ndarray) -> None:
         """Rows at the point times into ``out`` of shape (N, r, n_points)."""

@@ -3,7 +3,9 @@
 A reducer is any callable ``reducer(chunk, members)``: ``chunk`` is a batched
 :class:`~schuler.core.response.Response` of shape (k, T, .) holding members
 ``members`` (a slice of range(N)); it keeps what it needs and lets the
-histories go. Three common ones are here.
+histories go. Three common ones are here. The first two also take a
+summary, ``take_summary(final, peak, members)``: the engine then reduces the
+samples as it makes them and writes no history at all.
 
 Examples
 --------
@@ -52,6 +54,18 @@ class FinalOutputs:
     def __call__(self, chunk: Response, members: slice) -> None:
         self.values[members] = chunk.outputs[:, -1, :]
 
+    def take_summary(self, final: np.ndarray, peak: np.ndarray, members: slice) -> None:
+        """Keep the final outputs of members ``members``, computed without histories.
+
+        Parameters
+        ----------
+        final, peak : ndarray, shape (k, n_outputs)
+            Outputs at the last time and max over time of |output|, SI units of the outputs.
+        members : slice
+            Which members (of range(N)).
+        """
+        self.values[members] = final
+
 
 class PeakOutputs:
     """Every member's final outputs and their largest magnitude over the run (what a Monte Carlo keeps).
@@ -81,6 +95,18 @@ class PeakOutputs:
         k = chunk.outputs.shape[0]
         final, peak = np.empty((k, self.final.shape[1])), np.empty((k, self.final.shape[1]))
         final_and_peak(chunk.outputs, final, peak)
+        self.take_summary(final, peak, members)
+
+    def take_summary(self, final: np.ndarray, peak: np.ndarray, members: slice) -> None:
+        """Keep the final and peak outputs of members ``members``, computed without histories.
+
+        Parameters
+        ----------
+        final, peak : ndarray, shape (k, n_outputs)
+            Outputs at the last time and max over time of |output|, SI units of the outputs.
+        members : slice
+            Which members (of range(N)).
+        """
         self.final[members], self.peak[members] = final, peak
 
 
