@@ -192,10 +192,13 @@ def final_and_peak_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray,
     """Each member's last sample and largest magnitude of the block scheme's samples, never storing a history.
 
     The samples are those of :func:`fill_blocks`, computed a block at a time
-    into a buffer that stays in cache and reduced as they are made: nothing of
-    the N r T samples is written to memory. Fast-math lets the running maximum
-    vectorise; the inputs are finite (checked by the engine), so it changes
-    the result by rounding only.
+    and reduced as they are made: nothing of the N r T samples is written to
+    memory. For up to three moving entries (the single-channel and
+    gyrocompassing models) a sample is one pass of four loads, three
+    multiply-adds and a running maximum; larger models go through a block
+    buffer that stays in cache. Fast-math lets the running maximum vectorise;
+    the inputs are finite (checked by the engine), so it changes the result
+    by rounding only.
 
     Parameters
     ----------
@@ -208,7 +211,9 @@ def final_and_peak_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray,
     """
     members, r = final.shape
     q = z0.shape[1]
+    few = n_moving <= 3  # one loop of three zero-padded terms: four loads per sample, nothing stored
     gains = np.empty((r, q, substeps))
+    padded = np.zeros((r, 3, substeps))
     held = np.empty((r, substeps))
     start = np.empty(q)
     following = np.empty(q)
@@ -217,6 +222,8 @@ def final_and_peak_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray,
         a = 0 if step.shape[0] == 1 else i
         if i == 0 or step.shape[0] > 1 or rows.shape[0] > 1:
             _fine_rows(step, rows, a, 0 if rows.shape[0] == 1 else i, gains)
+            if few:
+                padded[:, :n_moving] = gains[:, :n_moving]
         _held_share(gains, z0[i], n_moving, held)
         start[:] = z0[i]
         for p in range(r):
@@ -224,14 +231,26 @@ def final_and_peak_blocks(step: np.ndarray, block: np.ndarray, rows: np.ndarray,
         for base in range(0, n_time, substeps):
             count = min(substeps, n_time - base)
             for p in range(r):
-                _block_line(gains, held, start, n_moving, p, line)
                 largest = peak[i, p]
-                for j in range(count):
-                    value = abs(line[j])
-                    largest = value if value > largest else largest
+                if few:
+                    h, g0, g1, g2 = held[p], padded[p, 0], padded[p, 1], padded[p, 2]
+                    s0 = start[0]
+                    s1 = start[1] if n_moving > 1 else 0.0
+                    s2 = start[2] if n_moving > 2 else 0.0
+                    for j in range(count):
+                        value = abs(h[j] + s0 * g0[j] + s1 * g1[j] + s2 * g2[j])
+                        largest = value if value > largest else largest
+                    j = count - 1
+                    last = h[j] + s0 * g0[j] + s1 * g1[j] + s2 * g2[j]
+                else:
+                    _block_line(gains, held, start, n_moving, p, line)
+                    for j in range(count):
+                        value = abs(line[j])
+                        largest = value if value > largest else largest
+                    last = line[count - 1]
                 peak[i, p] = largest
                 if base + count == n_time:
-                    final[i, p] = line[count - 1]
+                    final[i, p] = last
             _next_start(block, a, n_moving, start, following)
 
 
