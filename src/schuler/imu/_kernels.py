@@ -13,33 +13,60 @@ import numpy as np
 
 
 @numba.njit(cache=True, nogil=True)
-def recurse(phi: float, drive: float, normals: np.ndarray, last: float, out: np.ndarray) -> None:
-    """First-order recursion out[k] = phi out[k-1] + drive normals[k], starting from ``last``."""
-    value = last
-    for k in range(normals.size):
-        value = phi * value + drive * normals[k]
-        out[k] = value
+def slow_block(normals: np.ndarray, phis: np.ndarray, drives: np.ndarray, sigmas: np.ndarray, levels: np.ndarray,
+               block: int, first: bool, left: np.ndarray, scratch: np.ndarray, target: np.ndarray, lo: int) -> int:
+    """Add the sum of a channel's slow processes over one block of ``block`` samples to ``target``; returns normals used.
 
+    Process j lives on a grid of step D_j = 2**levels[j] samples (D_j <= ``block``):
+    x_{i+1} = phis[j] x_i + drives[j] w. ``left[j]`` holds its value at the block's
+    first sample and is advanced to the next block's. With ``first`` (the record's
+    first block) ``left[j] = sigmas[j] w`` is drawn first, one normal per process.
+    Each process's block_size / D_j innovations follow, process by process.
 
-@numba.njit(cache=True, nogil=True)
-def add_interpolated(target: np.ndarray, coarse: np.ndarray, first_coarse: int, step: int, start: int) -> None:
-    """target[i] += linear interpolation at fine sample start + i of ``coarse`` (index first_coarse, spacing step).
-
-    Sample n = j step + r (0 <= r < step) gets coarse[j] + (coarse[j + 1] - coarse[j]) r / step.
+    Every process is added to the accumulator of its level (the grid points of
+    the block, block / D + 1 of them, the last shared with the next block); the
+    levels are then refined from the coarsest down to the samples, a midpoint
+    at a time, so each sample gets the sum of the processes interpolated
+    linearly between their grid points in about 2 ``block`` operations whatever
+    the number of processes. ``target[i]`` gets the sum at sample ``lo + i`` of
+    the block; ``scratch`` holds at least 2 ``block`` + 17 values.
     """
-    i = 0
-    n = target.size
-    while i < n:
-        fine = start + i
-        j = fine // step
-        k = j - first_coarse
-        left = coarse[k]
-        slope = (coarse[k + 1] - left) / step
-        r = fine - j * step
-        count = min(step - r, n - i)
-        for q in range(count):
-            target[i + q] += left + slope * (r + q)
-        i += count
+    top = 0
+    for j in range(levels.size):
+        top = max(top, levels[j])
+    size = 0
+    for level in range(top + 1):
+        size += (block >> level) + 1
+    scratch[:size] = 0.0
+    used = 0
+    if first:
+        for j in range(levels.size):
+            left[j] = sigmas[j] * normals[j]
+        used = levels.size
+    for j in range(levels.size):
+        base = 0
+        for level in range(levels[j]):
+            base += (block >> level) + 1
+        value = left[j]
+        phi, drive = phis[j], drives[j]
+        scratch[base] += value
+        for i in range(1, (block >> levels[j]) + 1):
+            value = phi * value + drive * normals[used]
+            used += 1
+            scratch[base + i] += value
+        left[j] = value
+    coarse = size - ((block >> top) + 1)
+    for level in range(top, 0, -1):
+        n = block >> level
+        fine = coarse - ((block >> (level - 1)) + 1)
+        for i in range(n):
+            scratch[fine + 2 * i] += scratch[coarse + i]
+            scratch[fine + 2 * i + 1] += 0.5 * (scratch[coarse + i] + scratch[coarse + i + 1])
+        scratch[fine + 2 * n] += scratch[coarse + n]
+        coarse = fine
+    for i in range(target.size):
+        target[i] += scratch[lo + i]
+    return used
 
 
 @numba.njit(cache=True, nogil=True)

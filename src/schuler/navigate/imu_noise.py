@@ -54,10 +54,6 @@ from schuler.navigate.truth import TruthGenerator
 
 _RANDOM_TERMS = ("random_walk", "bias_instability", "gm_sigma", "rate_random_walk", "quantization")
 
-COARSE_BLOCK_BYTES = 65_536 * 8
-"""Normals ``ImuSimulator`` keeps per slow process and member (one generator block), bytes."""
-
-
 def load_error_model(text: str) -> ErrorModel:
     """The error model of ``--imu``: a grade preset or a TOML spec file (:mod:`schuler.imu.spec`).
 
@@ -104,6 +100,11 @@ def has_noise(model: ErrorModel) -> bool:
 def slow_processes(model: ErrorModel, interval: float) -> int:
     """How many slow processes (Gauss-Markov, flicker terms, rate random walk) the simulator carries per member."""
     return len(ImuSimulator(noise_model(model), interval).coarse_steps())
+
+
+def state_bytes(model: ErrorModel, interval: float) -> int:
+    """Memory the simulator may carry per member from one window to the next, bytes."""
+    return ImuSimulator(noise_model(model), interval).member_state_bytes()
 
 
 @dataclass(frozen=True)
@@ -212,11 +213,8 @@ class ImuNoise:
         if not np.isclose(dt, self.interval, rtol=1e-12, atol=0.0):
             raise InvalidParameter("imu_rate", f"the noise was set up for {1 / self.interval:g} Hz, "
                                                f"asked for {1 / dt:g} Hz")
-        gyro, accel = self._simulator.window(members, start, stop)
-        out = []
+        gyro, accel = self._simulator.window(members, start, stop)  # new C-contiguous arrays: errors in place
         for rates, truth in ((gyro, self.true_rate), (accel, self.true_specific_force)):
-            errors = np.empty(rates.shape)  # C-contiguous, as the time loops read it
-            np.subtract(rates, truth, out=errors)
-            errors *= self.interval
-            out.append(errors)
-        return out[0], out[1]
+            rates -= truth
+            rates *= self.interval
+        return gyro, accel
