@@ -171,9 +171,9 @@ class RandomStreams:
         stream : str
             Name of the stream.
         member : int
-            Member number (>= 0).
+            Member number, index >= 0.
         block : int
-            Block number (>= 0).
+            Block number, index >= 0 (block b starts at sample index b BLOCK of the series).
         size : int
             Number of normals drawn from the block's start (>= 0).
 

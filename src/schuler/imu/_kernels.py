@@ -15,7 +15,7 @@ import numpy as np
 @numba.njit(cache=True, nogil=True)
 def slow_block(normals: np.ndarray, phis: np.ndarray, drives: np.ndarray, sigmas: np.ndarray, levels: np.ndarray,
                block: int, first: bool, left: np.ndarray, scratch: np.ndarray, target: np.ndarray, lo: int) -> int:
-    """Add the sum of a channel's slow processes over one block of ``block`` samples to ``target``; returns normals used.
+    """Add the sum of a channel's slow processes over a block of ``block`` samples to ``target``; returns normals used.
 
     Process j lives on a grid of step D_j = 2**levels[j] samples (D_j <= ``block``):
     x_{i+1} = phis[j] x_i + drives[j] w. ``left[j]`` holds its value at the block's

@@ -123,8 +123,8 @@ def _slow_terms(errors: SensorErrors, axis: int, dt: float) -> _SlowTerms:
     if errors.gm_sigma[axis] > 0:
         terms.append(("gm", errors.gm_sigma[axis], errors.gm_correlation_time_s[axis]))
     if errors.bias_instability[axis] > 0:
-        sigmas, times = flicker_terms(errors.bias_instability[axis], errors.flicker_tau_range_s)
-        terms += [(f"flicker{j}", sigma, time) for j, (sigma, time) in enumerate(zip(sigmas, times))]
+        flicker = flicker_terms(errors.bias_instability[axis], errors.flicker_tau_range_s)
+        terms += [(f"flicker{j}", sigma, time) for j, (sigma, time) in enumerate(zip(*flicker))]
     rows = []
     for name, sigma, time in terms:
         level = _coarse_level(2 * sigma**2 / time, white, dt, time)
@@ -136,8 +136,8 @@ def _slow_terms(errors: SensorErrors, axis: int, dt: float) -> _SlowTerms:
         level = _coarse_level(k**2, white, dt, None)
         rows.append(("rate_random_walk", 1.0, k * math.sqrt((1 << level) * dt), 0.0, level))
     names, phis, drives, sigmas, levels = zip(*rows) if rows else ((), (), (), (), ())
-    return _SlowTerms(tuple(names), np.array(phis, dtype=float), np.array(drives, dtype=float),
-                      np.array(sigmas, dtype=float), np.array(levels, dtype=np.int64))
+    return _SlowTerms(names, np.array(phis, dtype=float), np.array(drives, dtype=float), np.array(sigmas, dtype=float),
+                      np.array(levels, dtype=np.int64))
 
 
 @dataclass
@@ -453,15 +453,28 @@ def simulate_record(model: ErrorModel, *, duration_s: float, sample_interval_s: 
     Parameters
     ----------
     model : ErrorModel
-    duration_s, sample_interval_s : float
-        Length and dt, s.
-    seed, member : int
-        Address of the random numbers.
-    latitude_rad, heading_rad : float
-        Site latitude and heading of the x axis, rad.
+        Sensor errors (SI): the member's constant errors are drawn from it, its random processes simulated.
+    duration_s : float
+        Length of the record, s.
+    sample_interval_s : float
+        Sample interval dt, s.
+    seed : int
+        Study seed of the addressed random numbers, plain number >= 0.
+    member : int
+        Member number, index >= 0: with the seed, the address of the random numbers.
+    latitude_rad : float
+        Geodetic latitude L of the site, rad.
+    heading_rad : float
+        Heading of the body x axis, clockwise from north, rad.
     kind : {"rate", "increment"}
+        What a sample holds: the mean rate over dt (rad/s, m/s^2) or its increment (rad, m/s).
     max_memory_bytes : int
         Largest record allocated, bytes (larger requests are refused).
+
+    Returns
+    -------
+    ImuRecord
+        Samples at t = dt, 2 dt, ..., body axes x forward, y right, z down.
     """
     dt = float(sample_interval_s)
     samples = _sample_count(duration_s, dt)
@@ -486,14 +499,26 @@ def write_simulation(path, model: ErrorModel, *, duration_s: float, sample_inter
         The Parquet file.
     model : ErrorModel
         Sensor errors (SI).
-    duration_s, sample_interval_s : float
-        Length and dt, s.
-    seed, member : int
-        Address of the random numbers.
-    latitude_rad, heading_rad : float
-        Site latitude and heading of the x axis, rad.
+    duration_s : float
+        Length of the record, s.
+    sample_interval_s : float
+        Sample interval dt, s.
+    seed : int
+        Study seed of the addressed random numbers, plain number >= 0.
+    member : int
+        Member number, index >= 0: with the seed, the address of the random numbers.
+    latitude_rad : float
+        Geodetic latitude L of the site, rad.
+    heading_rad : float
+        Heading of the body x axis, clockwise from north, rad.
     workers : int
-        Number of threads.
+        Threads over members, number of.
+
+    Returns
+    -------
+    Path
+        The file written: rates (rad/s, m/s^2), body axes x forward, y right, z down, the same samples as
+        :func:`simulate_record`.
     """
     from schuler.imu.native import ParquetRecordWriter
 

@@ -103,7 +103,15 @@ def slow_processes(model: ErrorModel, interval: float) -> int:
 
 
 def state_bytes(model: ErrorModel, interval: float) -> int:
-    """Memory the simulator may carry per member from one window to the next, bytes."""
+    """Memory the simulator may carry per member from one window to the next, bytes.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The full error model (its noise part is simulated).
+    interval : float
+        IMU interval dt, s.
+    """
     return ImuSimulator(noise_model(model), interval).member_state_bytes()
 
 
