@@ -23,47 +23,46 @@ def slow_block(normals: np.ndarray, phis: np.ndarray, drives: np.ndarray, sigmas
     first block) ``left[j] = sigmas[j] w`` is drawn first, one normal per process.
     Each process's block_size / D_j innovations follow, process by process.
 
-    Every process is added to the accumulator of its level (the grid points of
-    the block, block / D + 1 of them, the last shared with the next block); the
-    levels are then refined from the coarsest down to the samples, a midpoint
-    at a time, so each sample gets the sum of the processes interpolated
-    linearly between their grid points in about 2 ``block`` operations whatever
-    the number of processes. ``target[i]`` gets the sum at sample ``lo + i`` of
-    the block; ``scratch`` holds at least 2 ``block`` + 17 values.
+    The levels are summed from the coarsest down: a level's grid points (block / D
+    + 1 of them, the last shared with the next block) get the coarser levels'
+    sum refined a midpoint at a time, then the recursions of its own processes.
+    Each sample thus gets the sum of the processes interpolated linearly between
+    their grid points in about 2 ``block`` operations whatever the number of
+    processes. ``target[i]`` gets the sum at sample ``lo + i`` of the block;
+    ``scratch`` holds at least 2 ``block`` + 17 values.
     """
+    used = levels.size if first else 0
+    offsets = np.empty(levels.size, dtype=np.int64)  # each process's first innovation in ``normals``
     top = 0
     for j in range(levels.size):
-        top = max(top, levels[j])
-    size = 0
-    for level in range(top + 1):
-        size += (block >> level) + 1
-    scratch[:size] = 0.0
-    used = 0
-    if first:
-        for j in range(levels.size):
+        if first:
             left[j] = sigmas[j] * normals[j]
-        used = levels.size
-    for j in range(levels.size):
-        base = 0
-        for level in range(levels[j]):
-            base += (block >> level) + 1
-        value = left[j]
-        phi, drive = phis[j], drives[j]
-        scratch[base] += value
-        for i in range(1, (block >> levels[j]) + 1):
-            value = phi * value + drive * normals[used]
-            used += 1
-            scratch[base + i] += value
-        left[j] = value
-    coarse = size - ((block >> top) + 1)
-    for level in range(top, 0, -1):
-        n = block >> level
-        fine = coarse - ((block >> (level - 1)) + 1)
-        for i in range(n):
-            scratch[fine + 2 * i] += scratch[coarse + i]
-            scratch[fine + 2 * i + 1] += 0.5 * (scratch[coarse + i] + scratch[coarse + i + 1])
-        scratch[fine + 2 * n] += scratch[coarse + n]
-        coarse = fine
+        offsets[j] = used
+        used += block >> levels[j]
+        top = max(top, levels[j])
+    base = 0
+    for level in range(top):
+        base += (block >> level) + 1
+    n = block >> top
+    scratch[base:base + n + 1] = 0.0
+    for level in range(top, -1, -1):
+        if level < top:  # refine the coarser sum (at ``base``, n + 1 points) onto this level's 2 n + 1 points
+            fine = base - (2 * n + 1)
+            for i in range(n):
+                scratch[fine + 2 * i] = scratch[base + i]
+                scratch[fine + 2 * i + 1] = 0.5 * (scratch[base + i] + scratch[base + i + 1])
+            scratch[fine + 2 * n] = scratch[base + n]
+            base, n = fine, 2 * n
+        for j in range(levels.size):
+            if levels[j] == level:
+                value = left[j]
+                phi, drive, k = phis[j], drives[j], offsets[j]
+                scratch[base] += value
+                for i in range(1, n + 1):
+                    value = phi * value + drive * normals[k]
+                    k += 1
+                    scratch[base + i] += value
+                left[j] = value
     for i in range(target.size):
         target[i] += scratch[lo + i]
     return used
