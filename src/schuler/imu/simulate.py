@@ -277,15 +277,15 @@ class ImuSimulator:
             self._states.pop(int(member), None)
 
     def _member_window(self, member: int, start: int, stop: int, constants: dict, row: int,
-                       out: tuple[np.ndarray, np.ndarray]) -> None:
+                       out: tuple[np.ndarray, np.ndarray], as_errors: bool) -> None:
         state = self._states.get(member)
         if state is None or state.next_sample != start:
             state = _MemberState()
             for begin in range(0, start, WINDOW):  # replay from the start: results never depend on the cut
                 end = min(start, begin + WINDOW)
                 scratch = np.empty((end - begin, 3))
-                self._fill(member, state, begin, end, constants, row, (scratch, scratch))
-        self._fill(member, state, start, stop, constants, row, out)
+                self._fill(member, state, begin, end, constants, row, (scratch, scratch), False)
+        self._fill(member, state, start, stop, constants, row, out, as_errors)
         self._states[member] = state
 
     def _deterministic(self, sensor: str, constants: dict, row: int, start: int, stop: int):
@@ -302,10 +302,11 @@ class ImuSimulator:
         return value
 
     def _fill(self, member: int, state: _MemberState, start: int, stop: int, constants: dict, row: int,
-              out: tuple[np.ndarray, np.ndarray]) -> None:
+              out: tuple[np.ndarray, np.ndarray], as_errors: bool) -> None:
         """Samples start .. stop-1 of one member into ``out`` = (gyro, accel), each of shape (stop - start, 3)."""
         for s_index, (sensor, errors) in enumerate(self._sensors.items()):
             deterministic = self._deterministic(sensor, constants, row, start, stop)
+            truth = self.true_gyro if sensor == "gyro" else self.true_accel
             for axis in range(3):
                 channel = f"{sensor}_{_AXES[axis]}"
                 density = errors.random_walk[axis]
@@ -326,10 +327,13 @@ class ImuSimulator:
                     values *= self.dt
                     state.residual[channel] = _kernels.quantize(values, quantum, state.residual[channel])
                     values /= self.dt
+                if as_errors:  # while the channel is in cache
+                    values -= truth[axis] if truth.ndim == 1 else self._true_window(truth, start, stop)[:, axis]
+                    values *= self.dt
                 out[s_index][:, axis] = values
         state.next_sample = stop
 
-    def window(self, members, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
+    def window(self, members, start: int, stop: int, *, as_errors: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Rates of ``members`` over samples ``start .. stop-1``: gyro (m, L, 3) rad/s, accel (m, L, 3) m/s^2.
 
         Sample k is the mean over (k dt, (k + 1) dt]. With quantisation, rate = whole quanta / dt.
@@ -341,6 +345,8 @@ class ImuSimulator:
             Member numbers.
         start, stop : int
             Sample index range.
+        as_errors : bool
+            Return the increment errors (rate - true input) dt instead, rad and m/s.
 
         """
         members = np.asarray(members, dtype=np.int64).reshape(-1)
@@ -351,7 +357,8 @@ class ImuSimulator:
             raise InvalidParameter("members", "member numbers must be >= 0")
         constants = self.constants(members)
         gyro, accel = np.empty((members.size, stop - start, 3)), np.empty((members.size, stop - start, 3))
-        jobs = [(int(m), start, stop, constants, row, (gyro[row], accel[row])) for row, m in enumerate(members)]
+        jobs = [(int(m), start, stop, constants, row, (gyro[row], accel[row]), as_errors)
+                for row, m in enumerate(members)]
         if self.workers > 1 and len(jobs) > 1:
             with ThreadPoolExecutor(self.workers) as pool:
                 list(pool.map(lambda job: self._member_window(*job), jobs))
