@@ -142,10 +142,9 @@ def _slow_terms(errors: SensorErrors, axis: int, dt: float) -> _SlowTerms:
 
 @dataclass
 class _SlowState:
-    """A channel's slow processes at the start of block ``next_block``, and a block a window ended inside."""
+    """A channel's slow processes at the start of the next block, and the block a window ended inside."""
 
     left: np.ndarray
-    next_block: int = 0
     kept: tuple[int, np.ndarray] | None = None  # (block number, its summed slow processes), for the next window
 
 
@@ -261,7 +260,7 @@ class ImuSimulator:
             normals = self.streams.normal_block(f"{channel}/slow", member, block, terms.normals(block))
             _kernels.slow_block(normals, terms.phis, terms.drives, terms.sigmas, terms.levels, BLOCK, block == 0,
                                 slow.left, np.empty(2 * BLOCK + 17), target, 0 if keep else lo)
-            slow.next_block, slow.kept = block + 1, (block, target) if keep else None
+            slow.kept = (block, target) if keep else None
             if keep:
                 destination += target[lo:hi]
 

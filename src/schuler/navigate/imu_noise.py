@@ -16,7 +16,7 @@ in two parts, body axes (the platform's own axes in the platform mode):
 Draws are the IMU layer's own: member m of seed s takes its constants from the
 streams ``gyro/bias``, ``gyro/scale_factor``, ``gyro/misalignment``,
 ``gyro/g_sensitivity`` ... at address m, and its noise from ``gyro_x/white``,
-``gyro_x/flicker3`` ... (:class:`~schuler.core.random.RandomStreams`), so a
+``gyro_x/slow`` ... (:class:`~schuler.core.random.RandomStreams`), so a
 member's sensors are those ``schuler.imu.simulate`` gives that member, and no
 result depends on how the members are chunked. The nominal case (no random
 streams) takes every constant error at +1 sigma, the representative case of
