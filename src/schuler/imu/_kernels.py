@@ -69,6 +69,14 @@ def slow_block(normals: np.ndarray, phis: np.ndarray, drives: np.ndarray, sigmas
 
 
 @numba.njit(cache=True, nogil=True)
+def store(values: np.ndarray, offset: np.ndarray, factor: float, out: np.ndarray) -> None:
+    """out[k] = (values[k] - offset[k]) factor in one pass; ``out`` may be strided, an ``offset`` of size 1 constant."""
+    stride = 1 if offset.size > 1 else 0
+    for k in range(values.size):
+        out[k] = (values[k] - offset[k * stride]) * factor
+
+
+@numba.njit(cache=True, nogil=True)
 def quantize(increments: np.ndarray, quantum: float, residual: float) -> float:
     """Replace increments by whole quanta of the accumulated sum (in place); return the carried residual.
 

@@ -65,6 +65,7 @@ DEFAULT_MAX_MEMORY_BYTES = 2 * 1024**3
 """Largest in-memory simulation (members x samples x 6 x 8 bytes) built without being asked for more."""
 
 _AXES = "xyz"
+_NO_OFFSET = np.zeros(1)
 
 
 def static_truth(latitude_rad: float, heading_rad: float = 0.0, gravity_m_s2: float | None = None):
@@ -326,10 +327,11 @@ class ImuSimulator:
                     values *= self.dt
                     state.residual[channel] = _kernels.quantize(values, quantum, state.residual[channel])
                     values /= self.dt
-                if as_errors:  # while the channel is in cache
-                    values -= truth[axis] if truth.ndim == 1 else self._true_window(truth, start, stop)[:, axis]
-                    values *= self.dt
-                out[s_index][:, axis] = values
+                if not as_errors:
+                    _kernels.store(values, _NO_OFFSET, 1.0, out[s_index][:, axis])
+                else:  # (rate - true) dt while the channel is in cache
+                    true_axis = truth[axis:axis + 1] if truth.ndim == 1 else truth[start:stop, axis]
+                    _kernels.store(values, np.ascontiguousarray(true_axis), self.dt, out[s_index][:, axis])
         state.next_sample = stop
 
     def window(self, members, start: int, stop: int, *, as_errors: bool = False) -> tuple[np.ndarray, np.ndarray]:
