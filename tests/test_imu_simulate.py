@@ -157,6 +157,8 @@ def test_normal_block_is_the_start_of_the_series_block():
     assert np.array_equal(longer[:BLOCK], streams.normal_series("s", [4], 2 * BLOCK, 3 * BLOCK)[0])
     with pytest.raises(InvalidParameter, match="must be >= 0"):
         streams.normal_block("s", -1, 0, 10)
+    with pytest.raises(InvalidParameter, match="above 134,217,728 normals"):
+        streams.normal_block("s", 0, 0, 1 << 40)
 
 
 SLOW_MODEL = ErrorModel(accel=SensorErrors(random_walk=1e-3, gm_sigma=2e-4, gm_correlation_time_s=30.0,

@@ -23,7 +23,7 @@ Two generators serve two shapes of need:
   way to make parallel streams; SFC64 draws normals about 1.5 times as fast as the
   counter-based Philox on this kind of machine). Any time window ``[start, stop)``
   therefore gets the same numbers whichever windows came before.
-* :meth:`RandomStreams.normal_block`: the first n numbers of one such block, n
+* :meth:`RandomStreams.normal_block` (the same generator): the first n numbers of one such block, n
   not limited to :data:`BLOCK`; a series of several processes on grids coarser
   than the samples (the IMU layer's slow noise) draws from block b exactly what
   the samples of block b need, addressed by (seed, stream, member, b, position).
@@ -57,6 +57,7 @@ _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX2 = np.uint64(0x94D049BB133111EB)
 _MASK64 = (1 << 64) - 1
+_LARGEST_BLOCK = 1 << 27
 
 
 def _mix(z: np.ndarray) -> np.ndarray:
@@ -186,6 +187,8 @@ class RandomStreams:
         """
         if member < 0 or block < 0 or size < 0:
             raise InvalidParameter("block", f"member {member}, block {block} and size {size} must be >= 0")
+        if size > _LARGEST_BLOCK:
+            raise InvalidParameter("block", f"size {size:,} is above {_LARGEST_BLOCK:,} normals (1 GiB) per block")
         return _block_generator(_stream_key(self.seed, stream), int(member), int(block)).standard_normal(int(size))
 
 

@@ -1,7 +1,8 @@
 """numba kernels of the IMU layer: the time loops that cannot be vectorised, on plain arrays.
 
 Every kernel is sequential in time and carries its state in and out, so a
-record cut into windows gives bit-for-bit the samples of one long run.
+record cut into windows gives bit-for-bit the samples of one long run
+(:func:`store` only fuses a channel's last passes into one).
 """
 
 from __future__ import annotations
