@@ -20,8 +20,10 @@ pitch -5e-5 rad, heading 1e-3 rad) and body-axis biases (gyro 1e-8, -2e-8, 5e-9 
 * Monte Carlo through the system (``schuler navigate run --imu GRADE --monte-carlo N``: the contract's
   ``evaluate`` on members drawing the IMU layer's full error model, constant errors and noise from
   :mod:`schuler.imu.simulate`), 1 h at 100 Hz (target >= 3 M member-samples/s), with the share of the
-  time spent generating the noise; the tactical grade (white noise and flicker over 1 s to 1000 s, eleven
-  Gauss-Markov terms per axis) and a model of its white noise alone.
+  time spent generating the noise and the normals it draws per member-sample (one per channel for white
+  noise, one per grid point of each slow process: 14.4 for the tactical grade); the tactical grade (white
+  noise and flicker over 1 s to 1000 s, eleven Gauss-Markov terms per axis) and a model of its white
+  noise alone (6.0).
 
 Throughputs are printed from wall time and from CPU time (the machine is shared: CPU time shows the
 work, wall time what a user waits, with the load average beside it); ratios use the same clock on both
