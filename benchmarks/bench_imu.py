@@ -113,20 +113,24 @@ def bench_simulation() -> float:
     rate = members * length / seconds
     # the share of random-number generation, from a single-threaded run with the generator timed
     spent, drawn = [0.0], [0]
-    original = addressed_random.RandomStreams.normal_series
+    originals = {name: getattr(addressed_random.RandomStreams, name) for name in ("normal_series", "normal_block")}
 
-    def timed(self, *args, **kwargs):
-        begin = time.perf_counter()
-        values = original(self, *args, **kwargs)
-        spent[0] += time.perf_counter() - begin
-        drawn[0] += values.size
-        return values
+    def timed(original):
+        def draw(self, *args, **kwargs):
+            begin = time.perf_counter()
+            values = original(self, *args, **kwargs)
+            spent[0] += time.perf_counter() - begin
+            drawn[0] += values.size
+            return values
+        return draw
 
-    addressed_random.RandomStreams.normal_series = timed
+    for name, original in originals.items():  # white noise by series, the slow processes by blocks
+        setattr(addressed_random.RandomStreams, name, timed(original))
     try:
         single, _ = simulate(1, 2, length)
     finally:
-        addressed_random.RandomStreams.normal_series = original
+        for name, original in originals.items():
+            setattr(addressed_random.RandomStreams, name, original)
     streams = addressed_random.RandomStreams(3)
     begin = time.perf_counter()
     streams.normal_series("bench", [0], 0, 4 * length)

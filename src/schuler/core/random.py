@@ -23,6 +23,10 @@ Two generators serve two shapes of need:
   way to make parallel streams; SFC64 draws normals about 1.5 times as fast as the
   counter-based Philox on this kind of machine). Any time window ``[start, stop)``
   therefore gets the same numbers whichever windows came before.
+* :meth:`RandomStreams.normal_block` (the same generator): the first n numbers of one such block, n
+  not limited to :data:`BLOCK`; a series of several processes on grids coarser
+  than the samples (the IMU layer's slow noise) draws from block b exactly what
+  the samples of block b need, addressed by (seed, stream, member, b, position).
 
 Examples
 --------
@@ -53,6 +57,7 @@ _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX2 = np.uint64(0x94D049BB133111EB)
 _MASK64 = (1 << 64) - 1
+_LARGEST_BLOCK = 1 << 27
 
 
 def _mix(z: np.ndarray) -> np.ndarray:
@@ -145,8 +150,7 @@ class RandomStreams:
         scratch = np.empty(BLOCK)
         for row, member in enumerate(members):
             for block in range(first, last + 1):
-                generator = np.random.Generator(np.random.SFC64(np.random.SeedSequence(
-                    [key, int(member) & _MASK64, block])))
+                generator = _block_generator(key, int(member), block)
                 lo, hi = max(start, block * BLOCK), min(stop, (block + 1) * BLOCK)
                 if lo == block * BLOCK:
                     generator.standard_normal(out=out[row, lo - start:hi - start])
@@ -154,3 +158,40 @@ class RandomStreams:
                     generator.standard_normal(out=scratch[:hi - block * BLOCK])
                     out[row, lo - start:hi - start] = scratch[lo - block * BLOCK:hi - block * BLOCK]
         return out
+
+    def normal_block(self, stream: str, member: int, block: int, size: int) -> np.ndarray:
+        """The first ``size`` standard normals of one block of a member's stream, shape (size,).
+
+        Block ``block`` is the generator of samples ``block * BLOCK ..`` of
+        :meth:`normal_series`, drawn here for any ``size`` (also beyond
+        :data:`BLOCK`): ``normal_block(s, m, b, n)`` equals
+        ``normal_series(s, [m], b * BLOCK, b * BLOCK + n)[0]`` for n <= BLOCK.
+
+        Parameters
+        ----------
+        stream : str
+            Name of the stream.
+        member : int
+            Member number, index >= 0.
+        block : int
+            Block number, index >= 0 (block b starts at sample index b BLOCK of the series).
+        size : int
+            Number of normals drawn from the block's start (>= 0).
+
+        Examples
+        --------
+        >>> streams = RandomStreams(7)
+        >>> block = streams.normal_block("gyro_x/slow", 3, 1, 10)
+        >>> bool(np.array_equal(block, streams.normal_series("gyro_x/slow", [3], BLOCK, BLOCK + 10)[0]))
+        True
+        """
+        if member < 0 or block < 0 or size < 0:
+            raise InvalidParameter("block", f"member {member}, block {block} and size {size} must be >= 0")
+        if size > _LARGEST_BLOCK:
+            raise InvalidParameter("block", f"size {size:,} is above {_LARGEST_BLOCK:,} normals (1 GiB) per block")
+        return _block_generator(_stream_key(self.seed, stream), int(member), int(block)).standard_normal(int(size))
+
+
+def _block_generator(key: int, member: int, block: int) -> np.random.Generator:
+    """SFC64 seeded by SeedSequence with the address (stream key, member, block)."""
+    return np.random.Generator(np.random.SFC64(np.random.SeedSequence([key, member & _MASK64, block])))

@@ -1,7 +1,8 @@
 """numba kernels of the IMU layer: the time loops that cannot be vectorised, on plain arrays.
 
 Every kernel is sequential in time and carries its state in and out, so a
-record cut into windows gives bit-for-bit the samples of one long run.
+record cut into windows gives bit-for-bit the samples of one long run
+(:func:`store` only fuses a channel's last passes into one).
 """
 
 from __future__ import annotations
@@ -13,33 +14,67 @@ import numpy as np
 
 
 @numba.njit(cache=True, nogil=True)
-def recurse(phi: float, drive: float, normals: np.ndarray, last: float, out: np.ndarray) -> None:
-    """First-order recursion out[k] = phi out[k-1] + drive normals[k], starting from ``last``."""
-    value = last
-    for k in range(normals.size):
-        value = phi * value + drive * normals[k]
-        out[k] = value
+def slow_block(normals: np.ndarray, phis: np.ndarray, drives: np.ndarray, sigmas: np.ndarray, levels: np.ndarray,
+               block: int, first: bool, left: np.ndarray, scratch: np.ndarray, target: np.ndarray, lo: int) -> int:
+    """Add the sum of a channel's slow processes over a block of ``block`` samples to ``target``; returns normals used.
+
+    Process j lives on a grid of step D_j = 2**levels[j] samples (D_j <= ``block``):
+    x_{i+1} = phis[j] x_i + drives[j] w. ``left[j]`` holds its value at the block's
+    first sample and is advanced to the next block's. With ``first`` (the record's
+    first block) ``left[j] = sigmas[j] w`` is drawn first, one normal per process.
+    Each process's block_size / D_j innovations follow, process by process.
+
+    The levels are summed from the coarsest down: a level's grid points (block / D
+    + 1 of them, the last shared with the next block) get the coarser levels'
+    sum refined a midpoint at a time, then the recursions of its own processes.
+    Each sample thus gets the sum of the processes interpolated linearly between
+    their grid points in about 2 ``block`` operations whatever the number of
+    processes. ``target[i]`` gets the sum at sample ``lo + i`` of the block;
+    ``scratch`` holds at least 2 ``block`` + 17 values.
+    """
+    used = levels.size if first else 0
+    offsets = np.empty(levels.size, dtype=np.int64)  # each process's first innovation in ``normals``
+    top = 0
+    for j in range(levels.size):
+        if first:
+            left[j] = sigmas[j] * normals[j]
+        offsets[j] = used
+        used += block >> levels[j]
+        top = max(top, levels[j])
+    base = 0
+    for level in range(top):
+        base += (block >> level) + 1
+    n = block >> top
+    scratch[base:base + n + 1] = 0.0
+    for level in range(top, -1, -1):
+        if level < top:  # refine the coarser sum (at ``base``, n + 1 points) onto this level's 2 n + 1 points
+            fine = base - (2 * n + 1)
+            for i in range(n):
+                scratch[fine + 2 * i] = scratch[base + i]
+                scratch[fine + 2 * i + 1] = 0.5 * (scratch[base + i] + scratch[base + i + 1])
+            scratch[fine + 2 * n] = scratch[base + n]
+            base, n = fine, 2 * n
+        for j in range(levels.size):
+            if levels[j] == level:
+                value = left[j]
+                phi, drive, k = phis[j], drives[j], offsets[j]
+                scratch[base] += value
+                for i in range(1, n + 1):
+                    value = phi * value + drive * normals[k]
+                    k += 1
+                    scratch[base + i] += value
+                left[j] = value
+    for i in range(target.size):
+        target[i] += scratch[lo + i]
+    return used
 
 
 @numba.njit(cache=True, nogil=True)
-def add_interpolated(target: np.ndarray, coarse: np.ndarray, first_coarse: int, step: int, start: int) -> None:
-    """target[i] += linear interpolation at fine sample start + i of ``coarse`` (index first_coarse, spacing step).
-
-    Sample n = j step + r (0 <= r < step) gets coarse[j] + (coarse[j + 1] - coarse[j]) r / step.
-    """
-    i = 0
-    n = target.size
-    while i < n:
-        fine = start + i
-        j = fine // step
-        k = j - first_coarse
-        left = coarse[k]
-        slope = (coarse[k + 1] - left) / step
-        r = fine - j * step
-        count = min(step - r, n - i)
-        for q in range(count):
-            target[i + q] += left + slope * (r + q)
-        i += count
+def store(values: np.ndarray, offset: np.ndarray, factor: float, out: np.ndarray) -> None:
+    """out[k] = (values[k] - offset[k]) factor in one pass; ``out`` may be strided, an ``offset`` of size 1 constant."""
+    stride = 1 if offset.size > 1 else 0
+    for k in range(values.size):
+        out[k] = (values[k] - offset[k * stride]) * factor
 
 
 @numba.njit(cache=True, nogil=True)

@@ -15,10 +15,19 @@ a random number per sample for each would cost most of the time. Each such
 process is generated exactly (its exact discretisation) on a coarse grid of
 step D dt and interpolated linearly in between. The interpolation leaves out a
 Brownian-bridge part of variance q D dt / 6 (q the process's diffusion, 2 sigma^2 / T
-or K^2), which acts like white noise of PSD ~ q (D dt)^2 / 6; D is chosen so that this is
-below 1e-3 of the white-noise PSD N^2 (and D dt <= T / 2, two grid points per
-correlation time). With no white noise
-(N = 0) the grid is the sample grid (D = 1) and the simulation is exact.
+or K^2), which acts like white noise of PSD ~ q (D dt)^2 / 6; D is the largest power
+of two for which this is below 1e-3 of the white-noise PSD N^2 (and D dt <= T / 2, two
+grid points per correlation time; D <= :data:`~schuler.core.random.BLOCK`). With no
+white noise (N = 0) the grid is the sample grid (D = 1) and the simulation is exact.
+
+The grids of one channel nest (powers of two), so the processes are summed on
+them and refined to the samples once per channel (:func:`schuler.imu._kernels.slow_block`),
+not interpolated one by one. Their random numbers come from one stream per
+channel, ``"gyro_x/slow"``, block by block (:meth:`~schuler.core.random.RandomStreams.normal_block`):
+block b holds, process after process, the BLOCK / D innovations of the grid points
+in samples (b BLOCK, (b + 1) BLOCK] (block 0 first holds each process's initial
+value), so the samples of block b draw exactly the numbers they need, addressed
+by (seed, stream, member, b, position), whatever the windows.
 
 Examples
 --------
@@ -56,6 +65,7 @@ DEFAULT_MAX_MEMORY_BYTES = 2 * 1024**3
 """Largest in-memory simulation (members x samples x 6 x 8 bytes) built without being asked for more."""
 
 _AXES = "xyz"
+_NO_OFFSET = np.zeros(1)
 
 
 def static_truth(latitude_rad: float, heading_rad: float = 0.0, gravity_m_s2: float | None = None):
@@ -84,54 +94,68 @@ def static_truth(latitude_rad: float, heading_rad: float = 0.0, gravity_m_s2: fl
 
 
 @dataclass(frozen=True)
-class _Process:
-    """A slow process on a coarse grid of step D samples: x_{j+1} = phi x_j + drive w_j, x_0 = initial w_0."""
+class _SlowTerms:
+    """A channel's slow processes, x_{i+1} = phi x_i + drive w_i from x_0 = sigma w_0, on grids of 2**level samples."""
 
-    stream: str
-    phi: float
-    drive: float
-    initial: float
-    step: int
+    names: tuple[str, ...]
+    phis: np.ndarray
+    drives: np.ndarray
+    sigmas: np.ndarray
+    levels: np.ndarray
+
+    def normals(self, block: int) -> int:
+        """How many normals block ``block`` of the channel's slow stream holds."""
+        return int(np.sum(BLOCK >> self.levels)) + (self.levels.size if block == 0 else 0)
 
 
-def _coarse_step(diffusion: float, white_density: float, dt: float, correlation_time: float | None) -> int:
+def _coarse_level(diffusion: float, white_density: float, dt: float, correlation_time: float | None) -> int:
+    """log2 of the grid step D: the largest power of two within the interpolation and correlation limits."""
     if white_density <= 0 or diffusion <= 0:
-        return 1
+        return 0
     step = white_density * math.sqrt(6.0 * INTERPOLATION_TOLERANCE / diffusion) / dt
     if correlation_time is not None:
         step = min(step, correlation_time / (2.0 * dt))
-    return max(1, min(int(step), 1 << 20))
+    return min(max(0, int(math.floor(math.log2(max(step, 1.0))))), BLOCK.bit_length() - 1)
 
 
-def _processes(errors: SensorErrors, axis: int, prefix: str, dt: float) -> list[_Process]:
+def _slow_terms(errors: SensorErrors, axis: int, dt: float) -> _SlowTerms:
     white = errors.random_walk[axis]
     terms = []
     if errors.gm_sigma[axis] > 0:
         terms.append(("gm", errors.gm_sigma[axis], errors.gm_correlation_time_s[axis]))
     if errors.bias_instability[axis] > 0:
-        sigmas, times = flicker_terms(errors.bias_instability[axis], errors.flicker_tau_range_s)
-        terms += [(f"flicker{j}", sigma, time) for j, (sigma, time) in enumerate(zip(sigmas, times))]
-    processes = []
+        flicker = flicker_terms(errors.bias_instability[axis], errors.flicker_tau_range_s)
+        terms += [(f"flicker{j}", sigma, time) for j, (sigma, time) in enumerate(zip(*flicker))]
+    rows = []
     for name, sigma, time in terms:
-        step = _coarse_step(2 * sigma**2 / time, white, dt, time)
-        phi = math.exp(-step * dt / time)
-        processes.append(_Process(f"{prefix}/{name}", phi, sigma * math.sqrt(-math.expm1(-2 * step * dt / time)),
-                                  sigma, step))
+        level = _coarse_level(2 * sigma**2 / time, white, dt, time)
+        interval = (1 << level) * dt
+        rows.append((name, math.exp(-interval / time), sigma * math.sqrt(-math.expm1(-2 * interval / time)), sigma,
+                     level))
     k = errors.rate_random_walk[axis]
     if k > 0:
-        step = _coarse_step(k**2, white, dt, None)
-        processes.append(_Process(f"{prefix}/rate_random_walk", 1.0, k * math.sqrt(step * dt), 0.0, step))
-    return processes
+        level = _coarse_level(k**2, white, dt, None)
+        rows.append(("rate_random_walk", 1.0, k * math.sqrt((1 << level) * dt), 0.0, level))
+    names, phis, drives, sigmas, levels = zip(*rows) if rows else ((), (), (), (), ())
+    return _SlowTerms(names, np.array(phis, dtype=float), np.array(drives, dtype=float), np.array(sigmas, dtype=float),
+                      np.array(levels, dtype=np.int64))
+
+
+@dataclass
+class _SlowState:
+    """A channel's slow processes at the start of the next block, and the block a window ended inside."""
+
+    left: np.ndarray
+    kept: tuple[int, np.ndarray] | None = None  # (block number, its summed slow processes), for the next window
 
 
 @dataclass
 class _MemberState:
-    """Where one member's simulation stands: next sample, coarse values, quantiser residuals."""
+    """Where one member's simulation stands: next sample, slow processes per channel, quantiser residuals."""
 
     next_sample: int = 0
-    coarse: dict = field(default_factory=dict)  # stream -> (last index, value before, value at last)
+    slow: dict = field(default_factory=dict)  # channel -> _SlowState
     residual: dict = field(default_factory=dict)  # channel -> quantiser residual
-    blocks: dict = field(default_factory=dict)  # stream -> (block number, its BLOCK normals), see _normals
 
 
 class ImuSimulator:
@@ -152,10 +176,11 @@ class ImuSimulator:
     Notes
     -----
     Member m draws its constant errors (bias, scale factor, misalignment,
-    g-sensitivity) from streams ``"gyro/bias"`` ... at member index m, and its
-    noise from ``"gyro_x/white"``, ``"gyro_x/flicker3"`` ... at sample (or
-    coarse-grid) index k. A window that does not continue the member's last one
-    is recomputed from sample 0, so any cut gives the same numbers.
+    g-sensitivity) from streams ``"gyro/bias"`` ... at member index m, its white
+    noise from ``"gyro_x/white"`` ... at sample index k and its slow processes
+    from ``"gyro_x/slow"`` ... by blocks of samples (module docstring). A window
+    that does not continue the member's last one is recomputed from sample 0,
+    so any cut gives the same numbers.
     """
 
     def __init__(self, model: ErrorModel, sample_interval_s: float, *, true_gyro_rad_s=(0.0, 0.0, 0.0),
@@ -168,8 +193,8 @@ class ImuSimulator:
         self.true_gyro = self._truth(true_gyro_rad_s, "true_gyro_rad_s")
         self.true_accel = self._truth(true_accel_m_s2, "true_accel_m_s2")
         self._sensors = {"gyro": model.gyro, "accel": model.accel}
-        self._processes = {f"{s}_{a}": _processes(e, i, f"{s}_{a}", dt)
-                           for s, e in self._sensors.items() for i, a in enumerate(_AXES)}
+        self._slow_terms = {f"{s}_{a}": _slow_terms(e, i, dt) for s, e in self._sensors.items()
+                            for i, a in enumerate(_AXES)}
         self._states: dict[int, _MemberState] = {}
 
     @staticmethod
@@ -182,8 +207,13 @@ class ImuSimulator:
         return array
 
     def coarse_steps(self) -> dict[str, int]:
-        """Coarse-grid step D (in samples) of every slow process, by stream name."""
-        return {p.stream: p.step for processes in self._processes.values() for p in processes}
+        """Coarse-grid step D (in samples) of every slow process, by name (``"gyro_x/flicker3"``)."""
+        return {f"{channel}/{name}": 1 << int(level) for channel, terms in self._slow_terms.items()
+                for name, level in zip(terms.names, terms.levels)}
+
+    def member_state_bytes(self) -> int:
+        """Largest memory a member's carried state holds between windows, bytes (a block of slow sums per channel)."""
+        return sum(BLOCK * 8 for terms in self._slow_terms.values() if terms.levels.size)
 
     def constants(self, members) -> dict[str, np.ndarray]:
         """Each member's constant errors: ``gyro_bias`` (m, 3), ``gyro_matrix`` (m, 3, 3) = I + S + M, ``gyro_g`` ...
@@ -213,45 +243,27 @@ class ImuSimulator:
             raise InvalidParameter("samples", f"the true inputs cover {truth.shape[0]:,} samples, asked up to {stop:,}")
         return truth[start:stop]
 
-    def _slow(self, member: int, state: _MemberState, process: _Process, start: int, stop: int,
-              target: np.ndarray) -> None:
-        step = process.step
-        first, last = start // step, (stop - 1) // step + 1
-        if process.stream not in state.coarse:
-            w0 = self.streams.normal_series(process.stream, [member], 0, 1)[0, 0]
-            state.coarse[process.stream] = (0, math.nan, process.initial * w0)
-        index, before, value = state.coarse[process.stream]
-        new = np.empty(max(0, last - index))
-        if new.size:
-            normals = self._normals(member, state, process.stream, index + 1, last + 1)
-            _kernels.recurse(process.phi, process.drive, normals, value, new)
-        known = np.array([before, value]) if index == first + 1 else np.array([value])
-        coarse = np.concatenate([known, new])
-        _kernels.add_interpolated(target, coarse, first, step, start)
-        if new.size >= 2:
-            state.coarse[process.stream] = (last, new[-2], new[-1])
-        elif new.size == 1:
-            state.coarse[process.stream] = (last, value, new[-1])
-
-    def _normals(self, member: int, state: _MemberState, stream: str, lo: int, hi: int) -> np.ndarray:
-        """Normals lo .. hi-1 of a coarse stream, drawn by whole blocks with the last block kept for the next window.
-
-        A coarse window is short and starts inside a block; drawing whole blocks
-        and keeping the last one avoids regenerating its start every window. The
-        numbers are those of :meth:`~schuler.core.random.RandomStreams.normal_series`.
-        """
-        parts, k = [], lo
-        cached = state.blocks.get(stream)
-        if cached is not None and cached[0] * BLOCK <= k < (cached[0] + 1) * BLOCK:
-            end = min(hi, (cached[0] + 1) * BLOCK)
-            parts.append(cached[1][k - cached[0] * BLOCK:end - cached[0] * BLOCK])
-            k = end
-        if k < hi:
-            first, stop = (k // BLOCK) * BLOCK, -(-hi // BLOCK) * BLOCK
-            fresh = self.streams.normal_series(stream, [member], first, stop)[0]
-            parts.append(fresh[k - first:hi - first])
-            state.blocks[stream] = (stop // BLOCK - 1, fresh[-BLOCK:])
-        return parts[0] if len(parts) == 1 else np.concatenate(parts)
+    def _add_slow(self, member: int, state: _MemberState, channel: str, start: int, stop: int,
+                  values: np.ndarray) -> None:
+        """Add the channel's slow processes over samples start .. stop-1 to ``values``, block by block."""
+        terms = self._slow_terms[channel]
+        slow = state.slow.setdefault(channel, _SlowState(left=np.zeros(terms.levels.size)))
+        for block in range(start // BLOCK, (stop - 1) // BLOCK + 1):
+            origin = block * BLOCK
+            lo, hi = max(start, origin) - origin, min(stop, origin + BLOCK) - origin
+            destination = values[origin + lo - start:origin + hi - start]
+            if slow.kept is not None and slow.kept[0] == block:
+                destination += slow.kept[1][lo:hi]
+                continue
+            # windows continue each other (_member_window replays otherwise), so this block is the next one
+            keep = hi < BLOCK  # the next window starts inside this block: keep its sums
+            target = np.zeros(BLOCK) if keep else destination
+            normals = self.streams.normal_block(f"{channel}/slow", member, block, terms.normals(block))
+            _kernels.slow_block(normals, terms.phis, terms.drives, terms.sigmas, terms.levels, BLOCK, block == 0,
+                                slow.left, np.empty(2 * BLOCK + 17), target, 0 if keep else lo)
+            slow.kept = (block, target) if keep else None
+            if keep:
+                destination += target[lo:hi]
 
     def forget(self, members) -> None:
         """Drop the carried state of ``members`` (their next window replays from sample 0).
@@ -264,15 +276,17 @@ class ImuSimulator:
         for member in np.asarray(members, dtype=np.int64).reshape(-1):
             self._states.pop(int(member), None)
 
-    def _member_window(self, member: int, start: int, stop: int, constants: dict, row: int) -> np.ndarray:
+    def _member_window(self, member: int, start: int, stop: int, constants: dict, row: int,
+                       out: tuple[np.ndarray, np.ndarray], as_errors: bool) -> None:
         state = self._states.get(member)
         if state is None or state.next_sample != start:
             state = _MemberState()
             for begin in range(0, start, WINDOW):  # replay from the start: results never depend on the cut
-                self._fill(member, state, begin, min(start, begin + WINDOW), constants, row)
-        out = self._fill(member, state, start, stop, constants, row)
+                end = min(start, begin + WINDOW)
+                scratch = np.empty((end - begin, 3))
+                self._fill(member, state, begin, end, constants, row, (scratch, scratch), False)
+        self._fill(member, state, start, stop, constants, row, out, as_errors)
         self._states[member] = state
-        return out
 
     def _deterministic(self, sensor: str, constants: dict, row: int, start: int, stop: int):
         """(I + S + M) u + b (+ G f for gyros): a 3-vector for constant inputs, else (3, L)."""
@@ -287,23 +301,24 @@ class ImuSimulator:
             value = value + constants["gyro_g"][row] @ self._true_window(self.true_accel, start, stop).T
         return value
 
-    def _fill(self, member: int, state: _MemberState, start: int, stop: int, constants: dict, row: int) -> np.ndarray:
-        length = stop - start
-        out = np.empty((6, length))
+    def _fill(self, member: int, state: _MemberState, start: int, stop: int, constants: dict, row: int,
+              out: tuple[np.ndarray, np.ndarray], as_errors: bool) -> None:
+        """Samples start .. stop-1 of one member into ``out`` = (gyro, accel), each of shape (stop - start, 3)."""
         for s_index, (sensor, errors) in enumerate(self._sensors.items()):
             deterministic = self._deterministic(sensor, constants, row, start, stop)
+            truth = self.true_gyro if sensor == "gyro" else self.true_accel
             for axis in range(3):
                 channel = f"{sensor}_{_AXES[axis]}"
-                values = out[3 * s_index + axis]
                 density = errors.random_walk[axis]
                 if density > 0:
-                    values[:] = self.streams.normal_series(f"{channel}/white", [member], start, stop)[0]
+                    values = self.streams.normal_series(f"{channel}/white", [member], start, stop)[0]
                     values *= density / math.sqrt(self.dt)
                     values += deterministic[axis]
                 else:
+                    values = np.empty(stop - start)
                     values[:] = deterministic[axis]
-                for process in self._processes[channel]:
-                    self._slow(member, state, process, start, stop, values)
+                if self._slow_terms[channel].levels.size:
+                    self._add_slow(member, state, channel, start, stop, values)
                 quantum = errors.quantization[axis] * math.sqrt(12.0)
                 if quantum > 0:
                     if channel not in state.residual:
@@ -312,13 +327,18 @@ class ImuSimulator:
                     values *= self.dt
                     state.residual[channel] = _kernels.quantize(values, quantum, state.residual[channel])
                     values /= self.dt
+                if not as_errors:
+                    _kernels.store(values, _NO_OFFSET, 1.0, out[s_index][:, axis])
+                else:  # (rate - true) dt while the channel is in cache
+                    true_axis = truth[axis:axis + 1] if truth.ndim == 1 else truth[start:stop, axis]
+                    _kernels.store(values, np.ascontiguousarray(true_axis), self.dt, out[s_index][:, axis])
         state.next_sample = stop
-        return out
 
-    def window(self, members, start: int, stop: int) -> tuple[np.ndarray, np.ndarray]:
+    def window(self, members, start: int, stop: int, *, as_errors: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Rates of ``members`` over samples ``start .. stop-1``: gyro (m, L, 3) rad/s, accel (m, L, 3) m/s^2.
 
         Sample k is the mean over (k dt, (k + 1) dt]. With quantisation, rate = whole quanta / dt.
+        Both arrays are new and C-contiguous.
 
         Parameters
         ----------
@@ -326,6 +346,8 @@ class ImuSimulator:
             Member numbers.
         start, stop : int
             Sample index range.
+        as_errors : bool
+            Return the increment errors (rate - true input) dt instead, rad and m/s.
 
         """
         members = np.asarray(members, dtype=np.int64).reshape(-1)
@@ -335,14 +357,16 @@ class ImuSimulator:
         if members.size and members.min() < 0:
             raise InvalidParameter("members", "member numbers must be >= 0")
         constants = self.constants(members)
-        jobs = [(int(m), start, stop, constants, row) for row, m in enumerate(members)]
+        gyro, accel = np.empty((members.size, stop - start, 3)), np.empty((members.size, stop - start, 3))
+        jobs = [(int(m), start, stop, constants, row, (gyro[row], accel[row]), as_errors)
+                for row, m in enumerate(members)]
         if self.workers > 1 and len(jobs) > 1:
             with ThreadPoolExecutor(self.workers) as pool:
-                rows = list(pool.map(lambda job: self._member_window(*job), jobs))
+                list(pool.map(lambda job: self._member_window(*job), jobs))
         else:
-            rows = [self._member_window(*job) for job in jobs]
-        stacked = np.stack(rows) if rows else np.empty((0, 6, stop - start))
-        return stacked[:, :3].transpose(0, 2, 1), stacked[:, 3:].transpose(0, 2, 1)
+            for job in jobs:
+                self._member_window(*job)
+        return gyro, accel
 
 
 def _check_size(members: int, samples: int, max_memory_bytes: int) -> None:
@@ -437,15 +461,28 @@ def simulate_record(model: ErrorModel, *, duration_s: float, sample_interval_s: 
     Parameters
     ----------
     model : ErrorModel
-    duration_s, sample_interval_s : float
-        Length and dt, s.
-    seed, member : int
-        Address of the random numbers.
-    latitude_rad, heading_rad : float
-        Site latitude and heading of the x axis, rad.
+        Sensor errors (SI): the member's constant errors are drawn from it, its random processes simulated.
+    duration_s : float
+        Length of the record, s.
+    sample_interval_s : float
+        Sample interval dt, s.
+    seed : int
+        Study seed of the addressed random numbers, plain number >= 0.
+    member : int
+        Member number, index >= 0: with the seed, the address of the random numbers.
+    latitude_rad : float
+        Geodetic latitude L of the site, rad.
+    heading_rad : float
+        Heading of the body x axis, clockwise from north, rad.
     kind : {"rate", "increment"}
+        What a sample holds: the mean rate over dt (rad/s, m/s^2) or its increment (rad, m/s).
     max_memory_bytes : int
         Largest record allocated, bytes (larger requests are refused).
+
+    Returns
+    -------
+    ImuRecord
+        Samples at t = dt, 2 dt, ..., body axes x forward, y right, z down.
     """
     dt = float(sample_interval_s)
     samples = _sample_count(duration_s, dt)
@@ -470,14 +507,26 @@ def write_simulation(path, model: ErrorModel, *, duration_s: float, sample_inter
         The Parquet file.
     model : ErrorModel
         Sensor errors (SI).
-    duration_s, sample_interval_s : float
-        Length and dt, s.
-    seed, member : int
-        Address of the random numbers.
-    latitude_rad, heading_rad : float
-        Site latitude and heading of the x axis, rad.
+    duration_s : float
+        Length of the record, s.
+    sample_interval_s : float
+        Sample interval dt, s.
+    seed : int
+        Study seed of the addressed random numbers, plain number >= 0.
+    member : int
+        Member number, index >= 0: with the seed, the address of the random numbers.
+    latitude_rad : float
+        Geodetic latitude L of the site, rad.
+    heading_rad : float
+        Heading of the body x axis, clockwise from north, rad.
     workers : int
-        Number of threads.
+        Threads over members, number of.
+
+    Returns
+    -------
+    Path
+        The file written: rates (rad/s, m/s^2), body axes x forward, y right, z down, the same samples as
+        :func:`simulate_record`.
     """
     from schuler.imu.native import ParquetRecordWriter
 

@@ -310,9 +310,8 @@ def bytes_per_member(shared: Setup, noisy: ErrorModel | None) -> int:
     held = estimate_memory(2, shared.output_count, DEFAULT_CHUNK, noisy is not None) \
         - estimate_memory(1, shared.output_count, DEFAULT_CHUNK, noisy is not None)
     if noisy is not None:
-        # the simulator's window (six channels, stacked and transposed) and one block per slow process
-        held += DEFAULT_CHUNK * 6 * 8 * 2 + imu_noise.slow_processes(noisy, 1.0 / shared.imu_rate) \
-            * imu_noise.COARSE_BLOCK_BYTES
+        # the simulator's window (six channels) and the slow processes' sums it may keep between windows
+        held += DEFAULT_CHUNK * 6 * 8 * 2 + imu_noise.state_bytes(noisy, 1.0 / shared.imu_rate)
     return held
 
 

@@ -16,7 +16,7 @@ in two parts, body axes (the platform's own axes in the platform mode):
 Draws are the IMU layer's own: member m of seed s takes its constants from the
 streams ``gyro/bias``, ``gyro/scale_factor``, ``gyro/misalignment``,
 ``gyro/g_sensitivity`` ... at address m, and its noise from ``gyro_x/white``,
-``gyro_x/flicker3`` ... (:class:`~schuler.core.random.RandomStreams`), so a
+``gyro_x/slow`` ... (:class:`~schuler.core.random.RandomStreams`), so a
 member's sensors are those ``schuler.imu.simulate`` gives that member, and no
 result depends on how the members are chunked. The nominal case (no random
 streams) takes every constant error at +1 sigma, the representative case of
@@ -53,10 +53,6 @@ from schuler.imu.spec import GRADES, load_spec_file, preset
 from schuler.navigate.truth import TruthGenerator
 
 _RANDOM_TERMS = ("random_walk", "bias_instability", "gm_sigma", "rate_random_walk", "quantization")
-
-COARSE_BLOCK_BYTES = 65_536 * 8
-"""Normals ``ImuSimulator`` keeps per slow process and member (one generator block), bytes."""
-
 
 def load_error_model(text: str) -> ErrorModel:
     """The error model of ``--imu``: a grade preset or a TOML spec file (:mod:`schuler.imu.spec`).
@@ -146,6 +142,19 @@ def slow_processes(model: ErrorModel, interval: float) -> int:
         Number of slow processes per member.
     """
     return len(ImuSimulator(noise_model(model), interval).coarse_steps())
+
+
+def state_bytes(model: ErrorModel, interval: float) -> int:
+    """Memory the simulator may carry per member from one window to the next, bytes.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The full error model (its noise part is simulated).
+    interval : float
+        IMU interval dt, s.
+    """
+    return ImuSimulator(noise_model(model), interval).member_state_bytes()
 
 
 @dataclass(frozen=True)
@@ -301,11 +310,4 @@ class ImuNoise:
         if not np.isclose(dt, self.interval, rtol=1e-12, atol=0.0):
             raise InvalidParameter("imu_rate", f"the noise was set up for {1 / self.interval:g} Hz, "
                                                f"asked for {1 / dt:g} Hz")
-        gyro, accel = self._simulator.window(members, start, stop)
-        out = []
-        for rates, truth in ((gyro, self.true_rate), (accel, self.true_specific_force)):
-            errors = np.empty(rates.shape)  # C-contiguous, as the time loops read it
-            np.subtract(rates, truth, out=errors)
-            errors *= self.interval
-            out.append(errors)
-        return out[0], out[1]
+        return self._simulator.window(members, start, stop, as_errors=True)  # C-contiguous, as the loops read
