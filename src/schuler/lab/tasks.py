@@ -256,9 +256,10 @@ def constraint_panel(result) -> html.Table:
     rows = []
     for key, symbol, limit, unit in CONSTRAINTS:
         value = getattr(result, key)
-        holds = value is not None and value < limit
+        shown = value is not None and not np.isnan(value)
+        holds = shown and value < limit
         rows.append(html.Tr([html.Th(f"{symbol} < {limit:g} {unit}", scope="row"),
-                             html.Td(f"{views.number_text(value)} {unit}" if value is not None else "-",
+                             html.Td(f"{views.number_text(value)} {unit}" if shown else "-",
                                      className="number"),
                              html.Td("holds" if holds else "VIOLATED", className="ok" if holds else "violated")],
                             **views.data_attributes(constraint=key.removeprefix("max_abs_").removesuffix("_rad_s")
