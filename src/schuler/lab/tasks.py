@@ -339,8 +339,6 @@ def compute(system: System, page: str, typed: dict[str, str], sweep_typed: dict[
             others = ("simplified",) if number == 2 and result.model != "simplified" else ()
             table = sweep_table(system, values, name, x, progress, models=others)
             columns = {c: table[c].to_numpy() for c in table.columns[1:]}
-            if others:
-                columns["simplified_azimuth_error_arcmin"] = columns.pop("simplified_azimuth_error_arcmin")
             view.notes += sweep_violations(table)
             view.figures.append((f"task{number}_sweep", figures.sweep_curves(
                 table.iloc[:, 0].to_numpy(), table.columns[0], columns, CONSTRAINTS,
