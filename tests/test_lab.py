@@ -511,3 +511,16 @@ def test_number_texts_are_plain_numbers():
     for value in (3.5558, -0.000123, 123456.0, 1e-9, 42.0):
         assert float(views.number_text(value)) == pytest.approx(value, rel=5e-4)
     assert isinstance(views.headline(ALIGN, {}), html.Table)
+
+
+def test_an_internal_error_is_logged_with_its_traceback(caplog):
+    try:
+        raise ZeroDivisionError("float division by zero\nsecond line")
+    except ZeroDivisionError as error:
+        failure = error
+    with caplog.at_level("ERROR", logger="schuler.lab.system_page"):
+        line = system_page.internal_error(failure)
+    assert line == "internal error: ZeroDivisionError: float division by zero"
+    [record] = caplog.records
+    assert record.exc_info is not None and record.exc_info[1] is failure
+    assert "Traceback" in caplog.text and "raise ZeroDivisionError" in caplog.text
