@@ -524,3 +524,21 @@ def test_an_internal_error_is_logged_with_its_traceback(caplog):
     [record] = caplog.records
     assert record.exc_info is not None and record.exc_info[1] is failure
     assert "Traceback" in caplog.text and "raise ZeroDivisionError" in caplog.text
+
+
+@pytest.mark.parametrize("limit", [1, 0, -3, 2.5])
+def test_thin_refuses_a_limit_below_two(limit):
+    with pytest.raises(InvalidParameter, match=r"limit: must be a whole number of points >= 2"):
+        figures.thin(np.arange(10), limit=limit)
+    assert [a.tolist() for a in figures.thin(np.arange(10), limit=2)] == [[0, 9]]
+
+
+def test_a_history_shows_at_least_its_first_points():
+    from types import SimpleNamespace
+
+    run = SimpleNamespace(time=np.arange(50.0), analytic={"settling_time_s": 0.5})  # settles within a step
+    assert figures.shown_window(run).sum() == figures.MIN_POINTS_SHOWN == 10
+    short = SimpleNamespace(time=np.arange(4.0), analytic={"settling_time_s": 0.1})
+    assert figures.shown_window(short).all()
+    slow = SimpleNamespace(time=np.arange(50.0), analytic={"settling_time_s": 5.0})
+    assert figures.shown_window(slow).sum() == 21  # 4 settling times: t = 0 .. 20 s
