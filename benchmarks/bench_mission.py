@@ -63,7 +63,7 @@ def source_by_source(setup):
     start = rotation_matrix(trajectory.kinematics(np.array([0.0]))[1])[0]
     x0 = initial_state_map(setup, start, 7) * setup.constant_sigmas[:, None]
     sigmas = setup.constant_sigmas
-    inputs = sensor_inputs(setup, c.body_to_ned, c.body_rate, c.body_specific_force) * sigmas[None, :, None]
+    inputs = sensor_inputs(c.body_to_ned, c.body_rate, c.body_specific_force) * sigmas[None, :, None]
     total = 0.0
     for j in range(len(CONSTANT_SOURCES)):
         x = propagate_along(c.time, c.latitude, c.height, c.velocity_ned, c.specific_force_ned, x0[j],

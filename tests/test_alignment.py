@@ -19,7 +19,7 @@ from schuler.alignment.coarse import align_coarse
 from schuler.alignment.data import StaticBatch, convergence_time
 from schuler.alignment.gyrocompass import align_gyrocompass, loop_gains, settling_time
 from schuler.alignment.inertial import align_inertial, net_rotation
-from schuler.alignment.kalman import align_kalman
+from schuler.alignment.kalman import KalmanTuning, align_kalman
 from schuler.alignment.limits import (
     accuracy_limit,
     gyrocompass_error_model,
@@ -270,6 +270,16 @@ def test_bad_input_is_refused():
         align_kalman(batch, SIMPLE, update_interval_s=float("nan"))
     with pytest.raises(NotObservable):
         align_gyrocompass(static_batch(math.radians(89.9), 0.0, 0.0, 0.0, seconds=10.0, dt=0.1))
+
+
+@pytest.mark.parametrize("window", [0.0, -600.0, float("nan"), float("inf")])
+def test_kalman_tuning_refuses_a_bad_window_by_name(window):
+    model = preset("tactical")
+    with pytest.raises(InvalidParameter, match=r"window_s: must be finite and > 0 s"):
+        KalmanTuning.from_model(model, window_s=window)
+    # q = B^2 / window: over 400 s the walk is B / 20
+    tuning = KalmanTuning.from_model(model, window_s=400.0)
+    np.testing.assert_allclose(tuning.gyro_bias_walk, np.asarray(model.gyro.bias_instability) / 20.0, rtol=1e-15)
 
 
 def test_a_consumer_grade_record_gives_finite_answers():

@@ -55,6 +55,15 @@ def stab(shape=None, **kw):
     return Stabilizer(**base)
 
 
+@pytest.mark.parametrize("delta", [-1.0, -1.5, float("nan"), [0.0, -2.0]])
+def test_closed_form_and_simulation_refuse_a_second_pulse_of_no_length(delta):
+    for reading in (reading_closed_form, simulate_cycle):
+        with pytest.raises(InvalidParameter, match=r"duration_mismatch: must be > -1"):
+            reading(stab(), 1e-5, duration_mismatch=delta)
+    # just above -1 the closed form still gives a finite reading
+    assert np.isfinite(reading_closed_form(stab(), 1e-5, duration_mismatch=-0.999))
+
+
 @pytest.mark.parametrize("shape", SHAPES, ids=lambda s: s.name)
 @pytest.mark.parametrize("quadrant_azimuth", [30.0, 120.0, 210.0, 300.0])
 def test_noise_free_recovery_any_shape_all_quadrants(shape, quadrant_azimuth):

@@ -58,6 +58,15 @@ def test_closed_form_matches_simulator_over_200_s(alpha0, rate, lam, b_scale, to
     assert np.max(np.abs(exact - numeric)) < 1e-9
 
 
+@pytest.mark.parametrize("start, stop, step, name", [(0.0, 1.0, 0.0, "step"), (0.0, 1.0, -0.1, "step"),
+                                                     (0.0, 1.0, float("nan"), "step"), (0.0, 1.0, 1e-9, "step"),
+                                                     (1.0, 0.0, 0.1, "stop"), (0.0, float("inf"), 0.1, "stop")])
+def test_grid_axis_refuses_a_bad_step_or_range(start, stop, step, name):
+    with pytest.raises(InvalidParameter, match=rf"^{name}: "):
+        grid.axis(start, stop, step)
+    np.testing.assert_allclose(grid.axis(-9.0, 9.0, 1.0), np.arange(-9.0, 10.0))
+
+
 def test_closed_form_holds_1e_9_up_to_its_largest_bessel_argument():
     # the bound's reason: at z0 = MAX_BESSEL_ARGUMENT the closed form still agrees with the numerical
     # integration of (4) to 1e-9 of the motion (measured 7.9e-10; the error grows as ~1.6e-16 z0)

@@ -137,3 +137,22 @@ def test_cli_friction(run_cli, tmp_path):
     assert bad.code == 2 and "--dead-zone" in bad.stderr
     former = run_cli("vertical", "friction", "--ramp-time", "1")
     assert former.code == 2 and "--ramp-time" in former.stderr
+
+
+def test_friction_figure_leaves_the_session_backend_alone(monkeypatch):
+    import matplotlib
+    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
+
+    from schuler.gyro_vertical.plots import plot_friction, plot_monte_carlo
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a figure function must not switch the matplotlib backend")
+
+    monkeypatch.setattr(matplotlib, "use", refuse)
+    open_figures = plt.get_fignums()
+    response = simulate_friction((Q, Q), np.linspace(0.0, 2 * SCHULER_PERIOD, 400), initial_tilt=(0.0, 1e-6))
+    figure = plot_friction(response, (Q, Q), R)
+    histogram = plot_monte_carlo(np.linspace(0.0, 1.0, 50), np.linspace(1.0, 2.0, 50))
+    assert isinstance(figure, Figure) and len(figure.axes) == 3 and len(histogram.axes) == 2
+    assert plt.get_fignums() == open_figures  # not registered with pyplot: nothing left open

@@ -271,8 +271,8 @@ def test_batched_sweep_equals_single_runs():
                                                     damping=[0.5, 0.8, 1.3][i]), "full", duration=3000)
         assert batch["azimuth_error_simulated_rad"][i] == pytest.approx(single.delta[-1], rel=1e-10)
         assert batch["settling_time_simulated_s"][i] == single.simulated.settling_time[0]
-        assert batch["max_abs_delta_rate_rad_per_s"][i] == pytest.approx(single.simulated.max_abs_delta_rate[0],
-                                                                         rel=1e-10)
+        assert batch["max_abs_delta_rate_rad_s"][i] == pytest.approx(single.simulated.max_abs_delta_rate[0],
+                                                                     rel=1e-10)
         assert batch["azimuth_error_simulated_rad"][i] == pytest.approx(batch["azimuth_error_rad"][i], rel=1e-9)
 
 

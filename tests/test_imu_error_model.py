@@ -71,7 +71,7 @@ def test_gauss_markov_allan_peak_and_bias_instability_mapping():
     tau_over_t, peak = GAUSS_MARKOV_PEAK
     assert tau_over_t == pytest.approx(1.893, abs=1e-3)
     assert peak == pytest.approx(0.6174, abs=1e-4)
-    assert 1.0 / gauss_markov_for_bias_instability(1.0, 1.0) == pytest.approx(0.9294, abs=1e-4)
+    assert 1.0 / gauss_markov_for_bias_instability(1.0) == pytest.approx(0.9294, abs=1e-4)
     # brute-force check of the closed form's maximum on a fine grid
     tau = np.geomspace(0.1, 100.0, 200_001)
     adev = np.sqrt(gauss_markov_allan_variance(tau, 2.0, 10.0))

@@ -118,7 +118,7 @@ def test_short_record_leaves_rate_random_walk_unresolved_under_its_bound():
 def test_gauss_markov_sigma_for_a_bias_instability_gives_its_floor():
     # B -> Gauss-Markov sigma = B x 0.6643 / 0.6174: the simulated curve peaks at the flicker floor 0.6643 B
     b, t, dt = 2e-5, 1.0, 0.02
-    sigma = gauss_markov_for_bias_instability(b, t)
+    sigma = gauss_markov_for_bias_instability(b)
     gyro, _ = simulate_members(ErrorModel(gyro=SensorErrors(gm_sigma=sigma, gm_correlation_time_s=t)),
                                samples=300_000, sample_interval_s=dt, members=1, seed=8)
     curve = allan_deviation(gyro[0, :, 0], dt, lags=np.unique(np.geomspace(20, 400, 25).astype(int)))

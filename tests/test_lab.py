@@ -487,7 +487,58 @@ def test_every_task_page_has_its_manual_text_and_questions():
             assert schuler.lab.manual.QUESTIONS[question] in text
 
 
+def test_not_computed_numbers_render_as_a_dash():
+    from types import SimpleNamespace
+
+    import pandas as pd
+
+    nan = float("nan")
+    assert views.number_text(nan) == "-"
+    assert views.number_text(float("-inf")) == "-inf"
+    statistics = {"azimuth_error_rad": {"mean": nan, "std": 1e-3, "p05": nan, "p95": 2e-3, "min": 0.0, "max": 1.0}}
+    cells = [c.children for c in views.monte_carlo_table(ALIGN, statistics, 3).children[1].children[1].children[0]
+             .children[1:]]
+    assert cells[0] == "-" and cells[2] == "-" and cells[1] != "-"
+    result = SimpleNamespace(max_abs_delta_rad=nan, max_abs_beta_rad=1e-4, max_abs_delta_rate_rad_s=None)
+    shown = [row.children[1].children for row in tasks.constraint_panel(result).children[1].children]
+    assert shown[0] == "-" and shown[1] == "0.0001 rad" and shown[2] == "-"
+    sweep = pd.DataFrame({"latitude": [10.0, nan], "max_abs_delta_rad": [1.0, 1.0], "max_abs_beta_rad": [0.0, 0.0],
+                          "max_abs_delta_rate_rad_s": [0.0, 0.0]})
+    assert tasks.sweep_violations(sweep)[0].endswith("latitude = 10, -")
+
+
 def test_number_texts_are_plain_numbers():
     for value in (3.5558, -0.000123, 123456.0, 1e-9, 42.0):
         assert float(views.number_text(value)) == pytest.approx(value, rel=5e-4)
     assert isinstance(views.headline(ALIGN, {}), html.Table)
+
+
+def test_an_internal_error_is_logged_with_its_traceback(caplog):
+    try:
+        raise ZeroDivisionError("float division by zero\nsecond line")
+    except ZeroDivisionError as error:
+        failure = error
+    with caplog.at_level("ERROR", logger="schuler.lab.system_page"):
+        line = system_page.internal_error(failure)
+    assert line == "internal error: ZeroDivisionError: float division by zero"
+    [record] = caplog.records
+    assert record.exc_info is not None and record.exc_info[1] is failure
+    assert "Traceback" in caplog.text and "raise ZeroDivisionError" in caplog.text
+
+
+@pytest.mark.parametrize("limit", [1, 0, -3, 2.5])
+def test_thin_refuses_a_limit_below_two(limit):
+    with pytest.raises(InvalidParameter, match=r"limit: must be a whole number of points >= 2"):
+        figures.thin(np.arange(10), limit=limit)
+    assert [a.tolist() for a in figures.thin(np.arange(10), limit=2)] == [[0, 9]]
+
+
+def test_a_history_shows_at_least_its_first_points():
+    from types import SimpleNamespace
+
+    run = SimpleNamespace(time=np.arange(50.0), analytic={"settling_time_s": 0.5})  # settles within a step
+    assert figures.shown_window(run).sum() == figures.MIN_POINTS_SHOWN == 10
+    short = SimpleNamespace(time=np.arange(4.0), analytic={"settling_time_s": 0.1})
+    assert figures.shown_window(short).all()
+    slow = SimpleNamespace(time=np.arange(50.0), analytic={"settling_time_s": 5.0})
+    assert figures.shown_window(slow).sum() == 21  # 4 settling times: t = 0 .. 20 s

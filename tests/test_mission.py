@@ -168,3 +168,19 @@ def test_a_better_gyro_buys_more_than_a_longer_alignment_for_a_tactical_flight()
     navigation = covariance_budget(setup_of(grade="navigation", **base)).sigma("horizontal_position")[-1]
     assert navigation < longer.sigma("horizontal_position")[-1] < tactical
     assert from_unit(1.0, "arcmin") > 0
+
+
+def test_sensor_inputs_map_unit_sources_through_the_attitude():
+    from schuler.mission.stages import sensor_inputs
+
+    # heading 90 deg: body x points east, y south, z down
+    body_to_ned = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    rate, force = np.array([2.0, 3.0, 5.0]), np.array([0.0, 0.0, -9.8])
+    inputs = sensor_inputs(body_to_ned, rate, force)
+    assert inputs.shape == (len(CONSTANT_SOURCES), 6)
+    row = dict(zip(CONSTANT_SOURCES, inputs))
+    np.testing.assert_array_equal(row["gyro_bias_x"], [0, 0, 0, 0.0, -1.0, 0.0])          # epsilon = -C b_g
+    np.testing.assert_array_equal(row["accel_bias_y"], [-1.0, 0.0, 0.0, 0, 0, 0])         # nabla = C b_a
+    np.testing.assert_array_equal(row["gyro_scale_factor_y"], [0, 0, 0, 3.0, 0.0, 0.0])   # -C diag(omega) k
+    np.testing.assert_array_equal(row["accel_scale_factor_z"], [0.0, 0.0, -9.8, 0, 0, 0])  # C diag(f) k
+    np.testing.assert_array_equal(row["north_reference"], np.zeros(6))

@@ -14,7 +14,7 @@ from schuler.core.earth import (
 )
 from schuler.exceptions import InvalidParameter
 from schuler.navigate.errors import InitialErrors, SensorErrors, WhiteNoise
-from schuler.navigate.mechanization import navigate
+from schuler.navigate.mechanization import navigate, output_interval
 from schuler.navigate.trajectory import Stationary
 from schuler.navigation_errors.single_channel import spherical_error
 from schuler.navigation_errors.vertical_channel import hover_altitude_error
@@ -208,3 +208,10 @@ def test_result_json_names_units_and_rendering():
     data = free.to_dict()
     assert np.shape(data["height_error_m"]) == (2, 11) and data["members"] == 2
     assert "std final" in str(free)
+
+
+@pytest.mark.parametrize("rate", [float("nan"), float("inf"), 0.0, -100.0])
+def test_output_interval_refuses_a_bad_imu_rate_by_name(rate):
+    with pytest.raises(InvalidParameter, match=r"imu_rate: must be finite and > 0 Hz"):
+        output_interval(1.0, rate)
+    assert output_interval(0.5, 200.0) == 100

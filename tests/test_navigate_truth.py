@@ -77,6 +77,14 @@ def test_chunking_does_not_change_the_truth():
     np.testing.assert_array_equal(np.concatenate(whole), np.concatenate(pieces))
 
 
+@pytest.mark.parametrize("size", [0, -5, 2.5, True])
+def test_chunks_refuses_a_size_that_is_not_a_positive_whole_number(size):
+    truth = TruthGenerator(Stationary(latitude=0.5, longitude=0.0, height=0.0), 10.0, 10.0)
+    with pytest.raises(InvalidParameter, match=r"chunk_size: must be a whole number of IMU intervals >= 1"):
+        truth.chunks(size)
+    assert [part.increments.shape[0] for part in truth.chunks(np.int64(40))] == [40, 40, 20]
+
+
 @pytest.mark.parametrize("mode, vertical_channel", [("strapdown", "off"), ("strapdown", "free"),
                                                     ("platform", "off"), ("platform", "free")])
 def test_ideal_imu_returns_the_truth_on_a_manoeuvring_profile(mode, vertical_channel):

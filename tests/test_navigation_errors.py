@@ -223,8 +223,17 @@ def test_hover_error_after_one_schuler_period():
     sinh = printed_hover_expression(BOLLAY.schuler_period, 1e-4, R_BOLLAY, G_BOLLAY) / STATUTE_MILE
     assert sinh == pytest.approx(715.6, abs=0.05)  # the source's expression (spec errata)
     assert sinh * 4000 / 3960 == pytest.approx(722.8, abs=0.05)  # ... with R = 4000 mi
-    # the printed sinh solution violates z(0) = 0 in form only; it is the cosh solution's large-t limit
+    # the printed sinh solution is zero at t = 0 but starts at the rate k R omega_s / sqrt(2), not 0:
+    # forward differences over 1 ms (truncation (sqrt(2) omega dt)^2 / 6 ~ 5e-13 relative; the cosh
+    # solution's rate after 1 ms is b dt / 2 ~ 5e-7 m/s)
     assert float(printed_hover_expression(0.0, 1e-4, R_BOLLAY, G_BOLLAY)) == 0.0
+    dt, omega = 1e-3, math.sqrt(G_BOLLAY / R_BOLLAY)
+    printed_rate = float(printed_hover_expression(dt, 1e-4, R_BOLLAY, G_BOLLAY)) / dt
+    correct_rate = float(-hover_altitude_error(dt, -1e-4 * G_BOLLAY, R_BOLLAY, G_BOLLAY)) / dt
+    assert abs(correct_rate) < 1e-6
+    assert printed_rate == pytest.approx(1e-4 * R_BOLLAY * omega / math.sqrt(2.0), rel=1e-9)
+    assert printed_rate - correct_rate == pytest.approx(0.5596, abs=1e-4)  # m/s, about 1.8 ft/s
+    # ... and it is the cosh solution's large-t limit only
     assert float(-hover_altitude_error(1.0, -1e-4 * G_BOLLAY, R_BOLLAY, G_BOLLAY)) != pytest.approx(
         float(printed_hover_expression(1.0, 1e-4, R_BOLLAY, G_BOLLAY)), rel=0.1)
 

@@ -69,3 +69,13 @@ def test_example_sweeps_with_its_monte_carlo_table(path, tmp_path):
     assert summary.cases == len(frame) == 3
     assert len(frame.columns) > len(system.parameters) + 1  # parameters, case number and results
     assert summary.statistics and all(s["count"] + s["nan_count"] == 3 for s in summary.statistics.values())
+
+
+def test_an_unregistered_system_name_is_refused_with_the_registered_names():
+    from schuler.exceptions import InvalidParameter
+
+    with pytest.raises(InvalidParameter, match=r"^system: 'allign' is not a system; did you mean 'align'\? "
+                                               r"choose from errors, vertical, calibrate, align, north"):
+        load_system("allign")
+    with pytest.raises(InvalidParameter, match=r"'compass' is not a system; choose from errors, vertical"):
+        load_system("compass")

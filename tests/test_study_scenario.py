@@ -133,6 +133,22 @@ def test_a_bad_scenario_gives_one_line_naming_the_key_and_exit_2(tmp_path, run_c
     assert expected in lines[0]
 
 
+def test_a_normal_spread_needs_a_value_to_spread_around(tmp_path, run_cli):
+    from schuler.study.scenario import Distribution
+    from schuler.study.systems import load_system
+
+    spec = next(p for p in load_system("align").parameters if p.name == "c_gamma")
+    assert spec.default is None  # the case this guards: no default, nothing set in the file
+    with pytest.raises(ScenarioError, match=r"\[monte_carlo.normal\] c_gamma: has no value to spread around"):
+        Distribution("normal", 0.1).draw(spec, None, 0, np.arange(3))
+    path = write(tmp_path, 'system = "align"\n[monte_carlo]\ncases = 4\n[monte_carlo.normal]\nc_gamma = 0.1\n')
+    out = run_cli("run", path)
+    assert out.code == 2 and out.stdout == ""
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1, out.stderr
+    assert lines[0].startswith(f"schuler: error: {path}: [monte_carlo.normal] c_gamma: has no value")
+
+
 def test_malformed_toml_names_the_line(tmp_path):
     with pytest.raises(ScenarioError, match=r"line 3"):
         parse_scenario('system = "fake"\n[parameters]\nlatitude = = 1\n', source="x.toml")

@@ -232,9 +232,11 @@ def escape_bars(app, what, name, obj, options, lines: list[str]) -> None:
     The package's docstrings are read in terminals too, so they write an absolute
     value as ``|x|``, which reStructuredText takes for a substitution; they use no
     substitutions, line blocks or grid tables. Bars in prose are escaped; inline
-    literals, roles, literal blocks and doctests are left alone.
+    literals, roles, literal blocks and doctests (up to the blank line that ends
+    them, their expected output included) are left alone.
     """
     literal_indent = None
+    in_doctest = False
     for i, line in enumerate(lines):
         stripped = line.lstrip()
         indent = len(line) - len(stripped)
@@ -242,7 +244,8 @@ def escape_bars(app, what, name, obj, options, lines: list[str]) -> None:
             if not stripped or indent > literal_indent:
                 continue
             literal_indent = None
-        if stripped.startswith((">>>", "...")):
+        in_doctest = bool(stripped) and (in_doctest or stripped.startswith(">>>"))
+        if in_doctest:
             continue
         if "|" in line:
             parts = _LITERALS.split(line)

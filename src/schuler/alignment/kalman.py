@@ -107,7 +107,7 @@ class KalmanTuning:
         velocity_noise : float
             1-sigma of the zero-velocity measurement, m/s (> 0).
         window_s : float
-            Time over which the bias instability builds up in the bias walk, s.
+            Time over which the bias instability builds up in the bias walk, s (finite, > 0).
         gravity : float
             g at the site, m/s^2 (for the g-dependent constant errors).
 
@@ -119,10 +119,12 @@ class KalmanTuning:
         Raises
         ------
         InvalidParameter
-            ``velocity_noise`` not finite and positive.
+            ``velocity_noise`` or ``window_s`` not finite and positive.
         """
         if not (math.isfinite(velocity_noise) and velocity_noise > 0):
             raise InvalidParameter("velocity_noise", f"must be finite and > 0 m/s, got {velocity_noise!r}")
+        if not (math.isfinite(window_s) and window_s > 0):
+            raise InvalidParameter("window_s", f"must be finite and > 0 s, got {window_s!r}")
         gyro, accel = model.gyro, model.accel
         gyro_bias, accel_bias = effective_bias_sigma(model, gravity)
         return cls(np.asarray(gyro.random_walk, dtype=float), np.asarray(accel.random_walk, dtype=float),

@@ -313,8 +313,7 @@ def simulate_cycle(
     )
     rate, angle0, kappa, eps, delta, tilt, offset, sway0, swayrate0 = (a.copy() for a in arrays)
     members = rate.size
-    if np.any(1.0 + delta <= 0.0):
-        raise InvalidParameter("duration_mismatch", "the second pulse must last a positive time")
+    _check_duration_mismatch(delta)
     densities = np.broadcast_to(np.asarray(angle_random_walk, dtype=float), (members,)), \
         np.broadcast_to(np.asarray(sensor_noise_density, dtype=float), (members,))
     noisy = bool(np.any(densities[0] > 0.0) or np.any(densities[1] > 0.0))
@@ -373,6 +372,13 @@ def simulate_cycle(
     return CycleOutcome(reading, samples, time, angle, signal, integral)
 
 
+def _check_duration_mismatch(delta: np.ndarray) -> None:
+    # NaN fails the comparison too, so it is refused rather than carried into the reading
+    if not np.all(1.0 + delta > 0.0):
+        raise InvalidParameter("duration_mismatch", f"must be > -1 (the second pulse must last a positive time), "
+                                                    f"got {float(np.min(delta)):g}")
+
+
 def reading_closed_form(
     stabilizer: Stabilizer,
     rate,
@@ -425,6 +431,11 @@ def reading_closed_form(
     numpy.ndarray
         Delta U, the integrator's reading over the cycle, V s, in the broadcast shape of the arguments.
 
+    Raises
+    ------
+    InvalidParameter
+        ``duration_mismatch`` not above -1 (or NaN), as in :func:`simulate_cycle`.
+
     Examples
     --------
     >>> from schuler.drift_calibration.pulses import rectangular
@@ -435,6 +446,7 @@ def reading_closed_form(
     rate, angle0, kappa, eps, delta, tilt, offset, sway0, swayrate0 = np.broadcast_arrays(
         *(np.asarray(v, dtype=float) for v in (rate, initial_angle, sensor_scale_error, amplitude_mismatch,
                                               duration_mismatch, tilt, integrator_offset, sway_angle, sway_rate)))
+    _check_duration_mismatch(delta)
     tau = stabilizer.tau
     tau2 = tau * (1.0 + delta)
     area = stabilizer.shape.area()  # a tilt keeps the area

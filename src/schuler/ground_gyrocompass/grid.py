@@ -37,6 +37,8 @@ AXES = ("alpha0", "alpha0_dot", "decay_rate", "coefficient")
 
 STEP_ALPHA0 = math.pi / 540.0  # the source's alpha0 unit and first step, rad
 STEP_ALPHA0_DOT = 1e-4  # rad/s
+MAX_AXIS_POINTS = 100_000
+"""Most values of one grid axis (the source's boxes have a few tens; this bounds the misfit grid's memory)."""
 
 
 def axis(start: float, stop: float, step: float) -> np.ndarray:
@@ -47,14 +49,32 @@ def axis(start: float, stop: float, step: float) -> np.ndarray:
     start, stop : float
         First and last value, in the axis's SI unit (rad, rad/s, 1/s or 1/s^2).
     step : float
-        Spacing, same unit (> 0; not checked).
+        Spacing, same unit (> 0).
 
     Returns
     -------
     ndarray
         The values, same unit.
+
+    Raises
+    ------
+    InvalidParameter
+        ``step`` not finite and > 0, ``start``/``stop`` not finite or ``stop`` below ``start``, or more than
+        :data:`MAX_AXIS_POINTS` values.
+
+    Examples
+    --------
+    >>> axis(0.0, 1.0, 0.25)
+    array([0.  , 0.25, 0.5 , 0.75, 1.  ])
     """
+    if not (math.isfinite(step) and step > 0):
+        raise InvalidParameter("step", f"must be finite and > 0, got {step!r}")
+    if not (math.isfinite(start) and math.isfinite(stop) and stop >= start):
+        raise InvalidParameter("stop", f"must be finite and >= start ({start!r}), got {stop!r}")
     count = int(round((stop - start) / step)) + 1
+    if count > MAX_AXIS_POINTS:
+        raise InvalidParameter("step", f"{step!r} gives {count} values from {start!r} to {stop!r}; "
+                                       f"at most {MAX_AXIS_POINTS} are allowed")
     return start + step * np.arange(count)
 
 

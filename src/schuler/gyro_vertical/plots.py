@@ -14,12 +14,11 @@ HOUR = 3600.0
 
 
 def _figure(rows: int, height: float = 2.6):
-    import matplotlib
+    # a bare Figure: no pyplot state and no backend switch for the caller's session
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(rows, 1, sharex=True, squeeze=False, figsize=(9, height * rows))
+    fig = Figure(figsize=(9, height * rows))
+    axes = fig.subplots(rows, 1, sharex=True, squeeze=False)
     return fig, axes[:, 0]
 
 
@@ -121,12 +120,10 @@ def plot_monte_carlo(samples_x, samples_y, title: str = "Monte Carlo: systematic
     title : str
         Figure title.
     """
-    import matplotlib
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(2, 1, figsize=(9, 5.6))
+    fig = Figure(figsize=(9, 5.6))
+    axes = fig.subplots(2, 1)
     for axis, name, samples in zip(axes, ("Delta v_x", "Delta v_y"), (samples_x, samples_y)):
         values = np.asarray(samples, dtype=float)
         values = values[np.isfinite(values)]
@@ -190,13 +187,10 @@ def plot_friction(response, q, radius, title: str = "Coulomb friction: velocity 
     matplotlib.figure.Figure
         Three panels: Delta v_x and Delta v_y against time in hours, then the first ``zoom_hours`` enlarged.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     hours = response.time / HOUR
-    fig = plt.figure(figsize=(9, 8))
+    fig = Figure(figsize=(9, 8))
     grid = fig.add_gridspec(3, 1)
     top = fig.add_subplot(grid[0])
     axes = [top, fig.add_subplot(grid[1], sharex=top)]

@@ -208,11 +208,9 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
         "design_damping": result["damping"],
     }
     if simulate:
+        out.update({key: result[key] for key in ("settling_time_simulated_s", "max_abs_delta_rad", "max_abs_beta_rad",
+                                                 "max_abs_delta_rate_rad_s")})
         out.update({
-            "settling_time_simulated_s": result["settling_time_simulated_s"],
-            "max_abs_delta_rad": result["max_abs_delta_rad"],
-            "max_abs_beta_rad": result["max_abs_beta_rad"],
-            "max_abs_delta_rate_rad_s": result["max_abs_delta_rate_rad_per_s"],
             "constraints_ok": np.asarray(result["constraints_ok"], dtype=float),
             "simulated_duration_s": np.full(len(cases), duration),
         })

@@ -132,7 +132,7 @@ def evaluate_cases(case: AlignmentCase, model: str = "full", *, simulate_runs: b
     ``model`` (batched, chunked) over ``duration`` (default :func:`automatic_duration`)
     adding ``azimuth_error_simulated_rad``, ``level_error_beta_simulated_rad``,
     ``settling_time_simulated_s`` (1 % band), ``max_abs_delta_rad``,
-    ``max_abs_beta_rad``, ``max_abs_delta_rate_rad_per_s`` and ``constraints_ok``.
+    ``max_abs_beta_rad``, ``max_abs_delta_rate_rad_s`` and ``constraints_ok``.
 
     Parameters
     ----------
@@ -150,7 +150,7 @@ def evaluate_cases(case: AlignmentCase, model: str = "full", *, simulate_runs: b
     Returns
     -------
     dict of str to numpy.ndarray
-        Result name -> values, shape (N,), in the unit the name ends with (``_rad``, ``_s``, ``_rad_per_s``);
+        Result name -> values, shape (N,), in the unit the name ends with (``_rad``, ``_s``, ``_rad_s`` for rad/s);
         the gains ``c_gamma`` and ``c_a`` in 1/s, ``damping`` a plain number, ``constraints_ok`` a bool array.
 
     Examples
@@ -176,7 +176,7 @@ def evaluate_cases(case: AlignmentCase, model: str = "full", *, simulate_runs: b
         "settling_time_simulated_s": simulated.settling_time,
         "max_abs_delta_rad": simulated.max_abs_delta,
         "max_abs_beta_rad": simulated.max_abs_beta,
-        "max_abs_delta_rate_rad_per_s": simulated.max_abs_delta_rate,
+        "max_abs_delta_rate_rad_s": simulated.max_abs_delta_rate,
         "constraints_ok": simulated.constraints_ok,
     })
     return result

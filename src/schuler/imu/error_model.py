@@ -118,21 +118,28 @@ GAUSS_MARKOV_PEAK = _gm_peak()
 """(tau / T, sigma_A / sigma) at the Allan-deviation peak of a first-order Gauss-Markov process: (1.893, 0.6174)."""
 
 
-def gauss_markov_for_bias_instability(bias_instability: float, correlation_time: float) -> float:
+def gauss_markov_for_bias_instability(bias_instability: float) -> float:
     """The Gauss-Markov sigma whose Allan-deviation peak equals the flicker floor of B: sigma = B 0.6643 / 0.6174.
 
     Parameters
     ----------
     bias_instability : float
         B (IEEE 952), rad/s (gyro) or m/s^2 (accelerometer).
-    correlation_time : float
-        T of the Gauss-Markov process, s. The peak ratio does not depend on it (the peak only moves to
-        tau = 1.893 T), so it does not enter the result.
 
     Returns
     -------
     float
         Stationary standard deviation sigma of the Gauss-Markov bias, in the unit of ``bias_instability``.
+
+    Notes
+    -----
+    The peak ratio sigma_A / sigma = 0.6174 does not depend on the correlation time T (the peak only
+    moves to tau = 1.893 T), so T is chosen separately and does not enter.
+
+    Examples
+    --------
+    >>> round(1.0 / gauss_markov_for_bias_instability(1.0), 4)
+    0.9294
     """
     return bias_instability * FLICKER_FLOOR / GAUSS_MARKOV_PEAK[1]
 

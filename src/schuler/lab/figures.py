@@ -23,6 +23,7 @@ import numpy as np
 from dash import dcc, html
 
 from schuler.contract import System
+from schuler.exceptions import InvalidParameter
 from schuler.lab.views import data_attributes
 from schuler.units import to_unit
 
@@ -31,6 +32,9 @@ MAX_POINTS = 400
 
 SETTLING_TIMES_SHOWN = 4.0
 """The time axis of a history spans this many analytic settling times (or the whole run if shorter)."""
+
+MIN_POINTS_SHOWN = 10
+"""A history shows at least this many samples, so that a run settling within a step still draws a curve."""
 
 GRAPH_CONFIG: Any = {"displaylogo": False, "responsive": True,
                 "modeBarButtonsToRemove": ["select2d", "lasso2d", "autoScale2d"],
@@ -52,18 +56,25 @@ def thin(*arrays: np.ndarray, limit: int = MAX_POINTS) -> list[np.ndarray]:
     *arrays : array_like
         Equally long 1-D arrays (a trace's x and y values, any unit: only points are dropped).
     limit : int
-        Largest number of points to keep, at least 2.
+        Largest number of points to keep, at least 2 (the first and the last).
 
     Returns
     -------
     list of numpy.ndarray
         The arrays thinned alike; the arrays themselves when they hold ``limit`` points or fewer.
 
+    Raises
+    ------
+    InvalidParameter
+        ``limit`` is not a whole number >= 2.
+
     Examples
     --------
     >>> [a.tolist() for a in thin(np.arange(10), limit=4)]
     [[0, 3, 6, 9]]
     """
+    if isinstance(limit, bool) or not isinstance(limit, int | np.integer) or limit < 2:
+        raise InvalidParameter("limit", f"must be a whole number of points >= 2 (first and last), got {limit!r}")
     n = len(arrays[0])
     if n <= limit:
         return list(arrays)
@@ -112,7 +123,7 @@ def _level(value: float, row: int, label: str, color: str = "black") -> tuple[di
 
 
 def shown_window(run) -> np.ndarray:
-    """The part of a run a history figure shows: a few settling times, at least the first 10 points.
+    """The part of a run a history figure shows: a few settling times, at least the first ``MIN_POINTS_SHOWN`` points.
 
     Parameters
     ----------
@@ -122,9 +133,11 @@ def shown_window(run) -> np.ndarray:
     Returns
     -------
     numpy.ndarray of bool
-        Mask over ``run.time``: True up to ``SETTLING_TIMES_SHOWN`` settling times (and at least samples 0 to 10).
+        Mask over ``run.time``: True up to ``SETTLING_TIMES_SHOWN`` settling times and at least for the first
+        ``MIN_POINTS_SHOWN`` samples (all of a shorter run).
     """
-    end = max(SETTLING_TIMES_SHOWN * run.analytic["settling_time_s"], run.time[min(10, run.time.size - 1)])
+    last_of_first = run.time[min(MIN_POINTS_SHOWN, run.time.size) - 1]
+    end = max(SETTLING_TIMES_SHOWN * run.analytic["settling_time_s"], last_of_first)
     return run.time <= end
 
 

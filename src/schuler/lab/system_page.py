@@ -13,6 +13,7 @@ page's session token; nothing about a user is kept in the server.
 from __future__ import annotations
 
 import io
+import logging
 import tempfile
 import warnings
 import zipfile
@@ -28,6 +29,8 @@ from schuler.lab.controls import ERROR, PARAM, controls, error_owner, parse_type
 from schuler.lab.figures import GRAPH, block, empty, file_figures, interactive_figures, interactive_stems
 from schuler.params import Parameter, ParameterSet
 from schuler.registry import get_system
+
+_LOG = logging.getLogger(__name__)
 
 POLL_MS = 50
 """How often the browser asks whether a background job has finished, ms (it bounds the added latency)."""
@@ -312,18 +315,19 @@ def register(app: Dash) -> None:
 
 
 def internal_error(error: Exception) -> str:
-    """The one line a page shows for an unexpected failure (the server's log has the traceback).
+    """The one line a page shows for an unexpected failure; its traceback goes to the server's log.
 
     Parameters
     ----------
     error : Exception
-        The unexpected exception.
+        The unexpected exception (logged with its traceback at ERROR level on this module's logger).
 
     Returns
     -------
     str
         ``internal error: TYPE: MESSAGE``, cut at the message's first line break.
     """
+    _LOG.error("unexpected failure behind a page", exc_info=error)
     return f"internal error: {type(error).__name__}: {error}".splitlines()[0]
 
 

@@ -256,9 +256,10 @@ def constraint_panel(result) -> html.Table:
     rows = []
     for key, symbol, limit, unit in CONSTRAINTS:
         value = getattr(result, key)
-        holds = value is not None and value < limit
+        shown = value is not None and not np.isnan(value)
+        holds = shown and value < limit
         rows.append(html.Tr([html.Th(f"{symbol} < {limit:g} {unit}", scope="row"),
-                             html.Td(f"{views.number_text(value)} {unit}" if value is not None else "-",
+                             html.Td(f"{views.number_text(value)} {unit}" if shown else "-",
                                      className="number"),
                              html.Td("holds" if holds else "VIOLATED", className="ok" if holds else "violated")],
                             **views.data_attributes(constraint=key.removeprefix("max_abs_").removesuffix("_rad_s")
@@ -338,8 +339,6 @@ def compute(system: System, page: str, typed: dict[str, str], sweep_typed: dict[
             others = ("simplified",) if number == 2 and result.model != "simplified" else ()
             table = sweep_table(system, values, name, x, progress, models=others)
             columns = {c: table[c].to_numpy() for c in table.columns[1:]}
-            if others:
-                columns["simplified_azimuth_error_arcmin"] = columns.pop("simplified_azimuth_error_arcmin")
             view.notes += sweep_violations(table)
             view.figures.append((f"task{number}_sweep", figures.sweep_curves(
                 table.iloc[:, 0].to_numpy(), table.columns[0], columns, CONSTRAINTS,

@@ -30,8 +30,8 @@ def number_text(value: float) -> str:
     Returns
     -------
     str
-        ``inf``/``-inf`` for infinities, ``0`` for zero (also -0.0), fixed-point with 4 significant digits
-        from 0.001 up to 10^6, otherwise ``%.4g``.
+        ``-`` for NaN (not computed, as in :func:`quantity_text`), ``inf``/``-inf`` for infinities, ``0`` for
+        zero (also -0.0), fixed-point with 4 significant digits from 0.001 up to 10^6, otherwise ``%.4g``.
 
     Examples
     --------
@@ -39,7 +39,11 @@ def number_text(value: float) -> str:
     ('3.556', '0.05333', '10800', '1.234e-07')
     >>> number_text(-0.0), number_text(float("inf")), number_text(30.0), number_text(0.8)
     ('0', 'inf', '30', '0.8')
+    >>> number_text(float("nan"))
+    '-'
     """
+    if math.isnan(value):
+        return "-"
     if math.isinf(value):
         return "inf" if value > 0 else "-inf"
     if value == 0:

@@ -249,7 +249,7 @@ def covariance_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> Co
     sigma = setup.constant_sigmas * np.array([name not in disabled for name in CONSTANT_SOURCES])
     start_rotation = rotation_matrix(trajectory.kinematics(np.array([0.0]))[1])[0]
     x0 = initial_state_map(setup, start_rotation, n) * sigma[:, None]
-    inputs = sensor_inputs(setup, coefficients.body_to_ned, coefficients.body_rate,
+    inputs = sensor_inputs(coefficients.body_to_ned, coefficients.body_rate,
                            coefficients.body_specific_force) * sigma[None, :, None]
     rows = _output_rows(coefficients, n)
     K = F.shape[0]

@@ -77,16 +77,16 @@ from schuler.gyrocompassing.models import simplified_model
 from schuler.mission.setup import AXES, CONSTANT_SOURCES, SELF_ALIGNMENTS, MissionSetup
 
 
-def sensor_inputs(setup: MissionSetup, body_to_ned, body_rate, body_force) -> np.ndarray:
+def sensor_inputs(body_to_ned, body_rate, body_force) -> np.ndarray:
     """NED inputs (nabla, epsilon) of each unit constant source: shape (..., n_sources, 6).
 
     ``body_to_ned`` (..., 3, 3), ``body_rate`` and ``body_force`` (..., 3): the
     rotation and the body's angular rate and specific force where they act.
 
+    Every source has unit size here: the mission's 1-sigma sizes scale the result where it is used.
+
     Parameters
     ----------
-    setup : MissionSetup
-        The mission (not used by the map itself: every source has unit size here).
     body_to_ned : array_like
         C_b^n, shape (..., 3, 3), plain numbers (direction cosines), body x forward, y right, z down.
     body_rate : array_like
@@ -161,7 +161,7 @@ def initial_state_map(setup: MissionSetup, body_to_ned: np.ndarray, n_states: in
     omega = earth_rate_ned(L, EARTH_RATE)
     rate0 = body_to_ned.T @ omega
     force0 = body_to_ned.T @ np.array([0.0, 0.0, -g])
-    inputs = sensor_inputs(setup, body_to_ned, rate0, force0)
+    inputs = sensor_inputs(body_to_ned, rate0, force0)
     nabla, epsilon = inputs[:, :3], inputs[:, 3:]
     psi_n, psi_e = _levelling(nabla, g)
     cos_l = EARTH_RATE * math.cos(L)

@@ -93,14 +93,17 @@ def output_interval(output_step: float, imu_rate: float) -> int:
     Raises
     ------
     InvalidParameter
-        Naming ``output_step`` when it is not finite and positive or not a whole
-        number of IMU intervals (to 1e-6 of the count).
+        Naming ``imu_rate`` when it is not finite and positive; naming ``output_step``
+        when it is not finite and positive or not a whole number of IMU intervals
+        (to 1e-6 of the count).
 
     Examples
     --------
     >>> output_interval(10.0, 100.0)
     1000
     """
+    if not (np.isfinite(imu_rate) and imu_rate > 0):
+        raise InvalidParameter("imu_rate", f"must be finite and > 0 Hz, got {imu_rate!r}")
     if not (np.isfinite(output_step) and output_step > 0):
         raise InvalidParameter("output_step", f"must be finite and > 0, got {output_step!r}")
     count = output_step * imu_rate

@@ -149,11 +149,21 @@ class TruthGenerator:
         chunk_size : int
             Largest number of IMU intervals per block (>= 1): it bounds the memory held at once.
 
-        Yields
+        Returns
+        -------
+        Iterator of TruthChunk
+            The truth and ideal increments of each block in turn, SI.
+
+        Raises
         ------
-        TruthChunk
-            The truth and ideal increments of the next block, SI.
+        InvalidParameter
+            ``chunk_size`` is not a whole number >= 1 (checked at the call, before any block is made).
         """
+        if isinstance(chunk_size, bool) or not isinstance(chunk_size, int | np.integer) or chunk_size < 1:
+            raise InvalidParameter("chunk_size", f"must be a whole number of IMU intervals >= 1, got {chunk_size!r}")
+        return self._blocks(int(chunk_size))
+
+    def _blocks(self, chunk_size: int) -> Iterator[TruthChunk]:
         state = self.initial_state()
         for start in range(0, self.n_samples, chunk_size):
             stop = min(start + chunk_size, self.n_samples)

@@ -11,8 +11,10 @@ hovering pilot has b = -k g0). With delta_h(0) = delta_h'(0) = 0 the solution is
 
     delta_h = (b / (2 omega_s^2)) (cosh(sqrt(2) omega_s t) - 1).
 
-The source prints (k R / 2) sinh(sqrt(2) omega_s t), which does not vanish at
-t = 0 (its own initial condition); the two agree only for large t.
+The source prints (k R / 2) sinh(sqrt(2) omega_s t). It is zero at t = 0, but
+its initial rate is k R omega_s / sqrt(2) instead of 0 (it solves the unforced
+equation from that rate), so it breaks the condition delta_h'(0) = 0; with
+b = -k g0 the two agree only for large t.
 
 Frame and signs: delta_h is the indicated minus the true altitude, m, positive
 up. The baro-aided loop (beyond the source; the standard second- and
@@ -88,8 +90,10 @@ def hover_altitude_error(time, accelerometer_error, radius, gravity):
 def printed_hover_expression(time, k, radius, gravity):
     """The source's printed hover solution (k R / 2) sinh(sqrt(2) omega_s t), m.
 
-    Kept to show the erratum: it is not zero at t = 0 although the hovering
-    vehicle starts on the right height. ``k`` is the accelerometer error in
+    Kept to show the erratum: it is zero at t = 0, but its initial rate is
+    k R omega_s / sqrt(2) instead of 0 although the hovering vehicle starts at
+    rest on the right height (the correct solution is
+    (k R / 2)(cosh(sqrt(2) omega_s t) - 1)). ``k`` is the accelerometer error in
     units of g0 (dimensionless); other parameters as in :func:`hover_altitude_error`.
 
     Parameters

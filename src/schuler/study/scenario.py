@@ -151,8 +151,9 @@ class Distribution:
         ----------
         spec : Parameter
             The random parameter (its kind, range and display unit; an integer's draws are rounded).
-        base : float
-            The scenario's value of the parameter, SI: the mean of a ``normal`` draw (unused by ``uniform``).
+        base : float or None
+            The scenario's value of the parameter, SI: the mean of a ``normal`` draw (unused by ``uniform``);
+            None when neither the scenario nor the system's default sets it.
         seed : int
             The Monte Carlo's seed (plain number, 0 or more).
         cases : numpy.ndarray of int
@@ -166,8 +167,11 @@ class Distribution:
         Raises
         ------
         ScenarioError
-            A draw outside the parameter's range.
+            A draw outside the parameter's range, or a ``normal`` spread on a parameter without a value.
         """
+        if self.kind == "normal" and base is None:
+            raise ScenarioError(f"[monte_carlo.normal] {spec.name}: has no value to spread around; "
+                                f"set {spec.name} in the scenario's [parameters] (or use [monte_carlo.uniform])")
         # parameter draws have stream names of their own, apart from the system's random terms
         u = RandomStreams(seed).uniform(f"parameter/{spec.name}", cases)
         if self.kind == "normal":
@@ -193,7 +197,6 @@ def _check_draws(spec: Parameter, drawn: np.ndarray, kind: str) -> None:
             f"[monte_carlo.{kind}] {spec.name}: a draw of {bad:g}{unit} is outside {spec.range_text()}; "
             "narrow the distribution"
         )
-
 
 
 
@@ -265,14 +268,17 @@ class Scenario:
         Raises
         ------
         ScenarioError
-            A draw outside its parameter's range.
+            A draw outside its parameter's range, or a ``normal`` spread on a parameter without a value.
         """
         table = self.monte_carlo
         if table is None:
             return {}
         specs = {p.name: p for p in self.definition().parameters}
-        return {name: d.draw(specs[name], self.values[name], table.seed, cases)
-                for name, d in table.distributions.items()}
+        try:
+            return {name: d.draw(specs[name], self.values[name], table.seed, cases)
+                    for name, d in table.distributions.items()}
+        except ScenarioError as error:
+            raise ScenarioError(f"{self.source}: {error}") from None
 
     def given(self) -> dict[str, Any]:
         """The SI values the file sets (what ``System.run`` takes; the rest are defaults)."""

@@ -25,6 +25,8 @@ def load_system(name: str) -> System | None:
 
     Raises
     ------
+    InvalidParameter
+        ``name`` is not registered (the message lists the registered names and suggests a close one).
     ModuleNotFoundError
         A module the system needs (other than its own) is missing.
 
@@ -33,11 +35,10 @@ def load_system(name: str) -> System | None:
     >>> load_system("errors") is None or load_system("errors").name == "errors"
     True
     """
-    module = SYSTEM_MODULES[name]
     try:
-        return get_system(name)
+        return get_system(name)  # refuses an unregistered name before importing anything
     except ModuleNotFoundError as error:
-        if error.name in _module_and_parents(module):
+        if error.name in _module_and_parents(SYSTEM_MODULES[name]):
             return None
         raise
 
