@@ -40,7 +40,8 @@ known; gravity's magnitude and the rotations the gyros measure are enough:
 **Uncertainties** by noise propagation through the Gauss-Newton solution (a
 sandwich whose middle is the measured noise, not the residual variance):
 cov(p) = H cov(r) H^T, H = (J^T J)^-1 J^T. Accelerometers: dr_j/dm_j =
--2 v_j^T T K, cov(m_j) from the scatter within interval j over its length.
+-2 v_j^T T K (v_j = T K (m_j - b), m_j the static means), cov(m_j) from the
+scatter within interval j over its length.
 Gyros: cov(r) gathers (a) the gyro white noise over each motion, rotation
 error of covariance Q_j = sum_k R_j(t_k) G Sigma G^T R_j(t_k)^T dt^2 (Sigma the
 per-sample variance pooled over the static intervals), moving r_j by
@@ -64,6 +65,12 @@ what the scatter within an interval shows, and are not in the 1-sigma
 (:func:`~schuler.alignment.calibration_comparison.calibration_model` leaves them
 out of the simulated records for that reason). The Earth rate's correction is
 first order over each motion: a noise-free record returns G to 5e-9.
+
+References
+----------
+D. Tedaldi, A. Pretto, E. Menegatti, "A robust and easy to implement method for
+IMU calibration without external equipments", IEEE International Conference on
+Robotics and Automation (ICRA), 2014.
 
 Examples
 --------
