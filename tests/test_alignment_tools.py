@@ -162,10 +162,9 @@ def test_multi_static_monte_carlo_of_200_records(two_hundred_calibrations):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="six positions state 12-14 % less than they make for the gyro scale factors "
-                   "(rms z 1.14 over 200 IMUs) and misalignments (1.12); the other four groups are within the band")
 def test_six_position_monte_carlo_of_200_records(two_hundred_calibrations):
-    """The same check of the six-position calibration, on the same 200 IMUs."""
+    """The same check of the six-position calibration on the same 200 IMUs (before each dwell and turn mean had
+    its own variance in the fit's 1-sigma: rms z 1.14 for the gyro scale factors, 1.12 the misalignments)."""
     _check_normalised_errors(_normalised_errors(two_hundred_calibrations, "six_position"))
 
 
