@@ -16,6 +16,39 @@ from scipy.optimize import least_squares
 
 from schuler.alignment.attitude import rotation_matrix, skew_batch
 from schuler.exceptions import IdentificationError
+from schuler.imu.error_model import flicker_terms
+
+
+def slow_terms(errors) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per axis, the Gauss-Markov terms (sigmas, correlation times) of a triad's slow bias errors: its
+    Gauss-Markov bias and its bias instability as the simulator's sum of terms (:func:`flicker_terms`)."""
+    out = []
+    for axis in range(3):
+        sigmas, times = [errors.gm_sigma[axis]], [errors.gm_correlation_time_s[axis]]
+        if errors.bias_instability[axis] > 0:
+            flicker = flicker_terms(errors.bias_instability[axis], errors.flicker_tau_range_s)
+            sigmas, times = sigmas + list(flicker[0]), times + list(flicker[1])
+        keep = np.asarray(sigmas) > 0
+        out.append((np.asarray(sigmas, dtype=float)[keep], np.asarray(times, dtype=float)[keep]))
+    return out
+
+
+def mean_covariance(first: np.ndarray, second: np.ndarray, terms) -> np.ndarray:
+    """Covariance (n, m) of a slow process's means over spans ``first`` (n, 2) and ``second`` (m, 2), s.
+
+    For a term sigma^2 exp(-|tau| / T): the double integral over [a, b) x [c, d) is
+    K(b - c) - K(a - c) - K(b - d) + K(a - d), K(x) = T^2 (exp(-|x|/T) - 1 + |x|/T) (K'' the kernel),
+    divided by the two lengths.
+    """
+    sigmas, times = terms
+    (a, b), (c, d) = (first[:, 0, None], first[:, 1, None]), (second[None, :, 0], second[None, :, 1])
+    total = np.zeros((len(first), len(second)))
+    for sigma, T in zip(sigmas, times):
+        def K(x, T=T):
+            return T**2 * (np.expm1(-np.abs(x) / T) + np.abs(x) / T)
+
+        total += sigma**2 * (K(b - c) - K(a - c) - K(b - d) + K(a - d))
+    return total / ((b - a) * (d - c))
 
 
 def least_squares_fit(residuals, start: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray, float]:
@@ -143,10 +176,13 @@ class GyroProblem:
         Rc = self.rotations(p)[0]
         return (self.d[1:] - np.einsum("jki,jk->ji", Rc, self.d[:-1])).ravel()
 
-    def covariance(self, p, jacobian, rate_noise, bias_covariance, direction_gain, mean_variances):
-        """cov(p) from the gyro noise in the motions (per-sample covariance ``rate_noise`` (3, 3), raw
-        axes), the initial mean's noise (``bias_covariance``, common to every motion) and the static means'
-        noise (``mean_variances`` (j, 3)) through the directions: dd_j/dm = ``blocks`` (j, 3, 3) for its own
+    def covariance(self, p, jacobian, noise: dict, direction_gain) -> np.ndarray:
+        """cov(p) from the noise of the data (``noise``):
+
+        ``rate`` (3, 3) the gyros' per-sample white-noise covariance, raw axes; ``bias`` (3, 3) the white part of
+        the initial mean's error (common to every motion); ``gap_bias`` (3, gaps, gaps) per raw axis, the slow
+        bias's change from the initial mean, averaged over each motion; ``means`` (3, j, j) per axis, the
+        covariance of the static means, taken through the directions: dd_j/dm = ``blocks`` (j, 3, 3) for its own
         mean plus ``via_params`` (j, 3, 9) times ``gain`` (9, j, 3) through the accelerometer parameters
         (``direction_gain``, :func:`direction_gain`).
 
@@ -154,18 +190,20 @@ class GyroProblem:
         error dtheta (start frame); the gyro noise gives dtheta cov Q_j, a bias error db gives -S_j G db.
         """
         G = p[:9].reshape(3, 3)
-        Rc, S, Q = self.rotations(p, G @ rate_noise @ G.T)
+        Rc, S, Q = self.rotations(p, G @ noise["rate"] @ G.T)
         H = sensitivity(jacobian).reshape(p.size, -1, 3)
         cross = -skew_batch(np.einsum("jki,jk->ji", Rc, self.d[:-1]))
         Y = np.einsum("pja,jab,jcb->pjc", H, cross, Rc)                # dp per rotation error, start frame
         covariance = np.einsum("pja,jab,qjb->pq", Y, Q, Y)
-        bias = -np.einsum("pja,jab,bc->pc", Y, S, G)
-        covariance += bias @ bias_covariance @ bias.T
+        per_bias = -np.einsum("pja,jab,bc->pjc", Y, S, G)               # dp per bias error in motion j
+        bias = per_bias.sum(axis=1)
+        covariance += bias @ noise["bias"] @ bias.T
+        covariance += np.einsum("pja,ajk,qka->pq", per_bias, noise["gap_bias"], per_bias)
         # residual j holds +d_{j+1} and -Rc_j^T d_j
         per_direction = np.zeros((p.size, len(self.d), 3))
         per_direction[:, 1:] += H
         per_direction[:, :-1] -= np.einsum("pjk,jik->pji", H, Rc)
         blocks, via_params, gain = direction_gain
         per_mean = (np.einsum("pja,jab->pjb", per_direction, blocks)
-                    + np.einsum("pja,jaq,qkb->pkb", per_direction, via_params, gain)).reshape(p.size, -1)
-        return covariance + (per_mean * mean_variances.ravel()) @ per_mean.T
+                    + np.einsum("pja,jaq,qkb->pkb", per_direction, via_params, gain))
+        return covariance + np.einsum("pja,ajk,qka->pq", per_mean, noise["means"], per_mean)

@@ -97,6 +97,7 @@ from schuler.alignment.attitude import earth_rate_ned, rotation_matrix
 from schuler.core.earth import EARTH_RATE, normal_gravity
 from schuler.core.random import RandomStreams
 from schuler.exceptions import IdentificationError, InvalidParameter
+from schuler.imu.error_model import ErrorModel
 
 THRESHOLD_FACTORS = (2.0, 4.0, 8.0, 16.0, 32.0)
 """Static-detector thresholds tried, as multiples of the initial period's variance statistic."""
@@ -311,15 +312,36 @@ def _interval_statistics(samples: np.ndarray, intervals) -> tuple[np.ndarray, np
     return means, variances
 
 
-def _pooled_variance(samples: np.ndarray, intervals) -> np.ndarray:
-    """Per-sample variance (3,) pooled over the static intervals (each about its own mean)."""
-    squares = sum(((samples[a:b] - samples[a:b].mean(axis=0)) ** 2).sum(axis=0) for a, b in intervals)
-    return squares / sum(b - a - 1 for a, b in intervals)
+def _noise(gyro: np.ndarray, intervals, gaps, mean_variances: np.ndarray, dt: float, error_model) -> dict:
+    """The data's noise for :meth:`~schuler.alignment._multi_static_fits.GyroProblem.covariance` (module notes).
+
+    White: the gyros' per-sample variance pooled over the static intervals (each about its own mean), the
+    static means' from the scatter within each. Slow (``error_model`` given): its Gauss-Markov and flicker terms
+    between the static means (accelerometers) and between the motions and the initial period (gyros).
+    """
+    squares = sum(((gyro[a:b] - gyro[a:b].mean(axis=0)) ** 2).sum(axis=0) for a, b in intervals)
+    rate = np.diag(squares / sum(b - a - 1 for a, b in intervals))
+    first, stop = intervals[0]
+    means = np.stack([np.diag(mean_variances[:, axis]) for axis in range(3)])
+    gap_bias = np.zeros((3, len(gaps), len(gaps)))
+    bias_slow = np.zeros(3)
+    if error_model is not None:
+        spans, motions = np.asarray(intervals, dtype=float) * dt, np.asarray(gaps, dtype=float) * dt
+        for axis, terms in enumerate(fits.slow_terms(error_model.accel)):
+            means[axis] += fits.mean_covariance(spans, spans, terms)
+        for axis, terms in enumerate(fits.slow_terms(error_model.gyro)):
+            with_initial = fits.mean_covariance(motions, spans[:1], terms)
+            bias_slow[axis] = fits.mean_covariance(spans[:1], spans[:1], terms)[0, 0]
+            gap_bias[axis] = (fits.mean_covariance(motions, motions, terms) - with_initial - with_initial.T
+                              + bias_slow[axis])
+    return {"rate": rate, "bias": rate / (stop - first), "bias_slow": bias_slow, "means": means,
+            "gap_bias": gap_bias}
 
 
 def calibrate_multi_static(gyro, accel, sample_interval_s: float, *, initial_s: float,
                            gravity_m_s2: float | None = None, latitude_rad: float = math.radians(45.0),
-                           window_s: float = 1.0, min_static_s: float = 1.0) -> MultiStaticCalibration:
+                           window_s: float = 1.0, min_static_s: float = 1.0,
+                           error_model: ErrorModel | None = None) -> MultiStaticCalibration:
     """Calibrate both triads from a hand-held multi-static record (module notes).
 
     Parameters
@@ -336,6 +358,10 @@ def calibrate_multi_static(gyro, accel, sample_interval_s: float, *, initial_s: 
         Site latitude L, rad: the default g and the Earth rate's vertical part, Omega sin L (module notes, step 3).
     window_s, min_static_s : float
         Static detector settings, s.
+    error_model : ErrorModel, optional
+        The IMU's error model: its slow bias terms (Gauss-Markov bias, bias instability as the simulator's sum of
+        Gauss-Markov terms; rate random walk is not modelled) enter the 1-sigma (module notes). None: white
+        noise only.
 
     Raises
     ------
@@ -362,14 +388,13 @@ def calibrate_multi_static(gyro, accel, sample_interval_s: float, *, initial_s: 
                                   "sensor still longer or more often")
     factor, intervals, accel_params, accel_jacobian, accel_rms = best
     means, mean_variances = _interval_statistics(accel, intervals)
-    accel_gain = fits.accel_gain(accel_params, accel_jacobian, means).reshape(9, -1)
-    accel_covariance = (accel_gain * mean_variances.ravel()) @ accel_gain.T
-
     first, stop = intervals[0]
-    gyro_bias = gyro[first:stop].mean(axis=0)
-    rate_noise = np.diag(_pooled_variance(gyro, intervals))
-    bias_covariance = rate_noise / (stop - first)
     gaps = [(a_stop, b_first) for (_, a_stop), (b_first, _) in zip(intervals[:-1], intervals[1:])]
+    noise = _noise(gyro, intervals, gaps, mean_variances, dt, error_model)
+    accel_gain = fits.accel_gain(accel_params, accel_jacobian, means)
+    accel_covariance = np.einsum("pja,ajk,qka->pq", accel_gain, noise["means"], accel_gain)
+
+    gyro_bias = gyro[first:stop].mean(axis=0)
     lengths = np.array([b - a for a, b in gaps])
     motion = np.zeros((len(gaps), lengths.max(), 3))
     for j, (a, b) in enumerate(gaps):
@@ -378,15 +403,16 @@ def calibrate_multi_static(gyro, accel, sample_interval_s: float, *, initial_s: 
                                EARTH_RATE * math.sin(latitude_rad))
     gyro_params, gyro_jacobian, gyro_rms = fits.least_squares_fit(problem.residuals, np.r_[np.eye(3).ravel(), 0, 0],
                                                                   "gyro fit")
-    gyro_covariance = problem.covariance(gyro_params, gyro_jacobian, rate_noise, bias_covariance,
-                                         fits.direction_gain(accel_params, accel_jacobian, means), mean_variances)
+    gyro_covariance = problem.covariance(gyro_params, gyro_jacobian, noise,
+                                         fits.direction_gain(accel_params, accel_jacobian, means))
     accel_sigma, gyro_sigma = (np.sqrt(np.diag(c)) for c in (accel_covariance, gyro_covariance))
     return MultiStaticCalibration(
         accel_non_orthogonality=accel_params[0:3], accel_scale=accel_params[3:6], accel_bias=accel_params[6:9],
         accel_matrix=fits.accel_matrix(accel_params), gyro_matrix=gyro_params[:9].reshape(3, 3), gyro_bias=gyro_bias,
         accel_non_orthogonality_sigma=accel_sigma[0:3], accel_scale_sigma=accel_sigma[3:6],
         accel_bias_sigma=accel_sigma[6:9], gyro_matrix_sigma=gyro_sigma[:9].reshape(3, 3),
-        gyro_bias_sigma=np.sqrt(np.diag(bias_covariance)), static_intervals=len(intervals), threshold_factor=factor,
+        gyro_bias_sigma=np.sqrt(np.diag(noise["bias"]) + noise["bias_slow"]), static_intervals=len(intervals),
+        threshold_factor=factor,
         accel_residual_rms=accel_rms, gyro_residual_rms=gyro_rms)
 
 
