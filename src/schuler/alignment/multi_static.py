@@ -75,8 +75,8 @@ Limitations: rate random walk (not stationary) is not modelled; the slow gyro
 bias is taken at its mean over each motion (the turn within one motion left
 out of its weight); the fastest flicker terms are also in the scatter within the
 intervals, so counted twice (the variance they add there is below 0.1 % of the
-white noise's at the industrial grade). The Earth rate's correction is first order over each motion: a
-noise-free record returns G to 5e-9.
+white noise's at the industrial grade). The Earth rate's correction is first
+order over each motion: a noise-free record returns G to 5e-9.
 
 References
 ----------
