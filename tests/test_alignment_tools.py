@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from schuler.alignment.attitude import wrap_angle
-from schuler.alignment.calibration_comparison import compare_calibration
+from schuler.alignment._multi_static_fits import mean_covariance
+from schuler.alignment.attitude import earth_rate_ned, wrap_angle
+from schuler.alignment.calibration_comparison import calibration_model, compare_calibration
 from schuler.alignment.commands import align_compare
 from schuler.alignment.multi_static import MultiStaticPlan, calibrate_multi_static, identifiable_truth
 from schuler.alignment.north import AXES, NORTH_METHODS, find_north, north_sigma, schedule, turntable_rates
@@ -109,30 +111,118 @@ def test_multi_static_calibration_is_exact_without_noise():
     assert fit.accel_bias == pytest.approx(truth["accel_bias"], abs=1e-6)
     assert fit.accel_scale == pytest.approx(truth["accel_scale"], abs=1e-6)
     assert fit.accel_non_orthogonality == pytest.approx(truth["accel_non_orthogonality"], abs=1e-6)
-    # the gyro fit leaves out the Earth rate during the turns (module notes): 1e-4 of the matrix
-    assert fit.gyro_matrix == pytest.approx(truth["gyro_matrix"], abs=1e-4)
+    # the Earth rate followed through the turns (module notes): the gyro matrix to 1e-7 (5e-9 found)
+    assert fit.gyro_matrix == pytest.approx(truth["gyro_matrix"], abs=1e-7)
 
 
-def _z(entries: dict) -> np.ndarray:
-    return np.concatenate([np.asarray(v["z"]) for v in entries.values() if isinstance(v, dict)])
+def _normalised_errors(records, procedure: str) -> dict[str, np.ndarray]:
+    """z = (estimate - true) / predicted 1-sigma per parameter group of ``procedure``, over every record."""
+    groups: dict[str, list[float]] = {}
+    for result in records:
+        for name, entry in getattr(result, procedure).items():
+            if isinstance(entry, dict):
+                groups.setdefault(name, []).extend(entry["z"])
+    return {name: np.asarray(values) for name, values in groups.items()}
 
 
-@pytest.mark.parametrize("seed", [0, 1])
-def test_calibration_round_trip_within_the_predicted_accuracy(seed):
-    """Known errors of one industrial IMU in, estimates out: z = (estimate - true) / predicted 1-sigma.
+def _check_normalised_errors(groups: dict[str, np.ndarray]) -> None:
+    """Per group: the rms of its k z within the central 99.9 % of sqrt(chi^2_k / k) (k standard normal z if the
+    stated 1-sigma is right), and no |z| beyond the level k normal draws pass with 99.9 %."""
+    from scipy.stats import chi2, norm
 
-    Six positions: the rms of its 24 z is 1 within the spread of a chi distribution of 24 degrees of freedom
-    (0.6-1.4 is beyond 2.5 standard deviations); no |z| above 4.5. Multi-static: it states less than it makes
-    (rms z 1.0-1.6 over seeds 0-2 and two grades; accelerometer biases 1.5-1.9, see multi_static's notes):
-    no |z| above 5 and rms z below 2.
+    for name, z in groups.items():
+        low, high = np.sqrt(chi2.ppf([0.0005, 0.9995], z.size) / z.size)
+        assert low < np.sqrt(np.mean(z**2)) < high, (name, np.sqrt(np.mean(z**2)), low, high)
+        assert np.abs(z).max() < norm.isf(0.0005 / z.size), (name, np.abs(z).max())
+
+
+def test_calibration_round_trip_within_the_predicted_accuracy():
+    """Known errors of 12 industrial IMUs in, estimates out: the stated 1-sigma is what the errors are.
+
+    (12 records: the rms of 36 z per 3-vector group within 0.63-1.40, of 72 within 0.74-1.28, of the gyro
+    matrix's 108 within 0.78-1.23; the multi-static accelerometer biases come out at 1.35 here, 1.02 over the
+    200 records of the slow test.)
     """
-    result = compare_calibration("industrial", latitude_rad=LATITUDE, seed=seed)
-    six, multi = _z(result.six_position), _z(result.multi_static)
-    assert 0.6 < np.sqrt(np.mean(six**2)) < 1.4
-    assert np.abs(six).max() < 4.5
-    assert np.sqrt(np.mean(multi**2)) < 2.0
-    assert np.abs(multi).max() < 5.0
-    assert result.multi_static["static_intervals"] >= 37   # every orientation and the initial period found
+    records = [compare_calibration("industrial", latitude_rad=LATITUDE, seed=seed) for seed in range(12)]
+    _check_normalised_errors(_normalised_errors(records, "multi_static"))
+    _check_normalised_errors(_normalised_errors(records, "six_position"))
+    assert min(r.multi_static["static_intervals"] for r in records) >= 37   # every orientation and the initial one
+
+
+@pytest.fixture(scope="module")
+def two_hundred_calibrations():
+    return [compare_calibration("industrial", latitude_rad=LATITUDE, seed=seed) for seed in range(200)]
+
+
+@pytest.mark.slow
+def test_multi_static_monte_carlo_of_200_records(two_hundred_calibrations):
+    """As above over 200 industrial IMUs: rms z per 3-vector group within 0.91-1.10 (600 z), the gyro matrix's
+    within 0.95-1.06 (1,800 z). Found: accelerometer bias 1.02, scale 0.97, non-orthogonality 1.00, gyro bias
+    0.99, gyro matrix 0.99 (before the Earth rate and the noise propagation: gyro matrix 1.46).
+    """
+    _check_normalised_errors(_normalised_errors(two_hundred_calibrations, "multi_static"))
+
+
+@pytest.mark.slow
+def test_six_position_monte_carlo_of_200_records(two_hundred_calibrations):
+    """The same check of the six-position calibration on the same 200 IMUs (before each dwell and turn mean had
+    its own variance in the fit's 1-sigma: rms z 1.14 for the gyro scale factors, 1.12 the misalignments)."""
+    _check_normalised_errors(_normalised_errors(two_hundred_calibrations, "six_position"))
+
+
+def test_slow_bias_covariance_of_interval_means_closed_form():
+    """The closed form of the covariance of two interval means of sigma^2 exp(-|tau|/T) against a midpoint sum
+    on a 1 ms grid (1.2e-6 relative found); overlapping, disjoint and equal spans."""
+    spans = np.array([[0.0, 3.0], [3.5, 5.0], [2.0, 4.0]])
+    terms = (np.array([2.0, 0.5]), np.array([0.3, 40.0]))
+    step = 1e-3
+    grids = [np.arange(a + step / 2, b, step) for a, b in spans]
+    numeric = np.array([[sum(sigma**2 * np.exp(-np.abs(u[:, None] - v[None, :]) / T).mean()
+                             for sigma, T in zip(*terms)) for v in grids] for u in grids])
+    assert mean_covariance(spans, spans, terms) == pytest.approx(numeric, rel=1e-5)
+
+
+def test_multi_static_slow_terms_widen_the_1_sigma():
+    """An error model without slow terms changes nothing; with the grade's bias instability the 1-sigma grows."""
+    plan = MultiStaticPlan(positions=12, sample_interval_s=0.02, latitude_rad=LATITUDE)
+    gyro_true, accel_true = plan.truth(seed=2)
+    white, full = calibration_model("industrial"), preset("industrial")
+    gyro, accel = ImuSimulator(white, plan.sample_interval_s, true_gyro_rad_s=gyro_true, true_accel_m_s2=accel_true,
+                               seed=2).window([0], 0, gyro_true.shape[0])
+    fits = [calibrate_multi_static(gyro[0], accel[0], plan.sample_interval_s, initial_s=plan.initial_s,
+                                   gravity_m_s2=plan.gravity, latitude_rad=LATITUDE, error_model=model)
+            for model in (None, white, full)]
+    for name in ("accel_bias_sigma", "gyro_matrix_sigma", "gyro_bias_sigma"):
+        assert getattr(fits[1], name) == pytest.approx(getattr(fits[0], name), rel=1e-12)
+        assert np.all(getattr(fits[2], name) > getattr(fits[0], name))
+
+
+@pytest.mark.slow
+def test_multi_static_monte_carlo_with_slow_terms():
+    """200 industrial IMUs with the preset's bias instability (10 deg/h, 0.03 mg) left in and the error model given
+    to the fit: the same bands against the turn-on errors. Found: 0.99-1.03 per group (without the model:
+    accelerometer biases 1.46, gyro bias 3.0 over 40 IMUs)."""
+    model = preset("industrial")
+    model = replace(model, gyro=replace(model.gyro, g_sensitivity=np.zeros((3, 3))))   # what no calibration removes
+    records = []
+    for seed in range(200):
+        plan = MultiStaticPlan(positions=36, sample_interval_s=0.01, latitude_rad=LATITUDE)
+        gyro_true, accel_true = plan.truth(seed)
+        simulator = ImuSimulator(model, plan.sample_interval_s, true_gyro_rad_s=gyro_true,
+                                 true_accel_m_s2=accel_true, seed=seed)
+        gyro, accel = simulator.window([0], 0, gyro_true.shape[0])
+        constants = simulator.constants([0])
+        fit = calibrate_multi_static(gyro[0], accel[0], plan.sample_interval_s, initial_s=plan.initial_s,
+                                     gravity_m_s2=plan.gravity, latitude_rad=LATITUDE, error_model=model)
+        truth = identifiable_truth(constants["accel_matrix"][0], constants["accel_bias"][0],
+                                   constants["gyro_matrix"][0])
+        start = plan.attitudes(seed)[0]
+        truth["gyro_bias"] = constants["gyro_bias"][0] + constants["gyro_matrix"][0] @ (start.T @ earth_rate_ned(
+            LATITUDE))
+        records.append({name: (getattr(fit, name) - truth[name]).ravel() / getattr(fit, f"{name}_sigma").ravel()
+                        for name in ("accel_bias", "accel_scale", "accel_non_orthogonality", "gyro_bias",
+                                     "gyro_matrix")})
+    _check_normalised_errors({name: np.concatenate([r[name] for r in records]) for name in records[0]})
 
 
 def test_imu_simulator_and_six_position_agree_on_the_truth():

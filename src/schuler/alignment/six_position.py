@@ -195,9 +195,11 @@ def fit_triad(inputs: np.ndarray, outputs: np.ndarray, noise: np.ndarray | None 
     if noise is None:
         dof = max(1, design.shape[0] - 4)
         variance = ((outputs - design @ solution) ** 2).sum(axis=0) / dof
+        sigma = np.sqrt(np.outer(np.diag(covariance), variance))   # (4, 3): row j of [K b]^T, column axis
     else:
-        variance = (noise**2).mean(axis=0)
-    sigma = np.sqrt(np.outer(np.diag(covariance), variance))   # (4, 3): row j of [K b]^T, column axis
+        # each mean its own variance (dwells and turns differ in length): (X^T X)^-1 X^T diag(s^2) X (X^T X)^-1
+        gain = covariance @ design.T
+        sigma = np.sqrt(np.einsum("ji,ia->ja", gain**2, noise**2))
     return solution[:3].T, solution[3], sigma[:3].T, sigma[3]
 
 
