@@ -79,10 +79,6 @@ def unit_problems(function) -> list[str]:
 
 
 FUNCTIONS = list(schuler_api.public_functions())
-BACKLOG_FILE = Path(__file__).with_name("docstring_backlog.txt")
-BACKLOG = {line.strip() for line in BACKLOG_FILE.read_text(encoding="utf-8").splitlines()
-           if line.strip() and not line.startswith("#")}
-"""Functions documented before the check existed whose Parameters still lack units: only ever shrinks."""
 MODULES = sorted({name.rsplit(".", 2)[0] if name.split(".")[-2][0].isupper() else name.rsplit(".", 1)[0]
                   for name, _ in FUNCTIONS})
 
@@ -92,78 +88,14 @@ def test_public_functions_document_parameters_with_units(module):
     problems = {}
     for name, function in FUNCTIONS:
         owner = name.rsplit(".", 2)[0] if name.split(".")[-2][0].isupper() else name.rsplit(".", 1)[0]
-        if owner == module and name not in BACKLOG and (found := unit_problems(function)):
+        if owner == module and (found := unit_problems(function)):
             problems[name] = found
     assert not problems, "\n".join(f"{name}: {'; '.join(found)}" for name, found in problems.items())
-
-
-def _imports(module: str) -> bool:
-    try:
-        importlib.import_module(module)
-    except ImportError:
-        return False
-    return True
-
-
-def _bar_docstrings():
-    """(dotted name, docstring) of every documented module, class and function whose docstring has a bar."""
-    for name in schuler_api.public_modules():
-        module = importlib.import_module(name)
-        members = [(name, module), *((f"{name}.{k}", v) for k, v in schuler_api.public_members(module).items())]
-        members += [(name, function) for name, function in FUNCTIONS if name.startswith(f"{module.__name__}.")]
-        for dotted, member in members:
-            if "|" in (inspect.getdoc(member) or ""):
-                yield dotted, inspect.getdoc(member)
-
-
-def test_absolute_value_bars_in_docstrings_never_reach_the_build_as_substitutions():
-    # docstrings write |x| as plain text (read in terminals too); the build's escape_bars escapes it, so an
-    # escape written in the source (\|x\|) would show its backslashes: check what the build parses
-    import docutils.core
-    import docutils.nodes
-    from schuler_docs import escape_bars
-
-    problems, checked = [], set()
-    for dotted, text in _bar_docstrings():
-        lines = text.splitlines()
-        escape_bars(None, "", dotted, None, {}, lines)
-        tree = docutils.core.publish_doctree("\n".join(lines),
-                                             settings_overrides={"report_level": 5, "warning_stream": False})
-        bad = list(tree.findall(docutils.nodes.substitution_reference))
-        bad += [node for node in tree.findall(docutils.nodes.problematic) if "|" in node.astext()]
-        bad += [node for node in tree.findall(docutils.nodes.Text) if "\\|" in node.astext()]
-        problems += [f"{dotted}: {node.astext()!r}" for node in bad]
-        checked.add(dotted)
-    # the two the reviewers named are among those checked
-    assert {"schuler.imu.error_model.gauss_markov_allan_variance",
-            "schuler.navigate.alignment.GyrocompassingComparison"} <= checked
-    assert not problems, "\n".join(problems)
-    # without the escaping, docutils reads the same text as substitutions (the check can fail)
-    raw = docutils.core.publish_doctree("sigma^2 e^{-|t|/T} and (a - b) / |b|;",
-                                        settings_overrides={"report_level": 5, "warning_stream": False})
-    assert [node.astext() for node in raw.findall(docutils.nodes.problematic)] == ["|t|", "|b|"]
 
 
 @pytest.mark.parametrize("module", schuler_api.public_modules())
 def test_every_public_module_imports(module):
     importlib.import_module(module)
-
-
-def test_the_backlog_only_shrinks():
-    """A backlog entry that is now documented (or gone) must leave the list.
-
-    An entry of a module that fails to import is neither: that module's own test above fails.
-    """
-    functions = dict(FUNCTIONS)
-    modules = schuler_api.public_modules()
-
-    def is_stale(name):
-        if name in functions:
-            return not unit_problems(functions[name])
-        return _imports(max((m for m in modules if name.startswith(m + ".")), key=len))
-
-    stale = sorted(name for name in BACKLOG if is_stale(name))
-    assert not stale, f"remove from {BACKLOG_FILE.name}: {stale}"
 
 
 def test_the_unit_check_catches_what_it_should():
