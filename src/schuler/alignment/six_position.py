@@ -12,8 +12,10 @@ with u the true input (specific force C^T (0, 0, -g) at rest; angular rate
 C^T omega_ie plus the table rate along the vertical body axis), S the scale
 errors (diagonal), M the misalignments (off-diagonal) and b the bias. Stacking
 the dwell means, Y (3 x p) = [K b] [U; 1] is linear in (K, b): least squares
-gives all twelve numbers per triad, and their covariance follows from the
-residual variance. With the six static means alone this is the classic
+gives all twelve numbers per triad. Their 1-sigma propagates each mean's own
+noise through the least-squares gain (dwell and turn means differ in
+length, so in noise), or, without a noise figure, follows from the residual
+variance. With the six static means alone this is the classic
 
     b = (f_up + f_down) / 2,   scale error = (f_up - f_down) / (2 g) - 1
 
@@ -169,7 +171,7 @@ def fit_triad(inputs: np.ndarray, outputs: np.ndarray, noise: np.ndarray | None 
     outputs : ndarray of shape (p, 3)
         Measured mean Y of each position, in the same unit and axes.
     noise : ndarray of shape (p, 3), optional
-        1-sigma of each measured mean, same unit (its mean square over the positions is used per axis).
+        1-sigma of each measured mean, same unit; each mean's own value is propagated through the gain.
 
     Returns
     -------
