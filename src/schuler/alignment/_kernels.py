@@ -253,3 +253,41 @@ def gyrocompass_loop(gyro: np.ndarray, accel: np.ndarray, dt: float, attitude: n
                 attitude_out[member, out] = C
                 out += 1
         attitude[member] = C
+
+
+@numba.njit(cache=True, nogil=True)
+def partial_rotations(rates: np.ndarray, lengths: np.ndarray, dt: float, noise: np.ndarray, with_noise: bool,
+                      R: np.ndarray, S: np.ndarray, Q: np.ndarray) -> None:
+    """Per motion j: R_j = prod_k exp([w_k dt x]), S_j = integral of R_j(t) dt (trapezoid), Q_j = rotation noise.
+
+    Parameters
+    ----------
+    rates : ndarray, shape (J, L, 3)
+        Calibrated angular rates of each motion, rad/s, sensor axes (samples past ``lengths`` unused).
+    lengths : ndarray of int64, shape (J,)
+        Samples of each motion, number of.
+    dt : float
+        Sample interval, s.
+    noise : ndarray, shape (3, 3)
+        Per-sample covariance of the rates, (rad/s)^2 (read when ``with_noise``).
+    with_noise : bool
+        Whether to accumulate Q_j = sum_k R_j(t_k) noise R_j(t_k)^T dt^2, rad^2.
+    R, S, Q : ndarray, shape (J, 3, 3)
+        Written: the rotations (plain numbers), their time integrals (s) and noise covariances (rad^2).
+    """
+    step = np.empty((3, 3))
+    after = np.empty((3, 3))
+    for j in range(rates.shape[0]):
+        current = np.eye(3)
+        S[j] = 0.0
+        Q[j] = 0.0
+        for k in range(lengths[j]):
+            _rotation(rates[j, k, 0] * dt, rates[j, k, 1] * dt, rates[j, k, 2] * dt, step)
+            for r in range(3):
+                for c in range(3):
+                    after[r, c] = current[r, 0] * step[0, c] + current[r, 1] * step[1, c] + current[r, 2] * step[2, c]
+            S[j] += 0.5 * (current + after) * dt
+            if with_noise:
+                Q[j] += after @ noise @ after.T * (dt * dt)
+            current[:] = after
+        R[j] = current

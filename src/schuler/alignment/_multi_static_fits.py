@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import least_squares
 
+from schuler.alignment import _kernels
 from schuler.alignment.attitude import rotation_matrix, skew_batch
 from schuler.exceptions import IdentificationError
 from schuler.imu.error_model import flicker_terms
@@ -125,18 +126,13 @@ def partial_rotations(rates: np.ndarray, lengths: np.ndarray, dt: float, noise: 
     """Per motion j (rates (j, L, 3) rad/s, zero-padded past ``lengths``): R_j = prod_k exp([w_k dt x]),
     S_j = integral of the partial product R_j(t) dt (trapezoid), and, given the rates' per-sample noise
     covariance ``noise`` (3, 3), Q_j = sum_k R_j(t_k) noise R_j(t_k)^T dt^2 (the rotation's noise, start frame).
+    The time loop is compiled (:func:`~schuler.alignment._kernels.partial_rotations`).
     """
-    gaps, longest = rates.shape[:2]
-    steps = rotation_matrix(rates * dt)
-    live = (np.arange(longest)[None, :] < lengths[:, None])[:, :, None, None] * dt
-    R = np.broadcast_to(np.eye(3), (gaps, 3, 3)).copy()
-    S, Q = np.zeros((gaps, 3, 3)), np.zeros((gaps, 3, 3))
-    for k in range(longest):
-        after = R @ steps[:, k]
-        S += 0.5 * (R + after) * live[:, k]
-        if noise is not None:
-            Q += after @ noise @ np.swapaxes(after, 1, 2) * live[:, k] * dt
-        R = after
+    gaps = rates.shape[0]
+    R, S, Q = (np.empty((gaps, 3, 3)) for _ in range(3))
+    _kernels.partial_rotations(np.ascontiguousarray(rates, dtype=float), np.asarray(lengths, dtype=np.int64),
+                               float(dt), np.zeros((3, 3)) if noise is None else np.ascontiguousarray(noise),
+                               noise is not None, R, S, Q)
     return R, S, Q
 
 
