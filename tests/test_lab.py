@@ -144,6 +144,49 @@ def test_closing_the_lab_removes_its_job_cache():
     assert not bench.cache_dir.exists()
 
 
+FORKED_JOB = """
+import multiprocessing, os, signal, socket, sys, threading, time
+from schuler.lab.server import LabServer, serve_until_signal
+
+sock = socket.socket()
+sock.bind(("127.0.0.1", 0))
+sock.listen()
+server = LabServer(lambda environ, start: [], sock)
+
+def job_gets_sigterm():
+    time.sleep(0.3)
+    job = multiprocessing.get_context("fork").Process(target=time.sleep, args=(60,))  # as Dash starts a job
+    job.start()
+    time.sleep(0.3)
+    os.kill(job.pid, signal.SIGTERM)
+    job.join(10)
+    print("job", "ended" if job.exitcode is not None else "alive", job.exitcode, flush=True)
+    if job.exitcode is None:
+        job.kill()
+    os.kill(os.getpid(), signal.SIGTERM)
+
+threading.Thread(target=job_gets_sigterm).start()
+print("server", serve_until_signal(server), flush=True)
+"""
+
+
+def test_a_job_forked_from_the_server_ends_on_sigterm():
+    # the server's SIGTERM handler is inherited by the jobs it forks: there it must end the job, not the server
+    out = subprocess.run([sys.executable, "-c", FORKED_JOB], capture_output=True, text=True, timeout=60)
+    assert out.stdout.split("\n")[:2] == [f"job ended {-signal.SIGTERM}", "server SIGTERM"], out.stderr
+
+
+def test_closing_the_lab_ends_a_job_that_ignores_sigterm():
+    bench = create_app()
+    stubborn = subprocess.Popen([sys.executable, "-c", "import signal, time; "
+                                 "signal.signal(signal.SIGTERM, signal.SIG_IGN); print(1, flush=True); time.sleep(60)"],
+                                stdout=subprocess.PIPE, text=True)
+    stubborn.stdout.readline()  # its handler is in place
+    bench.close()
+    # gone well before its 60 s (close reaps it, so its exit status is not left for Popen to read)
+    stubborn.wait(timeout=5)
+
+
 # --- requests: size limit, assets, headers ----------------------------------------------------------------------
 
 def test_large_requests_are_refused_before_they_are_read(client):

@@ -96,7 +96,13 @@ class Lab:
                 child.terminate()
             except psutil.NoSuchProcess:
                 pass
-        psutil.wait_procs(psutil.Process().children(recursive=True), timeout=3)
+        _, alive = psutil.wait_procs(psutil.Process().children(recursive=True), timeout=3)
+        for child in alive:  # a job that ignores SIGTERM would keep the server from exiting (its exit joins jobs)
+            try:
+                child.kill()
+            except psutil.NoSuchProcess:
+                pass
+        psutil.wait_procs(alive, timeout=3)
         self._manager.handle.close()
         for _ in range(3):  # a job ending just now may still be closing its files in the folder
             shutil.rmtree(self.cache_dir, ignore_errors=True)

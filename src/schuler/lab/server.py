@@ -12,6 +12,7 @@ the listening socket is closed, running jobs are ended, the job cache is removed
 from __future__ import annotations
 
 import ipaddress
+import os
 import signal
 import socket
 import threading
@@ -252,8 +253,14 @@ def serve_until_signal(server: LabServer) -> str:
         ``"Ctrl-C"`` or ``"SIGTERM"``; ``"shutdown"`` when the server stopped for another reason.
     """
     received: list[str] = []
+    serving_pid = os.getpid()
 
     def stop(signum, frame):
+        if os.getpid() != serving_pid:
+            # a background job forked from the server inherits this handler: there the signal must end the job
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
         received.append("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
         server.stop()
 
