@@ -114,7 +114,11 @@ class Lab:
 def create_app() -> Lab:
     """Build the lab (pages for every registered system, the KPI tasks, limits and headers)."""
     import diskcache
+    from numba.core.registry import cpu_target
 
+    # jobs are forks of this threaded server: numba's lazily imported registries are loaded here, once, so that a
+    # job never imports them itself (a fork can inherit an import lock and wait on it forever)
+    cpu_target.target_context.refresh()
     cache_dir = Path(tempfile.mkdtemp(prefix="schuler-lab-jobs-"))
     manager = DiskcacheManager(diskcache.Cache(str(cache_dir)))
     app = Dash(
