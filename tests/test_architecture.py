@@ -55,3 +55,13 @@ def test_no_module_is_longer_than_600_lines():
     long = {str(p.relative_to(PACKAGE)): n for p in PACKAGE.rglob("*.py")
             if (n := len(p.read_text(encoding="utf-8").splitlines())) > 600}
     assert not long, f"split these along a seam: {long}"
+
+
+def test_ci_runs_every_test():
+    """CI runs the README's test command, then the tests it leaves out (marked slow), then the docs build."""
+    root = Path(__file__).resolve().parents[1]
+    commands = [line.strip() for line in (root / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+                if line.strip().startswith("make ")]
+    assert commands == ["make test", "make test-slow", "make docs"]
+    makefile = (root / "Makefile").read_text(encoding="utf-8")
+    assert '$(PYTEST) -m "not slow"' in makefile and "$(PYTEST) -m slow" in makefile
