@@ -93,6 +93,29 @@ class Result:
             console.print(self.render())
         return capture.get()
 
+    def _repr_html_(self) -> str:
+        """The readable table as HTML, for notebooks (inline styles, no scripts)."""
+        from rich.console import Console
+
+        console = Console(width=110, record=True, file=_Discard())
+        console.print(self.render())
+        return console.export_html(inline_styles=True, code_format="<pre style=\"font-family:monospace\">{code}</pre>")
+
+    def to_dataframe(self):
+        """The result as a pandas DataFrame: here one row of its scalar fields, units in the column names.
+
+        Results with time histories or members override it (histories indexed by time, one row per member).
+        """
+        import pandas as pd
+
+        row = {}
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if f.repr and isinstance(value, (int, float, str, bool, np.floating, np.integer, np.bool_)):
+                unit = self.units.get(f.name, "")
+                row[f"{f.name} [{unit}]" if unit and unit != "1" else f.name] = value
+        return pd.DataFrame([row])
+
 
 class Footnotes:
     """Numbered notes for a table: the table shows ``[n]``, the notes go below it.
@@ -136,22 +159,96 @@ class RunResult(Result):
     monte_carlo: MonteCarloSummary | None = None
 
 
+class _Discard:
+    """A file that drops what is written (the HTML export records, it need not print)."""
+
+    def write(self, text: str) -> int:
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+
+@dataclasses.dataclass
+class OutputStatistics(Result):
+    """Statistics of one output over the members of a Monte Carlo, in the output's SI unit.
+
+    ``count`` is the number of members with a finite value; ``std`` is the sample
+    standard deviation (ddof = 1); ``p05``, ``p50``, ``p95`` are percentiles
+    (exact up to 100,000 members, from a uniform sample beyond). Every other
+    field is None when no member has a finite value.
+    """
+
+    count: int
+    mean: float | None
+    std: float | None
+    min: float | None
+    max: float | None
+    rms: float | None
+    p05: float | None
+    p50: float | None
+    p95: float | None
+
+    def __getitem__(self, key: str) -> float | int | None:
+        """Field by name, as the statistics were read before they were typed (``stats["std"]``)."""
+        if key not in _STATISTIC_FIELDS:
+            raise KeyError(key)
+        return getattr(self, key)
+
+
+_STATISTIC_FIELDS = ("count", "mean", "std", "min", "max", "rms", "p05", "p50", "p95")
+
+
 @dataclasses.dataclass
 class MonteCarloSummary(Result):
     """Statistics of each output over the members of a Monte Carlo (SI, keyed by output name).
 
-    ``statistics[name]`` holds count (finite values), mean, std (sample, ddof = 1),
-    rms, min, max, p05, p50, p95 (percentiles exact up to 100,000 members, from a
-    uniform sample beyond). ``samples`` keeps the first 100,000 members' values.
+    ``summary["azimuth_error_rad"]`` (or ``summary.statistics[name]``) is an
+    :class:`OutputStatistics`: ``.mean``, ``.std``, ``.rms``, ``.p95`` ...
+    ``samples`` keeps the first 100,000 members' values, and
+    :meth:`to_dataframe` gives them as one row per member.
     """
 
     members: int
     seed: int
-    statistics: dict[str, dict[str, float | None]]
+    statistics: dict[str, OutputStatistics]
     display_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
     samples: dict[str, np.ndarray] = dataclasses.field(default_factory=dict, repr=False)
+    si_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
 
     units: ClassVar[dict[str, str]] = {"members": "1", "seed": "1"}
+
+    def __getitem__(self, name: str) -> OutputStatistics:
+        """The statistics of output ``name`` (KeyError naming the outputs there are)."""
+        try:
+            return self.statistics[name]
+        except KeyError:
+            raise KeyError(f"{name!r} is not an output of this Monte Carlo; outputs: {', '.join(self.statistics)}") \
+                from None
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.statistics
+
+    def to_dataframe(self):
+        """The members' outputs, one row per member kept (the first 100,000), SI units in the column names."""
+        import pandas as pd
+
+        columns = {}
+        for name, values in self.samples.items():
+            unit = self.si_units.get(name, "")
+            columns[f"{name} [{unit}]" if unit and unit != "1" and not name.endswith(_suffix_of(unit)) else name] = \
+                np.asarray(values)
+        frame = pd.DataFrame(columns)
+        frame.index.name = "member"
+        frame.attrs["seed"] = self.seed
+        frame.attrs["members"] = self.members
+        return frame
+
+    def statistics_frame(self):
+        """The statistics as a DataFrame: one row per output, one column per statistic (SI)."""
+        import pandas as pd
+
+        return pd.DataFrame({name: dataclasses.asdict(stats) for name, stats in self.statistics.items()}).T
 
     @classmethod
     def from_statistics(cls, members, seed, outputs, statistics, samples) -> MonteCarloSummary:
@@ -174,22 +271,24 @@ class MonteCarloSummary(Result):
         for output in outputs:
             stats = statistics[output.name]
             empty = stats.count == 0
-            entry: dict[str, float | None] = {"count": int(stats.count)}
-            for key, value in (("mean", stats.mean), ("std", stats.std), ("min", stats.min), ("max", stats.max)):
-                entry[key] = None if empty else float(value[0])
-            entry["rms"] = None if empty else float(stats.rms[0])
-            for q in (5, 50, 95):
-                entry[f"p{q:02d}"] = None if empty else float(stats.percentile(q)[0])
-            table[output.name] = entry
+
+            def value(array, empty=empty):
+                return None if empty else float(array[0])
+
+            table[output.name] = OutputStatistics(
+                count=int(stats.count), mean=value(stats.mean), std=value(stats.std), min=value(stats.min),
+                max=value(stats.max), rms=value(stats.rms), p05=None if empty else value(stats.percentile(5)),
+                p50=None if empty else value(stats.percentile(50)), p95=None if empty else value(stats.percentile(95)))
         shown = {o.name: o.display for o in outputs if o.display}
-        return cls(members=int(members), seed=int(seed), statistics=table, display_units=shown, samples=samples)
+        return cls(members=int(members), seed=int(seed), statistics=table, display_units=shown, samples=samples,
+                   si_units={o.name: o.unit for o in outputs})
 
     def render(self):
         from rich.table import Table
 
         from schuler.units import to_unit
 
-        constant = [name for name, stats in self.statistics.items() if stats["min"] == stats["max"]]
+        constant = [name for name, stats in self.statistics.items() if stats.min == stats.max]
         table = Table(title=f"Monte Carlo: {self.members} members (seed {self.seed})",
                       caption=f"the same in every member: {', '.join(constant)}" if constant else None)
         table.add_column("output")
@@ -201,13 +300,18 @@ class MonteCarloSummary(Result):
             unit = self.display_units.get(name, "")
             cells = []
             for key in ("mean", "std", "p05", "p95"):
-                value = stats[key]
+                value = getattr(stats, key)
                 cells.append("-" if value is None else f"{float(to_unit(value, unit)) if unit else value:.4g}")
             table.add_row(display_label(name, unit), *cells)
         return table
 
 
 _SI_SUFFIXES = ("_rad_s2", "_rad_s", "_m_s2", "_m_s", "_rad", "_s", "_m")
+
+
+def _suffix_of(unit: str) -> str:
+    """The key suffix that names an SI unit (``m/s`` -> ``_m_s``), as output keys spell it."""
+    return "_" + unit.replace("/", "_").replace("^", "")
 
 
 def display_label(name: str, unit: str = "") -> str:
