@@ -95,9 +95,11 @@ class Result:
 
     def _repr_html_(self) -> str:
         """The readable table as HTML, for notebooks (inline styles, no scripts)."""
+        import io
+
         from rich.console import Console
 
-        console = Console(width=110, record=True, file=_Discard())
+        console = Console(width=110, record=True, file=io.StringIO())
         console.print(self.render())
         return console.export_html(inline_styles=True, code_format="<pre style=\"font-family:monospace\">{code}</pre>")
 
@@ -157,16 +159,6 @@ class RunResult(Result):
     """
 
     monte_carlo: MonteCarloSummary | None = None
-
-
-class _Discard:
-    """A file that drops what is written (the HTML export records, it need not print)."""
-
-    def write(self, text: str) -> int:
-        return len(text)
-
-    def flush(self) -> None:
-        pass
 
 
 @dataclasses.dataclass
