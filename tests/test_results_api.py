@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from schuler import get_system
-from schuler.results import MonteCarloSummary, OutputStatistics
+from schuler.results import MonteCarloSummary, MonteCarloStatistics
 from test_contract import NAMES, light
 
 
@@ -37,7 +37,7 @@ def test_monte_carlo_statistics_are_typed_and_members_a_dataframe(name):
     assert isinstance(summary, MonteCarloSummary)
     for output in system.outputs:
         stats = summary[output.name]
-        assert isinstance(stats, OutputStatistics)
+        assert isinstance(stats, MonteCarloStatistics)
         values = summary.samples[output.name]
         finite = values[np.isfinite(values)]
         assert stats.count == finite.size

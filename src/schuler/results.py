@@ -162,7 +162,7 @@ class RunResult(Result):
 
 
 @dataclasses.dataclass
-class OutputStatistics(Result):
+class MonteCarloStatistics(Result):
     """Statistics of one output over the members of a Monte Carlo, in the output's SI unit.
 
     ``count`` is the number of members with a finite value; ``std`` is the sample
@@ -196,21 +196,21 @@ class MonteCarloSummary(Result):
     """Statistics of each output over the members of a Monte Carlo (SI, keyed by output name).
 
     ``summary["azimuth_error_rad"]`` (or ``summary.statistics[name]``) is an
-    :class:`OutputStatistics`: ``.mean``, ``.std``, ``.rms``, ``.p95`` ...
+    :class:`MonteCarloStatistics`: ``.mean``, ``.std``, ``.rms``, ``.p95`` ...
     ``samples`` keeps the first 100,000 members' values, and
     :meth:`to_dataframe` gives them as one row per member.
     """
 
     members: int
     seed: int
-    statistics: dict[str, OutputStatistics]
+    statistics: dict[str, MonteCarloStatistics]
     display_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
     samples: dict[str, np.ndarray] = dataclasses.field(default_factory=dict, repr=False)
     si_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
 
     units: ClassVar[dict[str, str]] = {"members": "1", "seed": "1"}
 
-    def __getitem__(self, name: str) -> OutputStatistics:
+    def __getitem__(self, name: str) -> MonteCarloStatistics:
         """The statistics of output ``name`` (KeyError naming the outputs there are)."""
         try:
             return self.statistics[name]
@@ -267,7 +267,7 @@ class MonteCarloSummary(Result):
             def value(array, empty=empty):
                 return None if empty else float(array[0])
 
-            table[output.name] = OutputStatistics(
+            table[output.name] = MonteCarloStatistics(
                 count=int(stats.count), mean=value(stats.mean), std=value(stats.std), min=value(stats.min),
                 max=value(stats.max), rms=value(stats.rms), p05=None if empty else value(stats.percentile(5)),
                 p50=None if empty else value(stats.percentile(50)), p95=None if empty else value(stats.percentile(95)))
