@@ -108,6 +108,50 @@ def zoh_discretize(A: np.ndarray, B: np.ndarray, dt) -> tuple[np.ndarray, np.nda
     return phi[..., :n, :n], phi[..., :n, n:]
 
 
+def discretise_noise(F: np.ndarray, noise_input: np.ndarray, dt) -> tuple[np.ndarray, np.ndarray]:
+    """Exact transition matrix and process noise of x' = F x + w over dt (Van Loan's block exponential).
+
+    Parameters
+    ----------
+    F : ndarray, shape ([k,] n, n)
+        System matrix held over the step, 1/s (each state's rate per unit of each state).
+    noise_input : ndarray, shape ([k,] n, n)
+        G Q_c G^T: the white input's power spectral density mapped onto the state
+        derivatives, (state unit)^2 / s.
+    dt : float
+        Step length, s (> 0).
+
+    Returns
+    -------
+    Phi : ndarray, shape ([k,] n, n)
+        expm(F dt).
+    Q : ndarray, shape ([k,] n, n)
+        integral_0^dt expm(F s) G Q_c G^T expm(F^T s) ds, (state unit)^2, symmetrised.
+
+    Notes
+    -----
+    M = expm([[-F, G Q_c G^T], [0, F^T]] dt) = [[M11, M12], [0, M22]] gives Phi = M22^T
+    and Q = Phi M12 (Van Loan 1978, Sec. 4).
+
+    Examples
+    --------
+    >>> Phi, Q = discretise_noise(np.array([[0.0, 1.0], [0.0, 0.0]]), np.diag([0.0, 2.0]), 3.0)
+    >>> Phi.tolist(), Q.round(12).tolist()   # q dt^3/3, q dt^2/2, q dt for a random walk integrated once
+    ([[1.0, 3.0], [0.0, 1.0]], [[18.0, 9.0], [9.0, 6.0]])
+    """
+    F = np.asarray(F, dtype=float)
+    noise_input = np.asarray(noise_input, dtype=float)
+    n = F.shape[-1]
+    M = np.zeros((*np.broadcast_shapes(F.shape[:-2], noise_input.shape[:-2]), 2 * n, 2 * n))
+    M[..., :n, :n] = -F
+    M[..., :n, n:] = noise_input
+    M[..., n:, n:] = np.swapaxes(F, -1, -2)
+    E = scipy.linalg.expm(M * dt)
+    Phi = np.swapaxes(E[..., n:, n:], -1, -2)
+    Q = Phi @ E[..., :n, n:]
+    return Phi, 0.5 * (Q + np.swapaxes(Q, -1, -2))
+
+
 def uniform_step(t: np.ndarray) -> float | None:
     """The grid's step if all steps agree to rounding (linspace and arange grids), else None.
 

@@ -1,0 +1,277 @@
+"""The error state of the aided INS: its layout, the sensor-error processes and the linear model.
+
+State (spec 07; Groves 2013, Sec. 14.2; Shin 2005, ch. 2), errors = computed - true:
+
+=========  =====  =====================================================================
+index      unit   state
+=========  =====  =====================================================================
+0-2        m      delta_r: position error, north, east, down
+3-5        m/s    delta_v: velocity error, NED
+6-8        rad    psi: attitude error, C_hat = (I - [psi x]) C (NED axes)
+9-11       rad/s  b_g: residual gyro bias, body axes (measured - true, after compensation)
+12-14      m/s^2  b_a: residual accelerometer bias, body axes
+15-17      1      s_g: residual gyro scale-factor error (optional)
+18-20      1      s_a: residual accelerometer scale-factor error (optional)
+=========  =====  =====================================================================
+
+Continuous model delta_x' = F delta_x + w (the psi-angle model of spec 06):
+
+* delta_r' = -omega_en x delta_r + delta_v;
+* delta_v' = -(2 omega_ie + omega_en) x delta_v - psi x f^n + delta_g + C_b^n (b_a + diag(f^b) s_a),
+  delta_g = (-(g/R) delta_r_N, -(g/R) delta_r_E, +(2 g/R) delta_r_D);
+* psi' = -(omega_ie + omega_en) x psi - C_b^n (b_g + diag(omega_ib^b) s_g);
+* each bias or scale state x: random constant (x' = 0), random walk (x' = w, PSD q) or
+  first-order Gauss-Markov (x' = -x/T + w, PSD q = 2 sigma^2 / T: steady standard deviation sigma).
+
+The angle and velocity random walks N_g (rad/sqrt(s)) and N_a (m/s/sqrt(s)) enter psi' and
+delta_v' through C_b^n with PSD N^2. With C_hat = (I - [psi x]) C, the heading error
+(computed - true) is -psi_D to first order, and the roll and pitch errors follow from
+psi resolved in body axes: every plot and NEES of "attitude error" in this package uses psi.
+
+References
+----------
+P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*,
+2nd ed., Artech House, 2013, Sec. 14.2.
+E.-H. Shin, *Estimation Techniques for Low-Cost Inertial Navigation*, PhD thesis, University of
+Calgary, 2005, ch. 2.
+B. W. Benson, "A comparison of two approaches to pure-inertial and Doppler-inertial error
+analysis", *IEEE Transactions on Aerospace and Electronic Systems* AES-11(4), 1975.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from schuler.core.earth import EARTH_RATE, radii_of_curvature, somigliana_gravity
+from schuler.core.propagation import discretise_noise
+from schuler.core.rotation import skew
+from schuler.exceptions import InvalidParameter
+
+POSITION, VELOCITY, ATTITUDE = slice(0, 3), slice(3, 6), slice(6, 9)
+GYRO_BIAS, ACCEL_BIAS = slice(9, 12), slice(12, 15)
+GYRO_SCALE, ACCEL_SCALE = slice(15, 18), slice(18, 21)
+
+STATE_NAMES = ("position_north", "position_east", "position_down",
+               "velocity_north", "velocity_east", "velocity_down",
+               "psi_north", "psi_east", "psi_down",
+               "gyro_bias_x", "gyro_bias_y", "gyro_bias_z",
+               "accel_bias_x", "accel_bias_y", "accel_bias_z",
+               "gyro_scale_x", "gyro_scale_y", "gyro_scale_z",
+               "accel_scale_x", "accel_scale_y", "accel_scale_z")
+STATE_UNITS = ("m",) * 3 + ("m/s",) * 3 + ("rad",) * 3 + ("rad/s",) * 3 + ("m/s^2",) * 3 + ("1",) * 6
+
+KINDS = ("constant", "random-walk", "gauss-markov")
+
+
+def _triple(name: str, value) -> np.ndarray:
+    array = np.broadcast_to(np.asarray(value, dtype=float), (3,)).copy()
+    if not np.all(np.isfinite(array)) or np.any(array < 0):
+        raise InvalidParameter(name, f"must be three finite numbers >= 0, got {value!r}")
+    return array
+
+
+@dataclass(frozen=True)
+class ErrorProcess:
+    """The model of one sensor-error triad (a bias or a scale factor) in the filter.
+
+    Parameters
+    ----------
+    kind : str
+        ``constant`` (x' = 0), ``random-walk`` (x' = w) or ``gauss-markov`` (x' = -x/T + w).
+    sigma : array_like, shape (3,)
+        Standard deviation of the initial value per axis (constant and random walk) or the steady
+        standard deviation (Gauss-Markov), in the state's unit (rad/s, m/s^2 or 1).
+    random_walk : array_like, shape (3,)
+        Random-walk density sqrt(q) of ``random-walk``, state unit / sqrt(s) (ignored otherwise).
+    correlation_time : float
+        T of ``gauss-markov``, s (> 0; ignored otherwise).
+    """
+
+    kind: str = "constant"
+    sigma: np.ndarray | float = 0.0
+    random_walk: np.ndarray | float = 0.0
+    correlation_time: float = np.inf
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise InvalidParameter("kind", f"{self.kind!r} is not a model; choose from {', '.join(KINDS)}")
+        object.__setattr__(self, "sigma", _triple("sigma", self.sigma))
+        object.__setattr__(self, "random_walk", _triple("random_walk", self.random_walk))
+        if self.kind == "gauss-markov" and not (np.isfinite(self.correlation_time) and self.correlation_time > 0):
+            raise InvalidParameter("correlation_time", f"a Gauss-Markov process needs T > 0 s, got "
+                                                       f"{self.correlation_time!r}")
+
+    @property
+    def decay_rate(self) -> float:
+        """1/T of a Gauss-Markov process, 1/s (0 otherwise)."""
+        return 1.0 / self.correlation_time if self.kind == "gauss-markov" else 0.0
+
+    @property
+    def density(self) -> np.ndarray:
+        """PSD q of the driving white noise per axis, (state unit)^2 / s."""
+        if self.kind == "random-walk":
+            return np.asarray(self.random_walk) ** 2
+        if self.kind == "gauss-markov":
+            return 2.0 * np.asarray(self.sigma) ** 2 / self.correlation_time
+        return np.zeros(3)
+
+
+@dataclass(frozen=True)
+class FilterModel:
+    """What the filter assumes of the IMU: white noise densities and the sensor-error processes.
+
+    Parameters
+    ----------
+    angle_random_walk : array_like, shape (3,)
+        N_g per gyro axis, rad/sqrt(s).
+    velocity_random_walk : array_like, shape (3,)
+        N_a per accelerometer axis, m/s/sqrt(s).
+    gyro_bias, accel_bias : ErrorProcess
+        Bias models, rad/s and m/s^2.
+    gyro_scale, accel_scale : ErrorProcess or None
+        Scale-factor models (dimensionless); None leaves the scale states out (15 states).
+    """
+
+    angle_random_walk: np.ndarray | float
+    velocity_random_walk: np.ndarray | float
+    gyro_bias: ErrorProcess
+    accel_bias: ErrorProcess
+    gyro_scale: ErrorProcess | None = None
+    accel_scale: ErrorProcess | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "angle_random_walk", _triple("angle_random_walk", self.angle_random_walk))
+        object.__setattr__(self, "velocity_random_walk", _triple("velocity_random_walk", self.velocity_random_walk))
+        if (self.gyro_scale is None) != (self.accel_scale is None):
+            raise InvalidParameter("scale", "give both scale-factor models (21 states) or neither (15 states)")
+
+    @property
+    def size(self) -> int:
+        """Number of error states: 15, or 21 with the scale factors."""
+        return 15 if self.gyro_scale is None else 21
+
+    def processes(self) -> list[tuple[slice, ErrorProcess]]:
+        """The sensor-error processes with the state slices they occupy."""
+        pairs = [(GYRO_BIAS, self.gyro_bias), (ACCEL_BIAS, self.accel_bias)]
+        if self.gyro_scale is not None and self.accel_scale is not None:
+            pairs += [(GYRO_SCALE, self.gyro_scale), (ACCEL_SCALE, self.accel_scale)]
+        return pairs
+
+    def initial_sigma(self) -> np.ndarray:
+        """1-sigma of the sensor-error states at the start (sizes 6 or 12), their units."""
+        return np.concatenate([process.sigma for _, process in self.processes()])
+
+
+@dataclass(frozen=True)
+class NavigationPoint:
+    """The navigation solution the linear model is evaluated at (one member or a batch: leading axis N).
+
+    Parameters
+    ----------
+    latitude : ndarray, shape ([N])
+        rad.
+    height : ndarray, shape ([N])
+        m.
+    velocity : ndarray, shape ([N,] 3)
+        NED, m/s.
+    body_to_ned : ndarray, shape ([N,] 3, 3)
+        C_b^n.
+    specific_force : ndarray, shape ([N,] 3)
+        f^b, body axes, m/s^2 (mean over the step).
+    angular_rate : ndarray, shape ([N,] 3)
+        omega_ib^b, body axes, rad/s (mean over the step).
+    """
+
+    latitude: np.ndarray
+    height: np.ndarray
+    velocity: np.ndarray
+    body_to_ned: np.ndarray
+    specific_force: np.ndarray
+    angular_rate: np.ndarray
+
+
+def system_matrix(model: FilterModel, point: NavigationPoint, earth_rate: float = EARTH_RATE) -> np.ndarray:
+    """F of the error state at a navigation point (module docstring), shape ([N,] n, n).
+
+    Parameters
+    ----------
+    model : FilterModel
+        Sensor-error processes (which states exist, the Gauss-Markov decay rates).
+    point : NavigationPoint
+        Where the model is linearised (SI).
+    earth_rate : float
+        Omega, rad/s.
+    """
+    L = np.asarray(point.latitude, dtype=float)
+    h = np.asarray(point.height, dtype=float)
+    v = np.asarray(point.velocity, dtype=float)
+    C = np.asarray(point.body_to_ned, dtype=float)
+    R_N, R_E = radii_of_curvature(L)
+    omega_ie = np.stack([earth_rate * np.cos(L), np.zeros_like(L), -earth_rate * np.sin(L)], axis=-1)
+    omega_en = np.stack([v[..., 1] / (R_E + h), -v[..., 0] / (R_N + h), -v[..., 1] * np.tan(L) / (R_E + h)], axis=-1)
+    f_n = np.einsum("...ij,...j->...i", C, point.specific_force)
+    g = somigliana_gravity(L, h)
+    radius = np.sqrt((R_N + h) * (R_E + h))
+    n = model.size
+    F = np.zeros(L.shape + (n, n))
+    F[..., POSITION, POSITION] = -skew(omega_en)
+    F[..., POSITION, VELOCITY] = np.eye(3)
+    F[..., VELOCITY, VELOCITY] = -skew(2.0 * omega_ie + omega_en)
+    F[..., VELOCITY, ATTITUDE] = skew(f_n)  # -psi x f = f x psi
+    gravity_gain = g / radius
+    F[..., 3, 0] = -gravity_gain
+    F[..., 4, 1] = -gravity_gain
+    F[..., 5, 2] = 2.0 * gravity_gain
+    F[..., ATTITUDE, ATTITUDE] = -skew(omega_ie + omega_en)
+    F[..., ATTITUDE, GYRO_BIAS] = -C
+    F[..., VELOCITY, ACCEL_BIAS] = C
+    if n == 21:
+        F[..., ATTITUDE, GYRO_SCALE] = -C * np.asarray(point.angular_rate)[..., None, :]
+        F[..., VELOCITY, ACCEL_SCALE] = C * np.asarray(point.specific_force)[..., None, :]
+    for states, process in model.processes():
+        index = np.arange(states.start, states.stop)
+        F[..., index, index] = -process.decay_rate
+    return F
+
+
+def noise_input(model: FilterModel, body_to_ned: np.ndarray) -> np.ndarray:
+    """G Q_c G^T: the white noises' PSD on the state derivatives, shape ([N,] n, n), (state unit)^2/s.
+
+    Parameters
+    ----------
+    model : FilterModel
+        Noise densities and sensor-error processes.
+    body_to_ned : ndarray, shape ([N,] 3, 3)
+        C_b^n, through which the sensor noises enter psi' and delta_v'.
+    """
+    C = np.asarray(body_to_ned, dtype=float)
+    n = model.size
+    Q = np.zeros(C.shape[:-2] + (n, n))
+    Ct = np.swapaxes(C, -1, -2)
+    # C diag(N^2) C^T: the body-axis densities resolved in NED
+    Q[..., ATTITUDE, ATTITUDE] = (C * np.asarray(model.angle_random_walk) ** 2) @ Ct
+    Q[..., VELOCITY, VELOCITY] = (C * np.asarray(model.velocity_random_walk) ** 2) @ Ct
+    for states, process in model.processes():
+        index = np.arange(states.start, states.stop)
+        Q[..., index, index] = process.density
+    return Q
+
+
+def transition(model: FilterModel, point: NavigationPoint, dt: float,
+               earth_rate: float = EARTH_RATE) -> tuple[np.ndarray, np.ndarray]:
+    """Exact (Phi, Q_d) of the error state over dt with F held at ``point`` (Van Loan), shapes ([N,] n, n).
+
+    Parameters
+    ----------
+    model : FilterModel
+        Sensor-error processes and noise densities.
+    point : NavigationPoint
+        Where F is evaluated (the solution at the step's start, the sensors' means over it).
+    dt : float
+        Covariance step, s.
+    earth_rate : float
+        Omega, rad/s.
+    """
+    return discretise_noise(system_matrix(model, point, earth_rate), noise_input(model, point.body_to_ned), dt)
