@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from schuler.aided import kalman, measurements
+from schuler.aided import analysis, kalman, measurements
 from schuler.aided.ekf import GnssFixes, Start, run_filter
 from schuler.aided.error_state import ErrorProcess, FilterModel, NavigationPoint, system_matrix, transition
 from schuler.core.earth import radii_of_curvature
@@ -324,3 +324,73 @@ def test_covariance_stays_symmetric_positive_definite_over_hours():
     P = run.covariance[0]
     np.testing.assert_allclose(P, np.swapaxes(P, -1, -2), rtol=0, atol=0)
     assert np.linalg.eigvalsh(P).min(axis=-1).min() > 0
+
+
+# --- analysis: outages and consistency ---------------------------------------------------------
+
+def truth_at(imu, every: int) -> analysis.Truth:
+    pick = slice(every - 1, None, every)
+    return analysis.Truth(imu.latitude_rad[pick], imu.longitude_rad[pick], imu.height_m[pick],
+                          imu.velocity_ned_m_s[pick], imu.quaternion[pick])
+
+
+def test_psi_and_heading_errors_follow_the_convention(short_drive):
+    """A solution turned by +0.01 rad about down has heading error +0.01 rad and psi_D = -0.01 rad."""
+    path, imu = short_drive
+    run = run_filter(increments_of(imu)[:400], 1.0 / RATE, start_of(path, offsets=(np.zeros(3), np.zeros(3),
+                                                                                  np.array([0.0, 0.0, -0.01]))),
+                     tactical_model(), GnssFixes(np.array([1e9]), np.zeros(1), np.zeros(1), np.zeros(1),
+                                                 np.ones((1, 3))), output_every=400)
+    found = analysis.errors(run, truth_at(first_samples(imu, 400), 400))
+    assert found.heading[0, 0] == pytest.approx(0.01, rel=1e-3)
+    assert found.psi[0, 0, 2] == pytest.approx(-0.01, rel=1e-3)
+
+
+@pytest.mark.slow
+def test_monte_carlo_of_the_filter_is_consistent_through_an_outage():
+    """60 members whose sensors and fixes the filter models exactly; a 60-s outage.
+
+    Each epoch's mean NEES over the members lies in the 99 % chi-square band for at least 95 % of the
+    epochs of every group (1 % expected outside, correlated epochs), and the predicted horizontal 1-sigma at
+    the outage's end is within 20 % of the members' RMS there (60 members, 2 axes: the RMS is known to 6.5 %).
+    Measured: 99 %, 98.7 % and 100 % inside; 3.844 m predicted against 3.854 m.
+    """
+    members, duration, every = 60, 300.0, int(RATE)
+    path = drive(duration)
+    imu = ideal_imu(path, duration, RATE)
+    model = FilterModel(D(0.05) / 60, 0.05 / 60, ErrorProcess("constant", D(5.0) / 3600),
+                        ErrorProcess("constant", 1e-3 * G0), ErrorProcess("constant", 300e-6),
+                        ErrorProcess("constant", 300e-6))
+    rng = np.random.default_rng(2024)
+    dt = 1.0 / RATE
+    ideal = increments_of(imu)
+    bias_g = rng.normal(size=(members, 3)) * model.gyro_bias.sigma
+    bias_a = rng.normal(size=(members, 3)) * model.accel_bias.sigma
+    scale_g = rng.normal(size=(members, 3)) * 300e-6
+    scale_a = rng.normal(size=(members, 3)) * 300e-6
+    measured = np.empty((members,) + ideal.shape)
+    noise = rng.normal(size=(members, len(ideal), 6)) * dt**0.5 * np.repeat([D(0.05) / 60, 0.05 / 60], 3)
+    measured[..., :3] = ideal[None, :, :3] * (1 + scale_g[:, None]) + bias_g[:, None] * dt + noise[..., :3]
+    measured[..., 3:] = ideal[None, :, 3:] * (1 + scale_a[:, None]) + bias_a[:, None] * dt + noise[..., 3:]
+    times = np.arange(1.0, duration) + 0.37
+    times = times[(times < 150.0) | (times > 210.0)]
+    shared = gnss_from(imu, times)
+    R_N, R_E = radii_of_curvature(shared.latitude)
+    k = times.size
+    fixes = GnssFixes(times, shared.latitude + rng.normal(size=(members, k)) * 0.5 / R_N,
+                      shared.longitude + rng.normal(size=(members, k)) * 0.5 / (R_E * np.cos(shared.latitude)),
+                      shared.height + rng.normal(size=(members, k)) * 1.0, shared.sigma_ned,
+                      shared.velocity + rng.normal(size=(members, k, 3)) * 0.05, shared.velocity_sigma)
+    psi0 = rng.normal(size=(members, 3)) * D([0.1, 0.1, 1.0])
+    start = start_of(path, members=members)
+    q = quaternion_multiply(quaternion_from_rotation_vector(-psi0), start.quaternion)
+    start = Start(start.latitude, start.longitude, start.height, start.velocity, q, np.full(3, 1e-6),
+                  np.full(3, 1e-6), D([0.1, 0.1, 1.0]))
+    run = run_filter(measured, dt, start, model, fixes, output_every=every, gate=1.0)
+    found = analysis.errors(run, truth_at(imu, every))
+    check = analysis.consistency(run, found)
+    for group, fraction in check.inside.items():
+        assert fraction >= 0.95, (group, fraction, check.band)
+    (outage,) = analysis.outage_drift(run, found, [(150.0, 60.0)])
+    assert outage.horizontal_error_sigma_m == pytest.approx(outage.horizontal_error_end_m, rel=0.2)
+    assert outage.horizontal_error_max_m >= outage.horizontal_error_end_m * 0.9

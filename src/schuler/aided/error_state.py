@@ -48,6 +48,7 @@ from schuler.core.earth import EARTH_RATE, radii_of_curvature, somigliana_gravit
 from schuler.core.propagation import discretise_noise
 from schuler.core.rotation import skew
 from schuler.exceptions import InvalidParameter
+from schuler.imu.error_model import ErrorModel, SensorErrors, gauss_markov_for_bias_instability
 
 POSITION, VELOCITY, ATTITUDE = slice(0, 3), slice(3, 6), slice(6, 9)
 GYRO_BIAS, ACCEL_BIAS = slice(9, 12), slice(12, 15)
@@ -190,6 +191,76 @@ class NavigationPoint:
     body_to_ned: np.ndarray
     specific_force: np.ndarray
     angular_rate: np.ndarray
+
+
+DEFAULT_CORRELATION_TIME = 3600.0
+"""T of a Gauss-Markov bias model when the IMU's error model gives none (s): an hour, KF-GINS's order."""
+
+
+def _bias_process(sensor: SensorErrors, kind: str, correlation_time: float | None) -> ErrorProcess:
+    """One triad's bias model from its error terms (see :func:`filter_model`)."""
+    instability = np.array([gauss_markov_for_bias_instability(b) for b in sensor.bias_instability])
+    slow = np.sqrt(sensor.gm_sigma**2 + instability**2)
+    sigma = np.sqrt(sensor.bias**2 + slow**2)
+    if correlation_time is None:
+        times = [float(t) for t, s in zip(sensor.gm_correlation_time_s, sensor.gm_sigma) if s > 0]
+        if np.any(sensor.bias_instability > 0):
+            times.append(sensor.flicker_tau_range_s[1] / 1.893)  # the slowest flicker term's peak
+        correlation_time = max(times) if times else DEFAULT_CORRELATION_TIME
+    if kind == "gauss-markov":
+        return ErrorProcess("gauss-markov", sigma, correlation_time=correlation_time)
+    if kind == "random-walk":
+        walk = np.sqrt(sensor.rate_random_walk**2 + 2.0 * slow**2 / correlation_time)
+        return ErrorProcess("random-walk", sigma, random_walk=walk)
+    return ErrorProcess("constant", sigma)
+
+
+def filter_model(error_model: ErrorModel, bias: str = "gauss-markov", correlation_time: float | None = None,
+                 scale_factors: bool | None = None) -> FilterModel:
+    """The filter's IMU model from the IMU layer's error model (a grade, a spec sheet or an identification).
+
+    The white noises are the model's N (angle and velocity random walk). Each bias state
+    lumps the turn-on bias b, the Gauss-Markov terms and the bias instability B (as a
+    Gauss-Markov sigma = B / 0.9294, :func:`~schuler.imu.error_model.gauss_markov_for_bias_instability`):
+    its 1-sigma is sqrt(b^2 + sigma_GM^2 + sigma_B^2), and it is
+
+    * ``gauss-markov``: that steady sigma with T = ``correlation_time``, else the model's longest
+      Gauss-Markov time or its flicker range's upper end / 1.893 (the Allan peak of a Gauss-Markov
+      process sits at 1.893 T), else :data:`DEFAULT_CORRELATION_TIME`;
+    * ``random-walk``: that initial sigma driven by the rate random walk K and the slow terms'
+      spread 2 sigma^2 / T;
+    * ``constant``: that initial sigma and no process noise.
+
+    Scale factors are random constants of the model's 1-sigma; they are states (21) when
+    ``scale_factors`` is True, or when None and the model has scale-factor errors.
+
+    Parameters
+    ----------
+    error_model : ErrorModel
+        The IMU's error terms (SI).
+    bias : str
+        ``gauss-markov``, ``random-walk`` or ``constant``.
+    correlation_time : float, optional
+        T of the Gauss-Markov bias model, s.
+    scale_factors : bool, optional
+        Whether the scale-factor states are carried.
+
+    Examples
+    --------
+    >>> from schuler.imu.spec import preset
+    >>> model = filter_model(preset("tactical"))
+    >>> model.size, round(float(np.degrees(model.angle_random_walk[0]) * 60), 4)   # deg/sqrt(h)
+    (21, 0.125)
+    """
+    if bias not in KINDS:
+        raise InvalidParameter("bias", f"{bias!r} is not a model; choose from {', '.join(KINDS)}")
+    gyro, accel = error_model.gyro, error_model.accel
+    with_scale = bool(np.any(gyro.scale_factor > 0) or np.any(accel.scale_factor > 0)) if scale_factors is None \
+        else scale_factors
+    return FilterModel(gyro.random_walk, accel.random_walk, _bias_process(gyro, bias, correlation_time),
+                       _bias_process(accel, bias, correlation_time),
+                       ErrorProcess("constant", gyro.scale_factor) if with_scale else None,
+                       ErrorProcess("constant", accel.scale_factor) if with_scale else None)
 
 
 def system_matrix(model: FilterModel, point: NavigationPoint, earth_rate: float = EARTH_RATE) -> np.ndarray:
