@@ -22,6 +22,7 @@ P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigati
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -75,6 +76,7 @@ class Update:
     residual_sigma: np.ndarray
 
 
+@functools.lru_cache(maxsize=64)
 def gate_threshold(dimension: int, probability: float = DEFAULT_GATE) -> float:
     """The chi-square quantile a NIS of ``dimension`` degrees of freedom is compared with.
 
@@ -121,7 +123,7 @@ def update(P: np.ndarray, residual: np.ndarray, H: np.ndarray, R: np.ndarray,
     # K^T = S^-1 H P: two triangular solves per member
     whitened = np.linalg.solve(L, residual[..., None])[..., 0]
     nis = np.einsum("...i,...i->...", whitened, whitened)
-    accepted = nis <= gate_threshold(residual.shape[-1], gate)
+    accepted = nis <= gate_threshold(int(residual.shape[-1]), float(gate))
     K = np.swapaxes(np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, np.swapaxes(PHt, -1, -2))), -1, -2)
     correction = np.einsum("...ij,...j->...i", K, residual) * accepted[:, None]
     A = np.eye(P.shape[-1]) - K @ H
