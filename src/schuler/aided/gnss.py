@@ -68,8 +68,8 @@ def validate_epochs(t_s, position_sigma_m, velocity_sigma_m_s=None, *, name: str
     steps = np.diff(t)
     if np.any(steps <= 0):
         row = int(np.flatnonzero(steps <= 0)[0]) + 1
-        kind = "repeated" if steps[row - 1] == 0 else "earlier than the one before"
-        raise InvalidParameter(name, f"{where(row)}: time {t[row]:.6f} s is {kind} (times must increase strictly)")
+        kind = "repeats the one before" if steps[row - 1] == 0 else "is earlier than the one before"
+        raise InvalidParameter(name, f"{where(row)}: time {t[row]:.6f} s {kind} (times must increase strictly)")
     for label, sigma in (("position", position_sigma_m), ("velocity", velocity_sigma_m_s)):
         if sigma is None:
             continue
@@ -77,7 +77,7 @@ def validate_epochs(t_s, position_sigma_m, velocity_sigma_m_s=None, *, name: str
         if np.any(bad):
             row, axis = np.argwhere(bad)[0]
             raise InvalidParameter(name, f"{where(int(row))}: {label} 1-sigma {('north', 'east', 'down')[axis]} "
-                                         f"is {sigma[row, axis]!r} (must be finite and > 0)")
+                                         f"is {float(sigma[row, axis])!r} (must be finite and > 0)")
 
 
 @dataclass(frozen=True)
@@ -163,11 +163,12 @@ class GnssRecord:
         GnssRecord
         """
         keep = np.asarray(keep, dtype=bool)
-        optional = {key: None if getattr(self, key) is None else getattr(self, key)[keep]
-                    for key in ("velocity_ned_m_s", "velocity_sigma_m_s")}
+        velocity, sigma = self.velocity_ned_m_s, self.velocity_sigma_m_s
         return replace(self, t_s=self.t_s[keep], latitude_rad=self.latitude_rad[keep],
                        longitude_rad=self.longitude_rad[keep], height_m=self.height_m[keep],
-                       position_sigma_m=self.position_sigma_m[keep], **optional)
+                       position_sigma_m=self.position_sigma_m[keep],
+                       velocity_ned_m_s=None if velocity is None else velocity[keep],
+                       velocity_sigma_m_s=None if sigma is None else sigma[keep])
 
     def without(self, outages) -> GnssRecord:
         """The record with the epochs inside the outages removed.
