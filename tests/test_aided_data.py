@@ -138,6 +138,8 @@ def _gnss_with(line_3: str) -> str:
     ("456302.0 30.5 114.5 20.0 0.01 0.0 0.02", "gnss_file: gnss.txt line 3: position 1-sigma east is 0.0"),
     ("456302.0 30.5 114.5 20.0 0.01 0.01 -0.02", "gnss_file: gnss.txt line 3: position 1-sigma down is -0.02"),
     ("456302.0 95.5 114.5 20.0 0.01 0.01 0.02", "gnss_file: gnss.txt line 3: latitude 95.5 deg is beyond"),
+    ("456302.0 30.5 114.5 20.0 0 0 0 0.01 0.01 0.02 0.1 0.1 0.1", "gnss_file: gnss.txt line 3: 13 columns, line 1 "
+                                                                   "has 7 (every line needs the same)"),
 ])
 def test_bad_gnss_files_get_one_line_naming_the_line(tmp_path, third_line, message):
     path = tmp_path / "gnss.txt"
@@ -396,6 +398,24 @@ def test_antenna_velocity_is_the_derivative_of_its_position():
     assert np.all(truths[1].body_rate_rad_s[:, 2] > 0.05)  # a right turn
 
 
+def test_epochs_off_the_imu_samples(imu200):
+    # 1-Hz epochs 2.5 ms after the 200-Hz samples, between two of them: the cubic Hermite interpolant's middle is
+    # the chord's middle plus (v_before - v_after) dt / 8 (up to 9.4e-6 m here); measured 1.2e-9 m from it
+    record = simulate_gnss(DRIVE, SHORT, imu_rate=200.0, time_offset=0.0025)
+    assert record.t_s[0] == 0.0025 and record.t_s[-1] == pytest.approx(199.0025, abs=1e-12)
+    k = np.round((record.t_s - 0.0025) * 200.0).astype(int) - 1  # the sample before each epoch
+    k = k[k >= 0]
+    before = np.column_stack([imu200.latitude_rad[k], imu200.longitude_rad[k], imu200.height_m[k]])
+    after = np.column_stack([imu200.latitude_rad[k + 1], imu200.longitude_rad[k + 1], imu200.height_m[k + 1]])
+    got = np.column_stack([record.latitude_rad, record.longitude_rad, record.height_m])[-k.size:]
+    error = _ned_metres(got[:, 0], got[:, 1], got[:, 2], (0.5 * (before + after)).T)
+    expected = (imu200.velocity_ned_m_s[k] - imu200.velocity_ned_m_s[k + 1]) * imu200.interval_s / 8.0
+    assert np.abs(expected).max() > 5e-6
+    np.testing.assert_allclose(error, expected, rtol=0, atol=1e-8)
+    with pytest.raises(InvalidParameter, match=r"time_offset: must lie in \[0, 1\) s, got 1.5"):
+        simulate_gnss(DRIVE, SHORT, imu_rate=200.0, time_offset=1.5)
+
+
 def test_latency_stamps_the_position_late(imu200):
     # stamped t, true at t - 0.3 s: which is an IMU sample, so the noise-free record equals the truth there
     record = simulate_gnss(DRIVE, SHORT, imu_rate=200.0, latency=0.3)
@@ -442,6 +462,8 @@ def test_a_member_s_draws_depend_on_nothing_else(rest_truth):
     np.testing.assert_array_equal(cut.latitude_rad, member.latitude_rad[keep])
     again = gnss_measurements(rest_truth, streams=RandomStreams(5), member=7)
     np.testing.assert_array_equal(again.height_m, member.height_m)
+    with pytest.raises(InvalidParameter, match="member: must be a whole number >= 0, got -1"):
+        gnss_measurements(rest_truth, streams=streams, member=-1)
 
 
 def test_odometer_speed_of_the_wheel_point():

@@ -116,6 +116,8 @@ def draws(streams: RandomStreams, stream: str, member: int, index: np.ndarray) -
     ndarray
         Standard normal numbers, dimensionless.
     """
+    if isinstance(member, bool) or not isinstance(member, int | np.integer) or member < 0:
+        raise InvalidParameter("member", f"must be a whole number >= 0, got {member!r}")
     series = streams.normal_series(stream, [member], int(index[0]), int(index[-1]) + 1)[0]
     return series[index - index[0]]
 
@@ -291,6 +293,7 @@ def truth_at(trajectory, duration: float, t, *, imu_rate: float = 100.0, earth_r
                                                          np.clip(t[done:stop], times[0], times[-1]))
         done = stop
         node_t, node_p, node_v = times[-1], chunk.positions[-1], chunk.velocities[-1]
+    positions[done:] = node_p  # times past the last sample by rounding only (within 1e-12 of the duration)
     velocity, quaternion = trajectory.kinematics(t)
     return EpochTruth(t, positions[:, 0], positions[:, 1], positions[:, 2], velocity, quaternion,
                       body_rate(trajectory, t))

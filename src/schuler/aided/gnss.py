@@ -133,7 +133,7 @@ class GnssRecord:
             raise InvalidParameter("velocity_ned_m_s", "must be finite")
         if np.any(np.abs(self.latitude_rad) > math.pi / 2):
             raise InvalidParameter("latitude_rad", "must lie within +/-90 deg")
-        validate_epochs(t, self.position_sigma_m, self.velocity_sigma_m_s, name=self.source or "gnss")
+        validate_epochs(t, self.position_sigma_m, self.velocity_sigma_m_s, name="gnss")
 
     @property
     def epochs(self) -> int:

@@ -77,6 +77,7 @@ def _data_lines(raw: bytes):
 def _diagnose(raw: bytes, path: Path, name: str, columns: tuple[int, ...]) -> InvalidParameter:
     """The one-line error of the first bad line of a file the fast reader refused."""
     expected = " or ".join(str(c) for c in columns)
+    first: tuple[int, int] | None = None
     for number, text in _data_lines(raw):
         fields = text.replace(",", " ").split()
         for token in fields:
@@ -89,6 +90,11 @@ def _diagnose(raw: bytes, path: Path, name: str, columns: tuple[int, ...]) -> In
                 return InvalidParameter(name, f"{path.name} line {number}: {token} is not a finite number")
         if len(fields) not in columns:
             return InvalidParameter(name, f"{path.name} line {number}: {len(fields)} columns, expected {expected}")
+        if first is None:
+            first = (number, len(fields))
+        elif len(fields) != first[1]:
+            return InvalidParameter(name, f"{path.name} line {number}: {len(fields)} columns, line {first[0]} has "
+                                          f"{first[1]} (every line needs the same)")
     return InvalidParameter(name, f"{path.name}: no data lines" if not any(True for _ in _data_lines(raw))
                             else f"{path.name}: cannot be read as {expected} numeric columns")
 
