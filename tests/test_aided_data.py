@@ -378,6 +378,8 @@ def test_lever_arm_position_and_velocity_signs():
                          (path.latitude, path.longitude, path.height))
     np.testing.assert_allclose(offset, np.tile([0.0, 1.0, -0.5], (5, 1)), rtol=0, atol=1e-9)
     np.testing.assert_allclose(truth.velocity_ned_m_s, 0.0, rtol=0, atol=1e-15)
+    with pytest.raises(InvalidParameter, match=r"lever_arm: \[500.0, 0.0, -300.0\] is longer than 30 m"):
+        gnss_truth(path, 5.0, imu_rate=10.0, lever_arm=(500.0, 0.0, -300.0))  # in mm
 
 
 def test_antenna_velocity_is_the_derivative_of_its_position():

@@ -51,6 +51,9 @@ DEFAULT_ODOMETER_SIGMA_M_S = 0.05
 DEFAULT_BAROMETER_SIGMA_M = 0.5
 """Default 1-sigma of the simulated barometer's white noise per epoch, m."""
 
+LARGEST_LEVER_ARM_M = 30.0
+"""Largest lever arm accepted, m: a longer one is most likely in cm or mm."""
+
 RATE_STEP_S = 1e-3
 """Step of the central differences giving omega_nb^b from the trajectory's attitude, s."""
 
@@ -122,7 +125,7 @@ def draws(streams: RandomStreams, stream: str, member: int, index: np.ndarray) -
     return series[index - index[0]]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class EpochTruth:
     """The truth of a trajectory at given times (IMU position, velocity, attitude and body rate).
 
@@ -162,6 +165,9 @@ class EpochTruth:
             Latitude, longitude (rad), height (m), shape (n, 3); v_N, v_E, v_D (m/s), shape (n, 3).
         """
         arm = vector3(lever_arm_m, "lever_arm")
+        if np.linalg.norm(arm) > LARGEST_LEVER_ARM_M:
+            raise InvalidParameter("lever_arm", f"{arm.tolist()} is longer than {LARGEST_LEVER_ARM_M:g} m: metres "
+                                                "are expected (is it in cm or mm?)")
         C = rotation_matrix(self.quaternion)
         offset = C @ arm
         velocity = self.velocity_ned_m_s + np.einsum("nij,nj->ni", C, np.cross(self.body_rate_rad_s, arm))
@@ -332,7 +338,7 @@ def epoch_schedule(rate_hz: float, duration: float, *, latency: float = 0.0,
 
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class OdometerRecord:
     """Odometer epochs: the forward speed of the wheel point.
 
@@ -351,7 +357,7 @@ class OdometerRecord:
     sigma_m_s: float
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class BarometerRecord:
     """Barometric heights.
 

@@ -26,7 +26,7 @@ Examples
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -80,7 +80,7 @@ def validate_epochs(t_s, position_sigma_m, velocity_sigma_m_s=None, *, name: str
                                          f"is {float(sigma[row, axis])!r} (must be finite and > 0)")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class GnssRecord:
     """GNSS epochs: positions with their 1-sigma, optionally NED velocities with theirs.
 
@@ -109,7 +109,7 @@ class GnssRecord:
     position_sigma_m: np.ndarray
     velocity_ned_m_s: np.ndarray | None = None
     velocity_sigma_m_s: np.ndarray | None = None
-    source: str = field(default="", compare=False)
+    source: str = ""
 
     def __post_init__(self):
         t = np.asarray(self.t_s, dtype=float).reshape(-1)
@@ -301,7 +301,7 @@ def detect_outages(t_s, nominal_interval_s: float | None = None) -> tuple[tuple[
     return tuple((float(t[k] + interval), float(steps[k] - interval)) for k in gaps)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class GnssTruth:
     """The antenna's true position and velocity at the GNSS epochs, before noise and outages.
 

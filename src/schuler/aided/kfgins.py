@@ -14,7 +14,7 @@ Formats (spec 07; whitespace- or comma-separated text, ``#`` comment lines and b
 Records are SI with the times as in the file. Written precision (the round trip's): times 1e-9 s, latitude and
 longitude 1e-12 deg (1e-7 m), heights, velocities and Euler angles 1e-9 (m, m/s, deg); IMU increments and all
 1-sigma with 17 significant digits (exact). Reading uses pandas' C parser (a 300,000-line IMU file in about
-0.3 s); only a file it refuses is read again line by line, to name the first bad line.
+0.5 s); only a file it refuses is read again line by line, to name the first bad line.
 
 Bad input is one :class:`~schuler.exceptions.InvalidParameter` naming the file's option and line: a wrong
 column count, text that is not a number (quoted, at most 80 characters), a value that is not finite, times
@@ -273,7 +273,7 @@ def check_overlap(imu: ImuRecord, gnss: GnssRecord, name: str = "gnss_file") -> 
                                      f"the IMU's [{first:.3f}, {last:.3f}] s")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class NavigationRecord:
     """Navigation states in KF-GINS's reference/result layout, SI.
 
@@ -300,6 +300,15 @@ class NavigationRecord:
     height_m: np.ndarray
     velocity_ned_m_s: np.ndarray
     attitude_rad: np.ndarray
+
+    def __post_init__(self):
+        n = np.asarray(self.t_s).size
+        for key, shape in (("week", (n,)), ("t_s", (n,)), ("latitude_rad", (n,)), ("longitude_rad", (n,)),
+                           ("height_m", (n,)), ("velocity_ned_m_s", (n, 3)), ("attitude_rad", (n, 3))):
+            array = np.asarray(getattr(self, key), dtype=np.int64 if key == "week" else float)
+            if array.shape != shape or not np.all(np.isfinite(array)):
+                raise InvalidParameter(key, f"must be finite numbers of shape {shape}, got shape {array.shape}")
+            object.__setattr__(self, key, array)
 
 
 def read_navigation(path, *, name: str = "reference") -> NavigationRecord:

@@ -35,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
+from schuler.aided.epochs import LARGEST_LEVER_ARM_M
 from schuler.aided.kfgins import SECONDS_PER_WEEK
 from schuler.exceptions import InvalidParameter
 
@@ -44,8 +45,6 @@ MGAL = 1e-5
 PPM = 1e-6
 """One part per million."""
 
-LARGEST_LEVER_ARM_M = 30.0
-"""Largest antenna lever arm accepted, m: a longer one is most likely in cm or mm."""
 
 
 _DEG = math.pi / 180.0
@@ -83,7 +82,7 @@ NOISE_KEYS = (*_NOISE_KEYS, "corrtime")
 """The keys of ``imunoise``, all mandatory."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class KfGinsConfiguration:
     """A KF-GINS configuration in SI (arrays of 3 are read-only; axes: NED for the state, body FRD for the IMU).
 
