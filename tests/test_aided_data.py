@@ -108,7 +108,11 @@ def test_navigation_file_is_kf_gins_result_layout(tmp_path, imu200):
 def test_readers_take_commas_tabs_comments_and_trailing_spaces(tmp_path):
     path = tmp_path / "gnss.txt"
     path.write_text("# a comment line\n456300.000,30.5,114.5,20.0,0.01,0.02,0.03\n\n"
-                    "456301.000\t30.5000001 114.5   20.1    0.01    0.02    0.03 \n")
+                    "  456301.000\t30.5000001 114.5   20.1    0.01    0.02    0.03 # fixed\n"
+                    "456301.000 30.5 114.5 20.1 0.01 0.02 0.03\n")
+    with pytest.raises(InvalidParameter, match="gnss.txt line 5: time 456301.000000 s repeats"):
+        read_gnss(path)  # the line counted in the file, comments and blank lines included
+    path.write_text("\n".join(path.read_text().splitlines()[:-1]) + "\n")
     record = read_gnss(path)
     assert record.epochs == 2
     assert math.degrees(record.latitude_rad[1]) == pytest.approx(30.5000001, abs=1e-12)
