@@ -5,9 +5,10 @@
 ``kinematics(t)`` (the truth's velocity and attitude at the samples are those values), the position by cubic
 Hermite interpolation between the two neighbouring samples with the velocity as its derivative
 (dL/dt = v_N / (R_N + h), dlambda/dt = v_E / ((R_E + h) cos L), dh/dt = -v_D). Its error is
-dt^4 / 384 max|d^4 r / dt^4| plus the truth's own trapezoid rounding between samples (the tests measure it
-against the truth at skipped samples). The body's rate omega_nb^b comes from central differences of the
-attitude (step :data:`RATE_STEP_S`, error step^2 |d^2 omega / dt^2| / 6, below 1e-8 rad/s on the drive).
+dt^4 / 384 max|d^4 r / dt^4| plus the truth's own trapezoid rounding between samples (against the truth at
+skipped samples of the drive: 1.2e-9 m with nodes at 100 Hz). The body's rate omega_nb^b comes from central
+differences of the attitude (step :data:`RATE_STEP_S`, error step^2 |d^2 omega / dt^2| / 6, 3e-8 rad/s in the
+drive's turns).
 
 A point at the body lever arm l (m, x forward, y right, z down; spec 07) is at r + C_b^n l and moves at
 v + C_b^n (omega_ib x l) - (omega_ie + omega_en) x C_b^n l = v + C_b^n (omega_nb x l). The NED offset
