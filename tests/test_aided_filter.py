@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 from schuler.aided import analysis, kalman, measurements
-from schuler.aided.ekf import GnssFixes, Start, run_filter
+from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import ErrorProcess, FilterModel, NavigationPoint, system_matrix, transition
+from schuler.aided.gnss import GnssRecord
 from schuler.core.earth import radii_of_curvature
 from schuler.core.propagation import discretise_noise
 from schuler.core.rotation import skew
@@ -50,7 +51,7 @@ def increments_of(imu) -> np.ndarray:
     return np.concatenate([imu.angle_increment_rad, imu.velocity_increment_m_s], axis=1)
 
 
-def gnss_from(imu, times, sigma=(0.5, 0.5, 1.0), velocity_sigma=(0.05, 0.05, 0.05), noise=None) -> GnssFixes:
+def gnss_from(imu, times, sigma=(0.5, 0.5, 1.0), velocity_sigma=(0.05, 0.05, 0.05), noise=None) -> GnssRecord:
     """Fixes of the truth at ``times`` (between IMU samples: the truth interpolated linearly)."""
     lat = np.interp(times, imu.t_s, imu.latitude_rad)
     lon = np.interp(times, imu.t_s, imu.longitude_rad)
@@ -63,7 +64,7 @@ def gnss_from(imu, times, sigma=(0.5, 0.5, 1.0), velocity_sigma=(0.05, 0.05, 0.0
         h = h + noise.normal(size=times.size) * sigma[2]
         v = v + noise.normal(size=v.shape) * np.asarray(velocity_sigma)
     k = times.size
-    return GnssFixes(times, lat, lon, h, np.tile(sigma, (k, 1)), v, np.tile(velocity_sigma, (k, 1)))
+    return GnssRecord(times, lat, lon, h, np.tile(sigma, (k, 1)), v, np.tile(velocity_sigma, (k, 1)))
 
 
 def start_of(path, position_sigma=1.0, velocity_sigma=0.1, attitude_sigma=D([0.1, 0.1, 1.0]), members=1,
@@ -211,7 +212,7 @@ def test_transition_matches_the_nonlinear_ins(short_drive):
                   np.array([h - dr[2]]), (v_true + dv)[None], q[None], start.position_sigma, start.velocity_sigma,
                   start.attitude_sigma)
     model = tactical_model()
-    no_fix = GnssFixes(np.array([1e9]), np.zeros(1), np.zeros(1), np.zeros(1), np.ones((1, 3)))
+    no_fix = GnssRecord(np.array([1e9]), np.zeros(1), np.zeros(1), np.zeros(1), np.ones((1, 3)))
     run = run_filter(sub, 1.0 / RATE, start, model, no_fix, t0=125.0, covariance_interval=20.0)
     sol = run.solution[0, -1]
     k = int(145 * RATE) - 1
@@ -301,9 +302,9 @@ def test_an_outlier_is_rejected_by_the_gate_and_counted(short_drive):
     path, imu = short_drive
     times = np.arange(1.0, 60.0)
     fix = gnss_from(imu, times)
-    latitude = fix.latitude.copy()
+    latitude = fix.latitude_rad.copy()
     latitude[30] += 100.0 / 6.4e6  # a 100-m jump north
-    bad = GnssFixes(fix.time_s, latitude, fix.longitude, fix.height, fix.sigma_ned, fix.velocity, fix.velocity_sigma)
+    bad = dataclasses.replace(fix, latitude_rad=latitude)
     run = run_filter(increments_of(imu)[: int(60 * RATE)], 1.0 / RATE, start_of(path), tactical_model(), bad)
     assert run.rejected[0] == 1 and not run.accepted[0, 30]
     assert run.nis[0, 30] > kalman.gate_threshold(6)
@@ -319,7 +320,7 @@ def test_covariance_stays_symmetric_positive_definite_over_hours():
     imu = ideal_imu(path, 7200.0, 10.0)
     times = np.arange(1.0, 7200.0)
     fix = gnss_from(imu, times, sigma=(1e-3, 1e-3, 1e-3))
-    fix = GnssFixes(fix.time_s, fix.latitude, fix.longitude, fix.height, fix.sigma_ned)
+    fix = dataclasses.replace(fix, velocity_ned_m_s=None, velocity_sigma_m_s=None)
     run = run_filter(increments_of(imu), 0.1, start_of(path), tactical_model(), fix, output_every=600)
     P = run.covariance[0]
     np.testing.assert_allclose(P, np.swapaxes(P, -1, -2), rtol=0, atol=0)
@@ -339,8 +340,8 @@ def test_psi_and_heading_errors_follow_the_convention(short_drive):
     path, imu = short_drive
     run = run_filter(increments_of(imu)[:400], 1.0 / RATE, start_of(path, offsets=(np.zeros(3), np.zeros(3),
                                                                                   np.array([0.0, 0.0, -0.01]))),
-                     tactical_model(), GnssFixes(np.array([1e9]), np.zeros(1), np.zeros(1), np.zeros(1),
-                                                 np.ones((1, 3))), output_every=400)
+                     tactical_model(), GnssRecord(np.array([1e9]), np.zeros(1), np.zeros(1), np.zeros(1),
+                                                  np.ones((1, 3))), output_every=400)
     found = analysis.errors(run, truth_at(first_samples(imu, 400), 400))
     assert found.heading[0, 0] == pytest.approx(0.01, rel=1e-3)
     assert found.psi[0, 0, 2] == pytest.approx(-0.01, rel=1e-3)
@@ -375,12 +376,12 @@ def test_monte_carlo_of_the_filter_is_consistent_through_an_outage():
     times = np.arange(1.0, duration) + 0.37
     times = times[(times < 150.0) | (times > 210.0)]
     shared = gnss_from(imu, times)
-    R_N, R_E = radii_of_curvature(shared.latitude)
-    k = times.size
-    fixes = GnssFixes(times, shared.latitude + rng.normal(size=(members, k)) * 0.5 / R_N,
-                      shared.longitude + rng.normal(size=(members, k)) * 0.5 / (R_E * np.cos(shared.latitude)),
-                      shared.height + rng.normal(size=(members, k)) * 1.0, shared.sigma_ned,
-                      shared.velocity + rng.normal(size=(members, k, 3)) * 0.05, shared.velocity_sigma)
+    R_N, R_E = radii_of_curvature(shared.latitude_rad)
+    fixes = [dataclasses.replace(
+        shared, latitude_rad=shared.latitude_rad + rng.normal(size=times.size) * 0.5 / R_N,
+        longitude_rad=shared.longitude_rad + rng.normal(size=times.size) * 0.5 / (R_E * np.cos(shared.latitude_rad)),
+        height_m=shared.height_m + rng.normal(size=times.size) * 1.0,
+        velocity_ned_m_s=shared.velocity_ned_m_s + rng.normal(size=(times.size, 3)) * 0.05) for _ in range(members)]
     psi0 = rng.normal(size=(members, 3)) * D([0.1, 0.1, 1.0])
     start = start_of(path, members=members)
     q = quaternion_multiply(quaternion_from_rotation_vector(-psi0), start.quaternion)

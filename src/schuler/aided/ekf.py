@@ -36,6 +36,7 @@ Calgary, 2005.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numba
@@ -54,6 +55,7 @@ from schuler.aided.error_state import (
     NavigationPoint,
     transition,
 )
+from schuler.aided.gnss import GnssRecord
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.exceptions import InvalidParameter
 from schuler.memory import require
@@ -66,46 +68,37 @@ _PARALLEL_STEPS = 200_000  # member-samples of a segment above which the mechani
 
 
 @dataclass(frozen=True)
-class GnssFixes:
-    """GNSS measurements at their own times (asynchronous to the IMU), SI.
+class _Epochs:
+    """The members' GNSS epochs as arrays: one record shared by every member, or one record per member."""
 
-    Parameters
-    ----------
-    time_s : ndarray, shape (k,)
-        Epochs, s, on the IMU's time scale, strictly increasing.
-    latitude, longitude : ndarray, shape (k,) or (N, k)
-        Antenna position, rad (one row per member, or shared).
-    height : ndarray, shape (k,) or (N, k)
-        Antenna ellipsoidal height, m.
-    sigma_ned : ndarray, shape (k, 3)
-        1-sigma of the position, north, east, down, m (> 0).
-    velocity : ndarray, shape (k, 3) or (N, k, 3), optional
-        Antenna velocity, NED, m/s; None: position only.
-    velocity_sigma : ndarray, shape (k, 3), optional
-        1-sigma of the velocity, m/s (> 0), with ``velocity``.
-    """
-
-    time_s: np.ndarray
-    latitude: np.ndarray
+    t: np.ndarray  # (k,)
+    latitude: np.ndarray  # (N, k)
     longitude: np.ndarray
     height: np.ndarray
-    sigma_ned: np.ndarray
-    velocity: np.ndarray | None = None
-    velocity_sigma: np.ndarray | None = None
+    sigma: np.ndarray  # (k, 3), shared
+    velocity: np.ndarray | None  # (N, k, 3)
+    velocity_sigma: np.ndarray | None  # (k, 3)
 
-    def __post_init__(self):
-        t = np.asarray(self.time_s, dtype=float)
-        if t.ndim != 1 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
-            raise InvalidParameter("gnss", "epoch times must be finite and strictly increasing")
-        sigma = np.asarray(self.sigma_ned, dtype=float)
-        if sigma.shape != (t.size, 3) or not np.all(np.isfinite(sigma)) or np.any(sigma <= 0):
-            raise InvalidParameter("gnss", "position sigmas must be finite and > 0, three per epoch")
-        if (self.velocity is None) != (self.velocity_sigma is None):
-            raise InvalidParameter("gnss", "a GNSS velocity needs its sigmas, and sigmas a velocity")
-        if self.velocity_sigma is not None:
-            vs = np.asarray(self.velocity_sigma, dtype=float)
-            if vs.shape != (t.size, 3) or not np.all(np.isfinite(vs)) or np.any(vs <= 0):
-                raise InvalidParameter("gnss", "velocity sigmas must be finite and > 0, three per epoch")
+    @classmethod
+    def of(cls, gnss: GnssRecord | Sequence[GnssRecord], members: int) -> _Epochs:
+        records = [gnss] if isinstance(gnss, GnssRecord) else list(gnss)
+        if len(records) not in (1, members):
+            raise InvalidParameter("gnss", f"give one GNSS record or one per member ({members}), got {len(records)}")
+        first = records[0]
+        for record in records[1:]:
+            if not np.array_equal(record.t_s, first.t_s) or not np.array_equal(record.position_sigma_m,
+                                                                                 first.position_sigma_m):
+                raise InvalidParameter("gnss", "the members' GNSS records must share their epochs and sigmas")
+            if record.has_velocity != first.has_velocity:
+                raise InvalidParameter("gnss", "either every member's GNSS record has velocities or none has")
+
+        def rows(name):
+            return np.broadcast_to(np.stack([getattr(r, name) for r in records]), (members,) + first.t_s.shape
+                                   + np.shape(getattr(first, name))[1:])
+
+        velocity = rows("velocity_ned_m_s") if first.has_velocity else None
+        return cls(first.t_s, rows("latitude_rad"), rows("longitude_rad"), rows("height_m"), first.position_sigma_m,
+                   velocity, first.velocity_sigma_m_s)
 
 
 @dataclass(frozen=True)
@@ -344,7 +337,8 @@ class _Navigator:
         return np.concatenate([self.gyro_bias, self.accel_bias, self.gyro_scale, self.accel_scale], axis=1)
 
 
-def run_filter(increments: np.ndarray, interval: float, start: Start, model: FilterModel, gnss: GnssFixes, *,
+def run_filter(increments: np.ndarray, interval: float, start: Start, model: FilterModel,
+               gnss: GnssRecord | Sequence[GnssRecord], *,
                t0: float = 0.0, lever_arm=(0.0, 0.0, 0.0), covariance_interval: float = 1.0,
                use_velocity: bool = True, gate: float = kalman.DEFAULT_GATE, output_every: int = 1,
                initial_sensor_errors: np.ndarray | None = None, earth_rate: float = EARTH_RATE) -> FilterRun:
@@ -361,8 +355,9 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         Initial solutions (N members) and their 1-sigma.
     model : FilterModel
         The filter's sensor model (15 or 21 states).
-    gnss : GnssFixes
-        The measurements; epochs outside (t0, t0 + n interval] are skipped.
+    gnss : GnssRecord or sequence of GnssRecord
+        The measurements (one record for every member, or one per member with the same epochs and sigmas; times on
+        the IMU's time scale); epochs outside (t0, t0 + n interval] are skipped.
     t0 : float
         Time of the start, s.
     lever_arm : array_like, shape (3,)
@@ -394,7 +389,8 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
                                                       f"{interval} s, got {covariance_interval} s")
     every_cov = int(round(steps))
     end = t0 + n_samples * interval
-    t = np.asarray(gnss.time_s, dtype=float)
+    epochs = _Epochs.of(gnss, members)
+    t = epochs.t
     inside = np.flatnonzero((t > t0) & (t <= end + 1e-9))
     n_cov = n_samples // every_cov + inside.size + 1
     n_out = n_samples // output_every
@@ -410,7 +406,7 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     accumulator = _Accumulator(members)
     point = navigator.point(accumulator)
     cov_t, covs, estimates = [t0], [P.copy()], [navigator.estimates()]
-    velocity = use_velocity and gnss.velocity is not None
+    velocity = use_velocity and epochs.velocity is not None
     m = 6 if velocity else 3
     nis = np.zeros((members, inside.size))
     accepted = np.zeros((members, inside.size), dtype=bool)
@@ -440,18 +436,16 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         if epoch >= 0:
             j = int(np.searchsorted(t[inside], time))
             solution = navigator.solution()
-            residual, H = measurements.gnss_position(solution, lever_arm, _at(gnss.latitude, epoch, members, False),
-                                                     _at(gnss.longitude, epoch, members, False),
-                                                     _at(gnss.height, epoch, members, False), n)
-            R = np.diag(np.asarray(gnss.sigma_ned)[epoch] ** 2)
+            residual, H = measurements.gnss_position(solution, lever_arm, epochs.latitude[:, epoch],
+                                                     epochs.longitude[:, epoch], epochs.height[:, epoch], n)
+            sigma = epochs.sigma[epoch]
             if velocity:
-                assert gnss.velocity is not None and gnss.velocity_sigma is not None
-                v_res, v_H = measurements.gnss_velocity(solution, lever_arm, _at(gnss.velocity, epoch, members, True),
-                                                        n, earth_rate)
+                assert epochs.velocity is not None and epochs.velocity_sigma is not None
+                v_res, v_H = measurements.gnss_velocity(solution, lever_arm, epochs.velocity[:, epoch], n, earth_rate)
                 residual = np.concatenate([residual, v_res], axis=1)
                 H = np.concatenate([H, v_H], axis=1)
-                R = np.diag(np.concatenate([np.asarray(gnss.sigma_ned)[epoch],
-                                            np.asarray(gnss.velocity_sigma)[epoch]]) ** 2)
+                sigma = np.concatenate([sigma, epochs.velocity_sigma[epoch]])
+            R = np.diag(sigma**2)
             outcome = kalman.update(P, residual, H, R, gate)
             P = outcome.covariance
             navigator.correct(outcome.correction, n)
@@ -467,10 +461,3 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     out_t = t0 + np.arange(1, n_out + 1) * output_every * interval
     return FilterRun(out_t, navigator.out[:, 1:], np.asarray(cov_t), np.stack(covs, axis=1),
                      np.stack(estimates, axis=1), t[inside], nis, accepted, residuals, residual_sigma, n)
-
-
-def _at(values, epoch: int, members: int, vector: bool) -> np.ndarray:
-    """Every member's measurement at ``epoch`` from a shared (k[, 3]) or per-member (N, k[, 3]) array."""
-    array = np.asarray(values, dtype=float)
-    per_member = array.ndim == (3 if vector else 2)
-    return array[:, epoch] if per_member else np.broadcast_to(array[epoch], (members, 3) if vector else (members,))
