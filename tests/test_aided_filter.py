@@ -395,3 +395,24 @@ def test_monte_carlo_of_the_filter_is_consistent_through_an_outage():
     (outage,) = analysis.outage_drift(run, found, [(150.0, 60.0)])
     assert outage.horizontal_error_sigma_m == pytest.approx(outage.horizontal_error_end_m, rel=0.2)
     assert outage.horizontal_error_max_m >= outage.horizontal_error_end_m * 0.9
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("arm, attitude_bound_deg", [((0.0, 0.0, 0.0), 1e-4), ((1.2, -0.3, -1.0), 5e-4)])
+def test_the_default_drive_with_ideal_sensors_and_exact_gnss_returns_the_truth(arm, attitude_bound_deg):
+    """The 1,500-s drive at 200 Hz, exact 1-Hz fixes 0.25 s after each IMU second: the solution stays on the
+    truth within 1 mm and 1e-4 deg. With the antenna 1.2 m ahead, 0.3 m left and 1 m up the velocity's lever-arm
+    term takes the body rate of the last (partial) IMU interval: in turns it differs from the rate at the epoch
+    by up to 1e-4 rad/s, and the attitude follows within 5e-4 deg (measured 1.7e-4)."""
+    from schuler.aided.gnss import simulate_gnss
+    from schuler.navigate.drive import drive as car_drive
+
+    path = car_drive()
+    imu = ideal_imu(path, path.duration, RATE)
+    fixes = simulate_gnss(path, path.duration, imu_rate=RATE, gnss_rate=1.0, position_sigma=(0.02, 0.02, 0.05),
+                          velocity_sigma=(0.01, 0.01, 0.01), lever_arm=arm, time_offset=0.25)
+    run = run_filter(increments_of(imu), 1.0 / RATE, start_of(path), tactical_model(), fixes, lever_arm=arm)
+    position, velocity, attitude = errors_against(run, imu)
+    assert np.abs(position).max() < 1e-3 and np.abs(velocity).max() < 1e-3
+    assert np.degrees(np.abs(attitude).max()) < attitude_bound_deg
+    assert run.rejected[0] == 0 and run.epoch_t_s.size == fixes.epochs
