@@ -430,7 +430,8 @@ def run_case(case: Case, fidelity: str | None = None) -> NavigateResult:
         trajectory=name, mode=shared.mode, vertical_channel=shared.vertical_channel,
         imu=_imu_name(case, shared), duration_s=shared.duration,
         imu_rate_hz=shared.imu_rate, output_step_s=shared.output_step,
-        errors={key: float(values[0]) for key, values in reduce(result).items()}, navigation=result)
+        errors={key: float(values[0]) for key, values in reduce(result).items()}, navigation=result,
+        warnings=list(result.warnings))
 
 
 def member_bytes(case: Case) -> int:
