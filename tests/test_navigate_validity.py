@@ -103,3 +103,11 @@ def test_a_run_inside_the_models_is_silent():
         result = navigate(Stationary(latitude=LATITUDE), 600.0, imu_rate=10.0, output_step=60.0,
                           vertical_channel="baro", initial_errors=InitialErrors(heading_error=math.radians(5.0)))
     assert result.warnings == []
+
+
+def test_a_computed_position_past_the_pole_is_still_inside_the_domain(run_cli):
+    # 200 km north of 89 deg is 90.8 deg: the other side's frame, turned half a turn; only the pole itself is refused
+    out = run_cli("navigate", "run", "--latitude", "89", "--position-error-north", "200000", "--duration", "600",
+                  "--imu-rate", "10", "--output-step", "60", "--json")
+    assert out.code == 0 and out.stderr == "", out.stderr
+    assert out.json()["final_position_error_north_m"] == pytest.approx(2e5, rel=1e-3)

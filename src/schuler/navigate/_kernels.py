@@ -86,8 +86,9 @@ HIGHEST_HEIGHT = _A
 """m: one equatorial radius up; gravity's height series there (1 - k1 h + 3 h^2 / a^2) grows again with height
 (2 g0 at h = a, against the inverse square's g0 / 4), so a diverging height runs away."""
 POLE_COSINE = 1e-6
-"""cos L below which the computed position is at a pole (within 6 m): the north-pointing frame's azimuth rate
-v_E tan L / (R_E + h) is unbounded there."""
+"""|cos L| below which the computed position is at a pole (within 6 m): the north-pointing frame's azimuth rate
+v_E tan L / (R_E + h) is unbounded there. (Past a pole, cos L < 0, the equations hold again: the frame is the
+other side's, turned half a turn about the vertical.)"""
 HIGHEST_SPEED = 1e5
 """m/s: nine times the escape velocity; no trajectory or error the parameters allow comes near it."""
 
@@ -95,7 +96,7 @@ HIGHEST_SPEED = 1e5
 @jit
 def inside_domain(h, c, vn, ve, vd):
     """Whether a computed state is inside the mechanization's domain (bounds above)."""
-    return (LOWEST_HEIGHT < h < HIGHEST_HEIGHT and c > POLE_COSINE
+    return (LOWEST_HEIGHT < h < HIGHEST_HEIGHT and abs(c) > POLE_COSINE
             and vn * vn + ve * ve + vd * vd < HIGHEST_SPEED * HIGHEST_SPEED)
 
 

@@ -76,14 +76,14 @@ def domain_message(states: np.ndarray, ids: np.ndarray, batch: int | None, dt: f
     t = state[_kernels.LEFT_AT] * dt
     h = state[_kernels.HGT]
     speed = float(np.linalg.norm(state[_kernels.VEL:_kernels.VEL + 3]))
-    when = f"at t = {t:,.0f} s{_who(left, ids, batch)}"
+    when = f"at t = {t:,.6g} s{_who(left, ids, batch)}"
     if h <= _kernels.LOWEST_HEIGHT:
         what = (f"the computed height fell below {_kernels.LOWEST_HEIGHT / 1e3:,.0f} km (half way to the Earth's "
                 f"centre) {when}, where the navigation equations' frame rates v / (R + h) grow without bound")
     elif h >= _kernels.HIGHEST_HEIGHT:
         what = (f"the computed height rose above {_kernels.HIGHEST_HEIGHT / 1e3:,.0f} km (one Earth radius) {when}, "
                 "where gravity's height series grows again with height and the height runs away")
-    elif state[_kernels.COS_LAT] <= _kernels.POLE_COSINE:
+    elif abs(state[_kernels.COS_LAT]) <= _kernels.POLE_COSINE:
         what = (f"the computed position reached a pole {when}, where the north-pointing latitude-longitude "
                 "mechanization is singular")
     else:
@@ -122,7 +122,7 @@ def validity_messages(t_s: np.ndarray, computed_height_m: np.ndarray, attitude_e
     --------
     >>> t = np.array([0.0, 10.0])
     >>> validity_messages(t, np.array([[0.0, 2e5]]), np.zeros((1, 2, 3)), np.array([0]), None, "off")[0][:60]
-    'the computed height left -10 km .. 100 km at t = 10 s, where'
+    'the computed height left -10 km .. 100 km at t = 10 s and re'
     """
     messages = []
     low, high = VALID_HEIGHTS
@@ -135,9 +135,9 @@ def validity_messages(t_s: np.ndarray, computed_height_m: np.ndarray, attitude_e
         worst = computed_height_m[members]
         extreme = float(worst.min() if worst.min() < low else worst.max())
         hint = _FREE_HINT if vertical_channel == "free" else ""
-        messages.append(f"the computed height left {low / 1e3:,.0f} km .. {high / 1e3:,.0f} km at t = {t_s[k]:,.0f} s, "
-                        f"where WGS-84 normal gravity models the Earth's{_who(members, ids, batch)}, and reached "
-                        f"{extreme / 1e3:,.4g} km: later errors follow the model's gravity, not the Earth's{hint}")
+        messages.append(f"the computed height left {low / 1e3:,.0f} km .. {high / 1e3:,.0f} km at t = {t_s[k]:,.6g} s"
+                        f"{_who(members, ids, batch)} and reached {extreme / 1e3:,.4g} km: outside that range WGS-84 "
+                        f"normal gravity no longer models the Earth's, so later errors are the model's{hint}")
     angle = np.linalg.norm(attitude_error_rad, axis=-1)
     large = angle > SMALL_ANGLE
     if large.any():
@@ -145,7 +145,7 @@ def validity_messages(t_s: np.ndarray, computed_height_m: np.ndarray, attitude_e
         first = large.argmax(axis=1)
         member = members[np.argmin(first[members])]
         k = int(first[member])
-        messages.append(f"the attitude error passed {math.degrees(SMALL_ANGLE):.2g} deg at t = {t_s[k]:,.0f} s"
+        messages.append(f"the attitude error passed {math.degrees(SMALL_ANGLE):.2g} deg at t = {t_s[k]:,.6g} s"
                         f"{_who(members, ids, batch)} and reached {math.degrees(float(angle[members].max())):.3g} "
                         "deg: beyond the small angles of the linear error models (0.5 % from their first-order "
                         "terms), which this run no longer referees")
