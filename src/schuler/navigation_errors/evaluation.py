@@ -9,7 +9,12 @@ true, positive in the direction the source pushes them.
 Fidelities: ``simulated`` (default) takes the spherical error at the end of the
 run from the exact simulation of the error equations (matrix exponential on the
 output grid) and reports the largest difference from the closed form there;
-``closed`` takes it from the closed form and leaves the difference NaN. The
+``closed`` takes it from the closed form and leaves the difference NaN. A
+simulation that departs from the closed form by more than
+:data:`SIMULATION_TOLERANCE` of the error's size (far more Schuler periods than
+the matrix exponential holds its accuracy over) raises a
+:class:`~schuler.navigation_errors.results.SimulationAccuracyWarning`, which
+``run_case`` also keeps in the result's ``warnings``. The
 flat-Earth errors and the largest errors over the run are closed forms in both
 (the largest spherical error is exact over continuous time, not sampled).
 
