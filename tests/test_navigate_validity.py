@@ -44,7 +44,7 @@ def test_an_ideal_imu_free_channel_over_a_day_is_refused_not_reported_as_numbers
 
 
 def test_a_height_beyond_the_gravity_model_warns_and_stays_finite(run_cli):
-    # 1e-5 g down on the free channel: h = -(b / w^2)(cosh w t - 1), w^2 = g0 k1, past -10 km at 3,671 s
+    # 1e-5 g down on the free channel: h = -(b / w^2)(cosh w t - 1), w^2 = g0 k1, past -11 km at 3,725 s
     out = run_cli("navigate", "run", "--vertical-channel", "free", "--accel-bias-z", "1e-5 g", "--duration", "4800",
                   "--imu-rate", "10", "--output-step", "60", "--json")
     assert out.code == 0
@@ -53,7 +53,7 @@ def test_a_height_beyond_the_gravity_model_warns_and_stays_finite(run_cli):
     b = 1e-5 * STANDARD_GRAVITY
     assert data["final_height_error_m"] == pytest.approx(-b / w**2 * (math.cosh(w * 4800) - 1), rel=0.01)
     [message] = data["warnings"]
-    assert message.startswith("the computed height left -10 km .. 100 km at t = 3,720 s")  # the next output
+    assert message.startswith("the computed height left -11 km .. 120 km at t = 3,780 s")  # the next output
     assert out.stderr == f"schuler: warning: {message}\n"
     assert all(math.isfinite(v) for v in data["height_error_m"])
 

@@ -23,7 +23,7 @@ case (``cases.random`` None) has no noise and the model's constant errors at
 +1 sigma.
 
 Validity (:mod:`schuler.navigate.validity`): a run whose computed height leaves
--10 km .. 100 km or whose attitude error passes 0.1 rad warns (and says so in the
+-11 km .. 120 km or whose attitude error passes 0.1 rad warns (and says so in the
 result's ``warnings``); one whose state leaves the mechanization's domain (half way
 to the Earth's centre, a pole) is refused with a :class:`~schuler.exceptions.SimulationError`.
 
@@ -113,7 +113,7 @@ PARAMETERS = ParameterSet((
               "rate, the only one allowed with it).", minimum=0, exclusive_minimum=True, maximum=1e5),
     Parameter("output_step", "s", 10.0, "Step of the error histories, a whole number of IMU intervals "
               "(the largest errors are taken at these times).", minimum=0, exclusive_minimum=True, maximum=86400),
-    Parameter("vertical_channel", "", "off", "free (pure inertial, unstable: a height beyond -10 km .. 100 km warns, "
+    Parameter("vertical_channel", "", "off", "free (pure inertial, unstable: a height beyond -11 km .. 120 km warns, "
               "one half way to the Earth's centre stops the run), off (height held to the truth) or baro (third-order "
               "baro-aided loop, 100 s).", choices=VERTICAL_CHANNELS, kind="choice"),
     Parameter("mode", "", "strapdown", "strapdown, or platform (gimballed, local level, torqued at the computed "

@@ -23,10 +23,12 @@ import numpy as np
 
 from schuler.navigate import _kernels
 
-VALID_HEIGHTS = (-1e4, 1e5)
-"""Heights (m) where WGS-84 normal gravity's height series (Groves 2013, eq. (2.139)) models gravity: below -10 km
+VALID_HEIGHTS = (-1.1e4, 1.2e5)
+"""Heights (m) where WGS-84 normal gravity's height series (Groves 2013, eq. (2.139)) models gravity: below -11 km
 (deeper than the deepest ocean) it continues free-air gravity downwards, ignoring the masses above (the Bouguer
-term, 0.11 mGal/m: 1 mg at -10 km); above 100 km its truncation, 4 (h / a)^3 of g, exceeds 1.5e-5 g."""
+term, 0.11 mGal/m: 1.2 mg at -11 km); above 120 km its truncation, 4 (h / a)^3 of g, exceeds 2.7e-5 g. Both lie
+beyond the start heights the parameters allow (-10 km .. 100 km), so that a run started at a limit warns only when
+its height really leaves them."""
 
 SMALL_ANGLE = 0.1
 """Largest attitude error (rad, 5.7 deg) of the small-angle error models: their first-order terms (sin x ~ x,
@@ -122,7 +124,7 @@ def validity_messages(t_s: np.ndarray, computed_height_m: np.ndarray, attitude_e
     --------
     >>> t = np.array([0.0, 10.0])
     >>> validity_messages(t, np.array([[0.0, 2e5]]), np.zeros((1, 2, 3)), np.array([0]), None, "off")[0][:60]
-    'the computed height left -10 km .. 100 km at t = 10 s and re'
+    'the computed height left -11 km .. 120 km at t = 10 s and re'
     """
     messages = []
     low, high = VALID_HEIGHTS
