@@ -221,6 +221,18 @@ def test_three_d_command(run_cli, tmp_path):
     assert {"t_s", "position_error_north_m", "velocity_error_east_m_s", "attitude_error_down_rad"} <= set(columns)
 
 
+def test_three_d_shows_a_channel_far_smaller_than_the_other(run_cli):
+    # at the equator the channels decouple: 1e-7 m/s north gives (dV / omega) sin(omega t) = -7.8e-5 m beside
+    # 782 km east; a floor scaled by the horizontal error showed it as 0
+    args = ("errors", "three-d", "--latitude", "0", "--initial-velocity-error-east", "1000",
+            "--initial-velocity-error-north", "1e-7", "--duration", "3600")
+    north = run_cli(*args, "--json").json()["final_position_error_north_m"]
+    omega = math.sqrt(9.80665 / 6.371e6)
+    assert north == pytest.approx(1e-7 / omega * math.sin(omega * 3600), rel=1e-6)
+    out = run_cli(*args)
+    assert out.code == 0 and "-7.81755e-05 m (-0.000256481 ft), -781,755 m (-2,564,813 ft)" in out.stdout
+
+
 def test_three_d_refuses_a_down_bias_without_the_vertical_channel(run_cli):
     out = run_cli("errors", "three-d", "--accel-bias-down", "1e-4")
     assert out.code == 2 and "--accel-bias-down" in out.stderr and "vertical channel only" in out.stderr
