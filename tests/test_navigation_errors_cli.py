@@ -96,6 +96,32 @@ def test_run_human_output_and_files(run_cli, tmp_path):
     assert table["t_s"].iloc[-1] == 10_120 and len(table) == 101
 
 
+def test_run_shows_a_spherical_error_far_below_the_flat_one(run_cli):
+    # 1e8 s of 0.01 deg/h drift: flat 7.9e16 m, spherical 3.1e7 m; a floor scaled by the flat error hid the latter
+    out = run_cli("errors", "run", "--duration", "1e8")
+    assert out.code == 0 and out.stderr == "", out.stderr
+    rows = {line.split("\u2502")[1].strip(): line.split("\u2502")[2].strip()
+            for line in out.stdout.splitlines() if line.count("\u2502") == 3}
+    assert rows["spherical Earth at 1e+08 s (simulated)"] == "30,887,641 m (101,337,404 ft)"
+    assert rows["largest spherical-Earth error (closed form)"] == "30,887,641 m (101,337,404 ft)"
+    # rounding noise is still hidden: the spherical column at t = 0 reads 0, not 1e-20
+    assert run_cli("errors", "run", "--duration", "1e8", "--json").json()["warnings"] == []
+
+
+def test_run_warns_when_the_simulation_loses_its_accuracy(run_cli):
+    # R = 1 km, g = 1000 m/s^2: 1.6e8 Schuler periods of 6.3 s in 1e9 s, far past what the simulation holds
+    out = run_cli("errors", "run", "--radius", "1", "--gravity", "1000", "--duration", "1e9", "--json")
+    assert out.code == 0
+    data = out.json()
+    assert data["simulation_minus_closed_m"] / data["max_spherical_m"] == pytest.approx(0.86, abs=0.02)
+    [message] = data["warnings"]
+    assert "departs from the closed form by 0.87 of the error's size" in message and "1.59e+08 Schuler" in message
+    assert out.stderr == f"schuler: warning: {message}\n"
+    # a day on the same Earth is within the tolerance: no warning
+    quiet = run_cli("errors", "run", "--radius", "1", "--gravity", "1000", "--duration", "1 d", "--json")
+    assert quiet.stderr == "" and quiet.json()["warnings"] == []
+
+
 @pytest.mark.parametrize(
     "args, option",
     [
@@ -193,6 +219,18 @@ def test_three_d_command(run_cli, tmp_path):
     assert {"errors_three_d.png", "errors_three_d.svg", "errors_three_d_track.png", "errors_three_d.csv"} <= names
     columns = pd.read_csv(tmp_path / "errors_three_d.csv").columns
     assert {"t_s", "position_error_north_m", "velocity_error_east_m_s", "attitude_error_down_rad"} <= set(columns)
+
+
+def test_three_d_shows_a_channel_far_smaller_than_the_other(run_cli):
+    # at the equator the channels decouple: 1e-7 m/s north gives (dV / omega) sin(omega t) = -7.8e-5 m beside
+    # 782 km east; a floor scaled by the horizontal error showed it as 0
+    args = ("errors", "three-d", "--latitude", "0", "--initial-velocity-error-east", "1000",
+            "--initial-velocity-error-north", "1e-7", "--duration", "3600")
+    north = run_cli(*args, "--json").json()["final_position_error_north_m"]
+    omega = math.sqrt(9.80665 / 6.371e6)
+    assert north == pytest.approx(1e-7 / omega * math.sin(omega * 3600), rel=1e-6)
+    out = run_cli(*args)
+    assert out.code == 0 and "-7.81755e-05 m (-0.000256481 ft), -781,755 m (-2,564,813 ft)" in out.stdout
 
 
 def test_three_d_refuses_a_down_bias_without_the_vertical_channel(run_cli):

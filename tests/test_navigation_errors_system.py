@@ -136,6 +136,23 @@ def test_simulated_and_closed_fidelities_agree_to_rounding(source):
     assert simulated.fidelity == "simulated" and closed.fidelity == "closed"
 
 
+def test_evaluate_warns_once_for_the_worst_group_that_lost_its_accuracy():
+    # the drift source on a 1-km Earth: 0.87 of the error at 1e9 s, 4.6e-3 at 1e8 s; the default Earth agrees
+    from schuler.navigation_errors.evaluation import SIMULATION_TOLERANCE
+    from schuler.navigation_errors.results import SimulationAccuracyWarning
+
+    cases = [PARAMETERS.case(source="drift", radius=1e3, gravity=1e3, duration=d) for d in (1e8, 1e9)]
+    cases.append(PARAMETERS.case(source="drift", radius=MEAN_RADIUS, gravity=STANDARD_GRAVITY, duration=1e8))
+    text = ("source", "earth", "magnitude")
+    cases = Cases({name: np.array([case[name] for case in cases], dtype=object if name in text else float)
+                   for name in PARAMETERS.names}, fidelity="simulated")
+    with pytest.warns(SimulationAccuracyWarning) as caught:
+        out = evaluate(cases)
+    assert len(caught) == 1 and "by 0.87 of" in str(caught[0].message)
+    relative = out["simulation_minus_closed_m"] / out["max_spherical_m"]
+    assert np.all(relative[:2] > SIMULATION_TOLERANCE) and relative[2] < 1e-11
+
+
 def test_unknown_fidelity_is_refused():
     with pytest.raises(InvalidParameter, match="choose from simulated, closed"):
         SYSTEM.run(fidelity="rough")

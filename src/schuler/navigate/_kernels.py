@@ -30,6 +30,7 @@ unknown increment), so that the forward step reproduces the truth to rounding.
 from __future__ import annotations
 
 import math
+from typing import Final
 
 import numba
 
@@ -60,7 +61,8 @@ QUAT = 11  # q0..q3: q_bn (strapdown) or q_pn (platform: platform axes -> true N
 DTHETA_PREV = 15  # the previous step's angle increment (coning)
 DV_PREV = 18  # the previous step's velocity increment (sculling)
 BARO_BIAS = 21  # the baro loop's accelerometer-error estimate b_hat, m/s^2
-STATE_SIZE = 22
+LEFT_AT = 22  # 0 while inside the mechanization's domain; else the sample at which the member left it (stopped)
+STATE_SIZE = 23
 
 OUTPUT_SIZE = 10  # latitude, longitude, height, v_N, v_E, v_D, q0..q3
 
@@ -71,7 +73,31 @@ FAST_MATH = {"contract", "arcp", "nsz", "nnan", "ninf"}
 """LLVM may fuse multiply-adds and use reciprocals, never reassociate (the compensated sums and the series
 depend on the order of operations) nor approximate functions: 25 % faster, results within rounding."""
 
-jit = numba.njit(cache=True, fastmath=FAST_MATH)
+ERROR_MODEL: Final = "numpy"
+"""Divisions never raise inside the kernels (no zero test per division): :func:`inside_domain` stops a member
+before any denominator nears 0 or any value leaves the finite numbers that ``FAST_MATH`` assumes."""
+
+jit = numba.njit(cache=True, fastmath=FAST_MATH, error_model=ERROR_MODEL)
+
+# The domain where the mechanization's equations are defined; each step of a member checks it.
+LOWEST_HEIGHT = -0.5 * _A
+"""m: half way to the Earth's centre; the frame rates v / (R + h) grow without bound as h nears -R."""
+HIGHEST_HEIGHT = _A
+"""m: one equatorial radius up; gravity's height series there (1 - k1 h + 3 h^2 / a^2) grows again with height
+(2 g0 at h = a, against the inverse square's g0 / 4), so a diverging height runs away."""
+POLE_COSINE = 1e-6
+"""|cos L| below which the computed position is at a pole (within 6 m): the north-pointing frame's azimuth rate
+v_E tan L / (R_E + h) is unbounded there. (Past a pole, cos L < 0, the equations hold again: the frame is the
+other side's, turned half a turn about the vertical.)"""
+HIGHEST_SPEED = 1e5
+"""m/s: nine times the escape velocity; no trajectory or error the parameters allow comes near it."""
+
+
+@jit
+def inside_domain(h, c, vn, ve, vd):
+    """Whether a computed state is inside the mechanization's domain (bounds above)."""
+    return (LOWEST_HEIGHT < h < HIGHEST_HEIGHT and abs(c) > POLE_COSINE
+            and vn * vn + ve * ve + vd * vd < HIGHEST_SPEED * HIGHEST_SPEED)
 
 
 @jit

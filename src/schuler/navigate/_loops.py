@@ -3,7 +3,10 @@
 Private. Each function advances every member (in parallel over members) through
 one chunk of IMU samples, writing its state back in place and its computed
 position, velocity and attitude into the output array at every ``out_every``-th
-sample. The step equations are those of :mod:`schuler.navigate._kernels`.
+sample. The step equations are those of :mod:`schuler.navigate._kernels`. A member
+whose state leaves the mechanization's domain (:func:`~schuler.navigate._kernels.inside_domain`)
+is stopped there: its state keeps the first sample outside (``LEFT_AT`` holds its number)
+and it is skipped from then on; the caller reports it.
 
 Per-member sensor errors come as rows of 12 values: a row-major 3x3 matrix and a
 bias (rad/s or m/s^2). For the strapdown the matrix is I + S + M (measured = M
@@ -23,10 +26,12 @@ from schuler.navigate._kernels import (
     COS_LAT,
     DTHETA_PREV,
     DV_PREV,
+    ERROR_MODEL,
     FAST_MATH,
     HELD,
     HGT,
     LAT,
+    LEFT_AT,
     LON,
     QUAT,
     SIN_LAT,
@@ -36,6 +41,7 @@ from schuler.navigate._kernels import (
     attitude_step,
     frame_step,
     geometry,
+    inside_domain,
     normalize,
     position_step,
     quat_from_rotation_vector,
@@ -46,7 +52,7 @@ from schuler.navigate._kernels import (
 )
 
 
-@numba.njit(cache=True, fastmath=FAST_MATH)
+@numba.njit(cache=True, fastmath=FAST_MATH, error_model=ERROR_MODEL)
 def _vertical(mode, h, vd, vd1, dt, h_true, vd_true, baro_error, k1, k2, k3, b_hat):
     """Vertical channel after the velocity update: returns (v_D, height override, use it, b_hat).
 
@@ -63,7 +69,7 @@ def _vertical(mode, h, vd, vd1, dt, h_true, vd_true, baro_error, k1, k2, k3, b_h
     return vd1, 0.0, False, b_hat
 
 
-@numba.njit(cache=True, parallel=True, fastmath=FAST_MATH)
+@numba.njit(cache=True, parallel=True, fastmath=FAST_MATH, error_model=ERROR_MODEL)
 def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, accel, gyro_noise, accel_noise,
                     has_noise, out, out_every, vertical_mode, baro, rate, coriolis, centripetal, entered_earth_rate,
                     use_entered):
@@ -107,6 +113,8 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
     k1, k2, k3, baro_error = baro[0], baro[1], baro[2], baro[3]
     for m in numba.prange(n_members):
         st = state[m]
+        if st[LEFT_AT] != 0.0:  # stopped when it left the domain
+            continue
         lat, lon, h = st[LAT], st[LON], st[HGT]
         vn, ve, vd = st[VEL], st[VEL + 1], st[VEL + 2]
         vnp, vep, vdp = st[VEL_PREV], st[VEL_PREV + 1], st[VEL_PREV + 2]
@@ -157,6 +165,9 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
             vn, ve, vd = vn1, ve1, vd1
             t0, t1, t2 = d0, d1, d2
             u0, u1, u2 = e0, e1, e2
+            if not inside_domain(h, c, vn, ve, vd):
+                st[LEFT_AT] = first_sample + k + 1
+                break
             countdown -= 1
             if countdown == 0:  # the sample first_sample + k + 1 is an output time
                 countdown = out_every
@@ -171,7 +182,7 @@ def strapdown_chunk(dt, first_sample, increments, truth_vertical, state, gyro, a
         st[BARO_BIAS] = b_hat
 
 
-@numba.njit(cache=True, parallel=True, fastmath=FAST_MATH)
+@numba.njit(cache=True, parallel=True, fastmath=FAST_MATH, error_model=ERROR_MODEL)
 def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro, accel, gyro_noise, accel_noise,
                    has_noise, out, out_every, vertical_mode, baro, rate, coriolis, centripetal, entered_earth_rate,
                    use_entered, slave_azimuth):
@@ -195,6 +206,8 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
     k1, k2, k3, baro_error = baro[0], baro[1], baro[2], baro[3]
     for m in numba.prange(n_members):
         st = state[m]
+        if st[LEFT_AT] != 0.0:  # stopped when it left the domain
+            continue
         lat, lon, h = st[LAT], st[LON], st[HGT]
         vn, ve, vd = st[VEL], st[VEL + 1], st[VEL + 2]
         vnp, vep, vdp = st[VEL_PREV], st[VEL_PREV + 1], st[VEL_PREV + 2]
@@ -248,6 +261,9 @@ def platform_chunk(dt, first_sample, nav_increments, truth_vertical, state, gyro
             q0, q1, q2, q3 = n0, n1, n2, n3
             vnp, vep, vdp = vn, ve, vd
             vn, ve, vd = vn1, ve1, vd1
+            if not inside_domain(h, c, vn, ve, vd):
+                st[LEFT_AT] = first_sample + k + 1
+                break
             countdown -= 1
             if countdown == 0:  # the sample first_sample + k + 1 is an output time
                 countdown = out_every

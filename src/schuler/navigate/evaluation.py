@@ -22,6 +22,11 @@ error model's constant errors and noise, all at its member number; the nominal
 case (``cases.random`` None) has no noise and the model's constant errors at
 +1 sigma.
 
+Validity (:mod:`schuler.navigate.validity`): a run whose computed height leaves
+-11 km .. 120 km or whose attitude error passes 0.1 rad warns (and says so in the
+result's ``warnings``); one whose state leaves the mechanization's domain (half way
+to the Earth's centre, a pole) is refused with a :class:`~schuler.exceptions.SimulationError`.
+
 Memory: a run holds its error histories (N members x outputs x 23 values) and
 one block of truth and noise; members are evaluated in parts that fit a
 quarter of the budget (:mod:`schuler.memory`), and a single member that does not
@@ -108,8 +113,9 @@ PARAMETERS = ParameterSet((
               "rate, the only one allowed with it).", minimum=0, exclusive_minimum=True, maximum=1e5),
     Parameter("output_step", "s", 10.0, "Step of the error histories, a whole number of IMU intervals "
               "(the largest errors are taken at these times).", minimum=0, exclusive_minimum=True, maximum=86400),
-    Parameter("vertical_channel", "", "off", "free (pure inertial, unstable), off (height held to the truth) or "
-              "baro (third-order baro-aided loop, 100 s).", choices=VERTICAL_CHANNELS, kind="choice"),
+    Parameter("vertical_channel", "", "off", "free (pure inertial, unstable: a height beyond -11 km .. 120 km warns, "
+              "one half way to the Earth's centre stops the run), off (height held to the truth) or baro (third-order "
+              "baro-aided loop, 100 s).", choices=VERTICAL_CHANNELS, kind="choice"),
     Parameter("mode", "", "strapdown", "strapdown, or platform (gimballed, local level, torqued at the computed "
               "frame rate).", choices=MODES, kind="choice"),
     Parameter("position_error_north", "m", 0.0, "Initial error Delta latitude (R_N + h), computed - true.",
@@ -430,7 +436,8 @@ def run_case(case: Case, fidelity: str | None = None) -> NavigateResult:
         trajectory=name, mode=shared.mode, vertical_channel=shared.vertical_channel,
         imu=_imu_name(case, shared), duration_s=shared.duration,
         imu_rate_hz=shared.imu_rate, output_step_s=shared.output_step,
-        errors={key: float(values[0]) for key, values in reduce(result).items()}, navigation=result)
+        errors={key: float(values[0]) for key, values in reduce(result).items()}, navigation=result,
+        warnings=list(result.warnings))
 
 
 def member_bytes(case: Case) -> int:

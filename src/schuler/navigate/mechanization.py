@@ -45,10 +45,12 @@ Examples
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE, radii_of_curvature, somigliana_gravity
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, SimulationError
 from schuler.navigate import _kernels, _loops
 from schuler.navigate.attitude import (
     attitude_error,
@@ -62,6 +64,7 @@ from schuler.navigate.attitude import (
 from schuler.navigate.errors import InitialErrors, SensorErrors, SensorNoise
 from schuler.navigate.results import NavigationResult, TruthSamples
 from schuler.navigate.truth import DEFAULT_CHUNK, TruthGenerator
+from schuler.navigate.validity import ModelValidityWarning, domain_message, validity_messages
 from schuler.navigation_errors.vertical_channel import critically_damped_gains
 
 MODES = ("strapdown", "platform")
@@ -312,6 +315,15 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
     ------
     InvalidParameter
         For a bad argument or a run that would not fit in ``max_memory``.
+    SimulationError
+        When a member's computed state leaves the mechanization's domain (:mod:`schuler.navigate.validity`):
+        the run stops at the end of that block of samples.
+
+    Warns
+    -----
+    ModelValidityWarning
+        When the computed height or the attitude error leaves the models' validity (also in the
+        result's ``warnings``).
     """
     _check_choice("mode", mode, MODES)
     entered = _check_choice("earth_rate_latitude", earth_rate_latitude, ("computed", "true")) == 1
@@ -372,14 +384,22 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
         kernel(generator.dt, part.start, sensed, vertical, states, gyro, accel, gyro_noise, accel_noise,
                noise is not None, out, every, vertical_code, baro, generator.earth_rate, *flags, entered_rate, entered,
                *((azimuth_reference,) if platform else ()))
+        if states[:, _kernels.LEFT_AT].any():
+            raise SimulationError(domain_message(states, ids, batch, generator.dt, vertical_channel))
         ends = part.start + np.arange(1, n + 1)
         rows = np.flatnonzero(ends % every == 0)
         truth[ends[rows] // every] = np.concatenate([part.positions[rows], part.velocities[rows],
                                                      part.quaternions[rows]], axis=1)
         if means is not None and n_out > 1:
             means.add(part)
-    return _result(out, truth, generator, every, mode, vertical_channel, batch,
-                   means.means() if means is not None else None)
+    result = _result(out, truth, generator, every, mode, vertical_channel, batch,
+                     means.means() if means is not None else None)
+    result.warnings = validity_messages(result.t_s, out[..., 2], np.reshape(result.attitude_error_rad,
+                                                                             (n_members, n_out, 3)),
+                                        ids, batch, vertical_channel)
+    for message in result.warnings:
+        warnings.warn(message, ModelValidityWarning, stacklevel=2)
+    return result
 
 
 def _result(out, truth, generator, every, mode, vertical_channel, batch, interval_means) -> NavigationResult:

@@ -60,6 +60,7 @@ class NavigationResult(Result):
     Single runs give arrays of shape (n_out,); a batch of N members gives
     (N, n_out). ``attitude_error_rad`` is the error rotation vector phi in NED
     (C_computed = (I - [phi x]) C_true to first order), shape (..., n_out, 3).
+    ``warnings`` says where the run left its models' validity (:mod:`schuler.navigate.validity`).
     """
 
     mode: str
@@ -79,6 +80,7 @@ class NavigationResult(Result):
     heading_error_rad: np.ndarray
     attitude_error_rad: np.ndarray = field(repr=False)
     truth: TruthSamples = field(repr=False)
+    warnings: list[str] = field(default_factory=list)
 
     units: ClassVar[dict[str, str]] = {"imu_rate_hz": "Hz", "output_step_s": "s",
                                        "members": "batch size (null for a single run)"}
@@ -154,6 +156,8 @@ class NavigateResult(RunResult):
     navigation : NavigationResult
         The run (histories of shape (1, n_out)); :meth:`to_dict` gives ``t_s`` and
         each channel's history, the vertical ones only when the channel is on.
+    warnings : list of str
+        Where the run left its models' validity (also warned on stderr).
     """
 
     trajectory: str
@@ -165,6 +169,7 @@ class NavigateResult(RunResult):
     output_step_s: float
     errors: dict[str, float] = field(repr=False)
     navigation: NavigationResult = field(repr=False)
+    warnings: list[str] = field(default_factory=list)
 
     units: ClassVar[dict[str, str]] = {"imu_rate_hz": "Hz"}
 

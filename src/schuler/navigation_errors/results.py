@@ -21,6 +21,14 @@ from schuler.units import to_unit
 LENGTH_UNITS = ("m", "ft")
 """Units in which human output shows lengths."""
 
+NOISE_FRACTION = 1e-9
+"""Below this fraction of its own series' largest magnitude a length shows as 0 (rounding noise, as the sine of a
+whole number of periods): each series (flat, spherical) has its own scale."""
+
+
+class SimulationAccuracyWarning(UserWarning):
+    """The simulated error departs from the closed form beyond the simulation's accuracy."""
+
 
 def length_text(value_si: float | None, unit: str, floor: float = 0.0) -> str:
     """A length for people: thousands separated, no float noise below ``floor`` (m), no negative zero.
@@ -82,7 +90,8 @@ class ErrorRunResult(RunResult):
     ``fidelity="simulated"`` ``final_spherical_m`` is the simulated error and
     ``simulation_minus_closed_m`` the largest difference from the closed form on
     the output grid; with ``"closed"`` both come from the closed form (the
-    difference is NaN). Histories ``t_s``, ``flat_m``, ``spherical_m`` (closed
+    difference is NaN). ``warnings`` holds what the run warned of (a simulation
+    that lost its accuracy), also shown on stderr. Histories ``t_s``, ``flat_m``, ``spherical_m`` (closed
     forms) and ``simulated_m`` (None with ``"closed"``) feed the figures and
     CSV, not ``to_dict()``.
     """
@@ -105,6 +114,7 @@ class ErrorRunResult(RunResult):
     flat_m: np.ndarray = field(repr=False)
     spherical_m: np.ndarray = field(repr=False)
     simulated_m: np.ndarray | None = field(default=None, repr=False)
+    warnings: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
         data = super().to_dict()
@@ -117,7 +127,8 @@ class ErrorRunResult(RunResult):
 
         from schuler.navigation_errors.plots import SOURCE_TITLES
 
-        floor = 1e-9 * max(abs(self.max_flat_m), abs(self.max_spherical_m), 1e-300)
+        flat_floor = NOISE_FRACTION * abs(self.max_flat_m)
+        spherical_floor = NOISE_FRACTION * abs(self.max_spherical_m)
         shown_unit = SOURCE_UNITS[self.source]
         summary = Table(title=f"{SOURCE_TITLES[self.source]} of {to_unit(self.magnitude, shown_unit):.6g} "
                               f"{shown_unit} ({self.earth} Earth, {self.fidelity})", show_header=False)
@@ -128,10 +139,10 @@ class ErrorRunResult(RunResult):
         rows = [
             ("Schuler period", f"{self.schuler_period_s:,.1f} s ({self.schuler_period_s / 60:.2f} min)"),
             ("radius R, gravity g", f"{self.radius_m / 1e3:,.1f} km, {self.gravity_m_s2:.5g} m/s^2"),
-            (f"flat Earth at {end}", lengths(self.final_flat_m, floor)),
-            (f"spherical Earth at {end} ({spherical_how})", lengths(self.final_spherical_m, floor)),
-            ("largest flat-Earth error", lengths(self.max_flat_m, floor)),
-            ("largest spherical-Earth error (closed form)", lengths(self.max_spherical_m, floor)),
+            (f"flat Earth at {end}", lengths(self.final_flat_m, flat_floor)),
+            (f"spherical Earth at {end} ({spherical_how})", lengths(self.final_spherical_m, spherical_floor)),
+            ("largest flat-Earth error", lengths(self.max_flat_m, flat_floor)),
+            ("largest spherical-Earth error (closed form)", lengths(self.max_spherical_m, spherical_floor)),
         ]
         if self.fidelity == "simulated":
             rows.append(("simulation - closed form (largest)", f"{self.simulation_minus_closed_m:.3g} m"))
@@ -142,10 +153,10 @@ class ErrorRunResult(RunResult):
         for column in columns:
             series.add_column(column, justify="right")
         for k in sample_indices(self.t_s.size):
-            cells = [f"{self.t_s[k]:,.6g}", length_text(self.flat_m[k], "m", floor),
-                     length_text(self.spherical_m[k], "m", floor)]
+            cells = [f"{self.t_s[k]:,.6g}", length_text(self.flat_m[k], "m", flat_floor),
+                     length_text(self.spherical_m[k], "m", spherical_floor)]
             if self.simulated_m is not None:
-                cells.append(length_text(self.simulated_m[k], "m", floor))
+                cells.append(length_text(self.simulated_m[k], "m", spherical_floor))
             series.add_row(*cells)
         parts = [summary, series]
         if self.monte_carlo is not None:

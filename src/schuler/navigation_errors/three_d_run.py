@@ -56,7 +56,7 @@ from schuler.navigation_errors.inputs import (
     grid_points,
     time_grid,
 )
-from schuler.navigation_errors.results import lengths, sample_indices
+from schuler.navigation_errors.results import NOISE_FRACTION, lengths, sample_indices
 from schuler.navigation_errors.three_d import psi_angle_model
 from schuler.params import Parameter, ParameterSet
 from schuler.results import Result
@@ -140,7 +140,10 @@ class ThreeDResult(Result):
         from rich.console import Group
         from rich.table import Table
 
-        floor = 1e-9 * max(self.max_horizontal_position_error_m, 1e-300)
+        # each channel hides rounding noise against its own scale: one channel may be far smaller, yet real
+        north_floor, east_floor = (NOISE_FRACTION * float(np.max(np.abs(self.histories[f"position_error_{axis}"])))
+                                   for axis in ("north", "east"))
+        horizontal_floor = NOISE_FRACTION * self.max_horizontal_position_error_m
         title = (f"3-D psi-angle errors at {math.degrees(self.latitude_rad):.6g} deg, V_N = "
                  f"{self.velocity_north_m_s:g} m/s, V_E = {self.velocity_east_m_s:g} m/s, {self.duration_s:,.6g} s")
         summary = Table(title=title, show_header=False)
@@ -151,9 +154,9 @@ class ThreeDResult(Result):
         rows = [
             ("Schuler period, Foucault rate Omega sin L",
              f"{self.schuler_period_s / 60:.2f} min, {foucault}"),
-            ("position error north, east at the end", (f"{lengths(self.final_position_error_north_m, floor)}, "
-                                                      f"{lengths(self.final_position_error_east_m, floor)}")),
-            ("largest horizontal position error", lengths(self.max_horizontal_position_error_m, floor)),
+            ("position error north, east at the end", (f"{lengths(self.final_position_error_north_m, north_floor)}, "
+                                                      f"{lengths(self.final_position_error_east_m, east_floor)}")),
+            ("largest horizontal position error", lengths(self.max_horizontal_position_error_m, horizontal_floor)),
             ("velocity error north, east at the end",
              f"{self.final_velocity_error_north_m_s:.4g} m/s, {self.final_velocity_error_east_m_s:.4g} m/s"),
             ("attitude error psi north, east, down at the end",
