@@ -295,15 +295,14 @@ def partial_rotations(rates: np.ndarray, lengths: np.ndarray, dt: float, noise: 
 
 @numba.njit(cache=True, nogil=True)
 def staged_gyrocompass_loop(gyro: np.ndarray, accel: np.ndarray, dt: float, attitude: np.ndarray,
-                            earth_rate: np.ndarray, gravity: float, stage_ends: np.ndarray, k_velocity: np.ndarray,
-                            k_level: np.ndarray, k_azimuth: np.ndarray, ends: np.ndarray,
-                            attitude_out: np.ndarray) -> None:
+                            earth_rate: np.ndarray, gravity: float, k_velocity: np.ndarray, k_level: np.ndarray,
+                            k_azimuth: np.ndarray, ends: np.ndarray, attitude_out: np.ndarray) -> None:
     """The staged strapdown gyrocompass: a computed level frame torqued by its own computed velocity.
 
     Per sample the horizontal velocity v in the computed frame integrates the sensed specific force and is
     damped, v += (C dv)_h - k1 v dt, and the frame turns at omega_ie + u with
     u = (k2 v_E / g, -k2 v_N / g, -k3 v_N / g) (see :mod:`~schuler.alignment.staged_gyrocompass`).
-    The gains are constant over each stage.
+    The gains follow the design's schedule, one value per sample.
 
     Parameters
     ----------
@@ -317,10 +316,8 @@ def staged_gyrocompass_loop(gyro: np.ndarray, accel: np.ndarray, dt: float, atti
         omega_ie^n, rad/s.
     gravity : float
         g, m/s^2.
-    stage_ends : ndarray (S,) of int
-        Sample count at which each stage ends (the last at least n).
-    k_velocity, k_level, k_azimuth : ndarray (S,)
-        k1 (1/s), k2 (1/s^2) and k3 (1/s^2) of each stage.
+    k_velocity, k_level, k_azimuth : ndarray (n,)
+        k1 (1/s), k2 (1/s^2) and k3 (1/s^2) over each sample.
     ends : ndarray (K,) of int
         Sample counts at which to write ``attitude_out`` (m, K, 3, 3).
     """
@@ -340,11 +337,8 @@ def staged_gyrocompass_loop(gyro: np.ndarray, accel: np.ndarray, dt: float, atti
         v_n = 0.0
         v_e = 0.0
         out = 0
-        stage = 0
         for k in range(n):
-            while stage < stage_ends.size - 1 and k >= stage_ends[stage]:
-                stage += 1
-            k1, k2, k3 = k_velocity[stage], k_level[stage], k_azimuth[stage]
+            k1, k2, k3 = k_velocity[k], k_level[k], k_azimuth[k]
             for i in range(3):
                 dtheta[i] = gyro[member, k, i]
                 dv[i] = accel[member, k, i]

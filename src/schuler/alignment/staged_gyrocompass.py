@@ -1,11 +1,12 @@
 """The strapdown gyrocompass for a disturbed base: levelling, then azimuth, each loop driven by velocity.
 
-Structure (the compass alignment of strapdown practice: Titterton, D. H. and
-Weston, J. L., *Strapdown Inertial Navigation Technology*, 2nd ed., IET, 2004,
-ch. 10, "gyrocompass alignment"; Savage, P. G., *Strapdown Analytics*, Strapdown
-Associates, 2000, ch. 6 on initial alignment; Yan Gongmin's compass alignment
-in the PSINS toolbox, as described in Qin Yongyuan, *Inertial Navigation*,
-Science Press, 2006, ch. 9). A computed level frame C_b^n is carried by the
+Structure: the compass (gyrocompass) alignment of strapdown practice, levelling
+loops first and the azimuth loop after them, each a second- or third-order loop fed
+by the velocity the computed frame accumulates (Titterton, D. H. and Weston, J. L.,
+*Strapdown Inertial Navigation Technology*, 2nd ed., IET, 2004, ch. 10, gyrocompass
+alignment; Savage, P. G., *Strapdown Analytics*, Strapdown Associates, 2000, on
+initial alignment; the compass alignment of Yan Gongmin's PSINS toolbox works the
+same way). A computed level frame C_b^n is carried by the
 gyros; the horizontal velocity v in it integrates the sensed specific force and
 is damped, and v, not the specific force itself, torques the frame:
 
@@ -27,7 +28,7 @@ Its roots are placed at a level pair (natural frequency omega_L, damping zeta) a
 an azimuth root -sigma: k1 = 2 zeta omega_L + sigma, k2 = omega_L^2 + 2 zeta omega_L sigma - W^2,
 k3 = (sigma omega_L^2 - k1 W^2) / W (:func:`stage_gains`).
 
-Stages (:func:`design_gyrocompass`), each with constant gains (level damping zeta = 1/sqrt(2)):
+Stages (:func:`design_gyrocompass`; level damping zeta = 1/sqrt(2); the gains follow from omega_L and sigma):
 
 1. coarse levelling: natural period 10 s, azimuth open (k3 = 0), 4 envelope time constants 1 / (zeta omega_L);
 2. fine levelling at omega_L = sqrt(1 + 4 zeta^2) g N_g / N_a, the bandwidth that minimises the level loop's
@@ -38,16 +39,20 @@ Stages (:func:`design_gyrocompass`), each with constant gains (level damping zet
    constants (a start error shrinks by e^-5; at most half of what is left of the window);
 4. fine azimuth to the window's end, the time constant 1 / sigma growing with the time t spent in it as
    the minimum-variance estimate of a constant seen in white noise does (Gelb, A. (ed.), *Applied Optimal
-   Estimation*, MIT Press, 1974, sec. 4.2): sigma = 1 / (tau0 + t), with tau0 = q / P0 = 2 / sigma_max
-   from the heading variance P0 = q sigma_max / 2 the coarse azimuth stage leaves for the east gyro noise
-   seen as heading, q = (N_E / W)^2; sigma is held constant over sub-stages of doubling length.
+   Estimation*, MIT Press, 1974, sec. 4.2): sigma = 1 / (tau0 + t). The optimal tau0 is q / P0, q =
+   (N_E / W)^2 the east gyro noise seen as heading and P0 = q sigma_max / 2 the heading variance the coarse
+   azimuth stage leaves, so 2 / sigma_max; tau0 = 1 / sigma_max is taken instead, so that k3 has no step:
+   a step in k3 freezes the sway's heading ripple k3 X / g into the heading, which then decays only as
+   slowly as the fine stage averages.
 
 Stated limit (:func:`staged_limit`): its noise part is the exact 1-sigma of the
-linear error model above (both channels, Omega sin L coupling included) driven by
-the sensors' white noise through the stages from the start's own uncertainty
-(covariance propagated stage by stage, Van Loan's method); its bias part is the
-last stage's steady error for the constant errors, -b_gE / (W) (the east drift over
-Omega cos L) plus the loop's small own terms.
+linear error model above (both channels, the Omega sin L coupling included) driven by
+the sensors' white noise through the stages from the start's own noise (covariance
+propagated in steps of 1 s, Van Loan's method); its bias part is the steady error at
+the end's gains for the constant errors: the east drift over Omega cos L,
+-b_gE / W, the accelerometer's b_aE tan L / g, and the loop's small own terms. It
+leaves out what the base's motion does, which :mod:`~schuler.alignment.sway` measures
+(tests/test_alignment_staged.py).
 """
 
 from __future__ import annotations
@@ -100,54 +105,67 @@ COARSE_AZIMUTH_SHARE = 0.5
 
 @dataclass(frozen=True)
 class Stage:
-    """One stage of the loop: its span and its constant gains (SI).
+    """One stage of the loop: its span, its level loop and its azimuth root (SI).
 
     Attributes
     ----------
     name : str
-        ``coarse levelling``, ``fine levelling`` or ``azimuth``.
+        ``coarse levelling``, ``fine levelling``, ``coarse azimuth`` or ``fine azimuth``.
     start_s, end_s : float
         Span from the window's start, s.
-    k_velocity, k_level, k_azimuth : float
-        k1 (1/s), k2 (1/s^2), k3 (1/s^2) of the module notes.
     level_period_s : float
         Natural period 2 pi / omega_L of the level loop, s.
     azimuth_time_constant_s : float or None
-        1 / sigma of the azimuth root, s (None: azimuth open).
+        1 / sigma of the azimuth root at the stage's start, s (None: azimuth open).
+    growing : bool
+        The azimuth time constant grows by the time spent in the stage (fine azimuth).
     """
 
     name: str
     start_s: float
     end_s: float
-    k_velocity: float
-    k_level: float
-    k_azimuth: float
     level_period_s: float
     azimuth_time_constant_s: float | None
+    growing: bool = False
+
+    def azimuth_rate(self, time_s):
+        """sigma at times ``time_s`` (s from the window's start) inside the stage, 1/s (0: azimuth open).
+
+        Parameters
+        ----------
+        time_s : ndarray
+            Times, s from the window's start.
+        """
+        time_s = np.asarray(time_s, dtype=float)
+        if self.azimuth_time_constant_s is None:
+            return np.zeros_like(time_s)
+        if not self.growing:
+            return np.full_like(time_s, 1.0 / self.azimuth_time_constant_s)
+        return 1.0 / (self.azimuth_time_constant_s + (time_s - self.start_s))
 
 
-def stage_gains(level_frequency: float, azimuth_rate: float, latitude: float) -> tuple[float, float, float]:
+def stage_gains(level_frequency: float, azimuth_rate, latitude: float):
     """(k1, k2, k3) placing the north channel's roots at the level pair and -sigma (module notes).
 
     Parameters
     ----------
     level_frequency : float
         omega_L of the level loop, rad/s.
-    azimuth_rate : float
+    azimuth_rate : float or ndarray
         sigma of the azimuth root, 1/s (0: azimuth open, k3 = 0).
     latitude : float
         L, rad.
 
     Returns
     -------
-    k1, k2, k3 : float
-        1/s, 1/s^2, 1/s^2.
+    k1, k2, k3 : ndarray
+        1/s, 1/s^2, 1/s^2, the shape of ``azimuth_rate``.
     """
     rate = float(horizontal_rate(latitude))
-    w, sigma = level_frequency, azimuth_rate
+    w, sigma = level_frequency, np.asarray(azimuth_rate, dtype=float)
     k1 = 2.0 * LEVEL_DAMPING * w + sigma
     k2 = w**2 + 2.0 * LEVEL_DAMPING * w * sigma - rate**2
-    k3 = (sigma * w**2 - k1 * rate**2) / rate if sigma > 0 else 0.0
+    k3 = np.where(sigma > 0, (sigma * w**2 - k1 * rate**2) / rate, 0.0)
     return k1, k2, k3
 
 
@@ -198,29 +216,51 @@ def _start_noise(errors, latitude: float, heading: float, initial_window: float,
 
 @dataclass(frozen=True)
 class GyrocompassDesign:
-    """The stages of one window's loop, and the noise they were chosen from.
+    """The stages of one window's loop.
 
     Attributes
     ----------
     stages : tuple of Stage
-    fine_level_period_s : float
-        2 pi / omega_L of the fine levelling and azimuth stages, s.
-    start_tau_s : float
-        tau0 of the fine azimuth stages, s.
+        In time order, the first starting at 0 s and the last ending at the window's end.
     """
 
     stages: tuple[Stage, ...]
-    fine_level_period_s: float
-    start_tau_s: float
 
     def as_dicts(self) -> list[dict]:
         """The stages as plain dictionaries (JSON)."""
         return [asdict(stage) for stage in self.stages]
 
+    def gains(self, time_s, latitude: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(k1, k2, k3) at times ``time_s`` (s from the window's start; beyond the last stage: its end gains).
+
+        Parameters
+        ----------
+        time_s : ndarray
+            Times, s.
+        latitude : float
+            L, rad.
+
+        Returns
+        -------
+        k1, k2, k3 : ndarray
+            1/s, 1/s^2, 1/s^2, one per time.
+        """
+        time_s = np.asarray(time_s, dtype=float)
+        ends = np.array([stage.end_s for stage in self.stages])
+        which = np.minimum(np.searchsorted(ends, time_s, side="right"), len(self.stages) - 1)
+        gains = np.empty((3, time_s.size))
+        for index, stage in enumerate(self.stages):
+            chosen = which == index
+            if np.any(chosen):
+                inside = np.minimum(time_s[chosen], stage.end_s)
+                gains[:, chosen] = stage_gains(2.0 * math.pi / stage.level_period_s,
+                                               stage.azimuth_rate(inside), latitude)
+        return gains[0], gains[1], gains[2]
+
 
 def design_gyrocompass(errors, *, latitude: float, duration: float,
                        gravity: float = STANDARD_GRAVITY) -> GyrocompassDesign:
-    """The stages and gains for a window of ``duration`` s and these sensors (module notes).
+    """The stages for a window of ``duration`` s and these sensors (module notes).
 
     Parameters
     ----------
@@ -246,6 +286,7 @@ def design_gyrocompass(errors, *, latitude: float, duration: float,
     """
     if not (math.isfinite(duration) and duration > 0):
         raise InvalidParameter("duration", f"must be finite and > 0 s, got {duration!r}")
+    horizontal_rate(latitude)    # refuses a latitude where heading is unobservable
     n_g = float(np.mean(errors.gyro.random_walk[:2]))
     n_a = float(np.mean(errors.accel.random_walk[:2]))
     shortest, longest = (2.0 * math.pi / period for period in FINE_LEVEL_PERIOD_RANGE_S)
@@ -253,26 +294,16 @@ def design_gyrocompass(errors, *, latitude: float, duration: float,
     coarse = 2.0 * math.pi / COARSE_LEVEL_PERIOD_S
     coarse_end = min(STAGE_TIME_CONSTANTS / (LEVEL_DAMPING * coarse), LEVELLING_SHARE[0] * duration)
     fine_end = coarse_end + min(STAGE_TIME_CONSTANTS / (LEVEL_DAMPING * fine), LEVELLING_SHARE[1] * duration)
-    stages = [Stage("coarse levelling", 0.0, coarse_end, *stage_gains(coarse, 0.0, latitude),
-                    2.0 * math.pi / coarse, None),
-              Stage("fine levelling", coarse_end, fine_end, *stage_gains(fine, 0.0, latitude), 2.0 * math.pi / fine,
-                    None)]
     fastest = LEVEL_DAMPING * fine / AZIMUTH_SEPARATION
-    remaining = duration - fine_end
-    coarse_azimuth = min(AZIMUTH_SETTLING / fastest, COARSE_AZIMUTH_SHARE * remaining)
-    stages.append(Stage("coarse azimuth", fine_end, fine_end + coarse_azimuth, *stage_gains(fine, fastest, latitude),
-                        2.0 * math.pi / fine, 1.0 / fastest))
-    # the coarse azimuth loop leaves a heading variance of about q / (2 tau_min): tau0 = q / P0 = 2 tau_min
-    tau0 = 2.0 / fastest
-    elapsed, remaining = 0.0, remaining - coarse_azimuth
-    start = fine_end + coarse_azimuth
-    while elapsed < remaining:
-        end = min(2.0 * elapsed + tau0, remaining)
-        tau = tau0 + (elapsed + end) / 2.0
-        stages.append(Stage("fine azimuth", start + elapsed, start + end, *stage_gains(fine, 1.0 / tau, latitude),
-                            2.0 * math.pi / fine, tau))
-        elapsed = end
-    return GyrocompassDesign(tuple(stages), 2.0 * math.pi / fine, tau0)
+    azimuth_end = fine_end + min(AZIMUTH_SETTLING / fastest, COARSE_AZIMUTH_SHARE * (duration - fine_end))
+    fine_period = 2.0 * math.pi / fine
+    return GyrocompassDesign((
+        Stage("coarse levelling", 0.0, coarse_end, COARSE_LEVEL_PERIOD_S, None),
+        Stage("fine levelling", coarse_end, fine_end, fine_period, None),
+        Stage("coarse azimuth", fine_end, azimuth_end, fine_period, 1.0 / fastest),
+        # sigma = 1 / (tau0 + t) from tau0 = 1 / sigma_max: no step in k3, which would freeze the sway's
+        # heading ripple k3 X / g into the heading
+        Stage("fine azimuth", azimuth_end, duration, fine_period, 1.0 / fastest, growing=True)))
 
 
 def _propagate(A: np.ndarray, intensity: np.ndarray, span: float) -> tuple[np.ndarray, np.ndarray]:
@@ -280,17 +311,11 @@ def _propagate(A: np.ndarray, intensity: np.ndarray, span: float) -> tuple[np.nd
     from scipy.linalg import expm
 
     size = A.shape[0]
-    steps = max(1, math.ceil(span / PROPAGATION_STEP_S))
     M = np.zeros((2 * size, 2 * size))
     M[:size, :size], M[:size, size:], M[size:, size:] = -A, intensity, A.T
-    E = expm(M * (span / steps))
-    step = E[size:, size:].T
-    step_noise = step @ E[:size, size:]
-    # short steps keep the exponential of the stiff (fast level, slow azimuth) system accurate
-    transition, driven = np.eye(size), np.zeros((size, size))
-    for _ in range(steps):
-        transition, driven = step @ transition, step @ driven @ step.T + step_noise
-    return transition, driven
+    E = expm(M * span)
+    transition = E[size:, size:].T
+    return transition, transition @ E[:size, size:]
 
 
 def staged_limit(errors, design: GyrocompassDesign, *, latitude: float, heading: float,
@@ -320,12 +345,18 @@ def staged_limit(errors, design: GyrocompassDesign, *, latitude: float, heading:
     accel_noise = _north_east_down(heading, errors.accel.random_walk)
     intensity = np.diag(np.square(gyro_noise + accel_noise))
     P = _start_noise(errors, latitude, heading, initial_window, gravity)
-    for stage in design.stages:
-        A, B = error_model(latitude, stage.k_velocity, stage.k_level, stage.k_azimuth, gravity)
-        transition, driven = _propagate(A, B @ intensity @ B.T, stage.end_s - stage.start_s)
+    # steps of at most PROPAGATION_STEP_S inside each stage, the gains taken at each step's middle
+    edges = np.unique(np.concatenate([np.linspace(stage.start_s, stage.end_s,
+                                                  max(2, math.ceil((stage.end_s - stage.start_s)
+                                                                   / PROPAGATION_STEP_S) + 1))
+                                      for stage in design.stages]))
+    k1, k2, k3 = design.gains((edges[:-1] + edges[1:]) / 2.0, latitude)
+    for step in range(edges.size - 1):
+        A, B = error_model(latitude, k1[step], k2[step], k3[step], gravity)
+        transition, driven = _propagate(A, B @ intensity @ B.T, edges[step + 1] - edges[step])
         P = transition @ P @ transition.T + driven
-    last = design.stages[-1]
-    A, B = error_model(latitude, last.k_velocity, last.k_level, last.k_azimuth, gravity)
+    end_k1, end_k2, end_k3 = design.gains(np.array([design.stages[-1].end_s]), latitude)
+    A, B = error_model(latitude, float(end_k1[0]), float(end_k2[0]), float(end_k3[0]), gravity)
     steady = -np.linalg.solve(A, B)      # (5, 6): steady error per unit constant input
     gyro_b, accel_b = effective_bias_sigma(errors, gravity)
     bias_sigma = np.array(_north_east_down(heading, gyro_b) + _north_east_down(heading, accel_b))
@@ -361,13 +392,10 @@ def align_staged_gyrocompass(batch: StaticBatch, design: GyrocompassDesign, *, i
     dt = batch.sample_interval_s
     attitude = start_attitude(batch.head(initial_window_s))
     ends = batch.history_indices(history_step_s)
-    stage_ends = np.array([max(1, int(round(stage.end_s / dt))) for stage in design.stages], dtype=np.int64)
-    stage_ends[-1] = max(stage_ends[-1], batch.samples)
-    gains = np.array([[stage.k_velocity, stage.k_level, stage.k_azimuth] for stage in design.stages])
+    k1, k2, k3 = design.gains(dt * (np.arange(batch.samples) + 0.5), batch.latitude_rad)
     history = np.empty((batch.members, ends.size, 3, 3))
     _kernels.staged_gyrocompass_loop(batch.gyro_increment, batch.accel_increment, dt, attitude,
-                                     earth_rate_ned(batch.latitude_rad), batch.gravity, stage_ends,
-                                     gains[:, 0].copy(), gains[:, 1].copy(), gains[:, 2].copy(), ends, history)
+                                     earth_rate_ned(batch.latitude_rad), batch.gravity, k1, k2, k3, ends, history)
     roll, pitch, heading = euler_from_dcm(history)
     return MethodEstimate("gyrocompass", roll[:, -1], pitch[:, -1], heading[:, -1], None, ends * dt, roll, pitch,
                           heading)
