@@ -187,8 +187,9 @@ class AlignmentComparison(Result):
     parts), and, when the truth is known, ``heading_error_rad`` (computed - true) and
     ``predicted_heading_error_rad`` (the static limit's formula with the record's own biases).
     ``gyrocompass_design`` names the loop's design; ``time_constant_s``, ``damping``, ``c_gamma`` and ``c_a`` are
-    the KPI design's; ``gyrocompass_stages`` lists the staged design's stages (span, gains k1 1/s, k2 and k3
-    1/s^2, level period and azimuth time constant, s), empty for the KPI design.
+    the KPI design's; ``gyrocompass_stages`` lists the staged design's stages (name, span, level loop's natural
+    period, azimuth time constant at the stage's start, and whether it grows with the time spent in the stage),
+    empty for the KPI design.
     """
 
     source: str
@@ -213,8 +214,8 @@ class AlignmentComparison(Result):
     histories: dict[str, MethodEstimate] = field(default_factory=dict, repr=False)
 
     units = {"latitude_rad": "rad", "c_gamma": "1/s", "c_a": "1/s", "damping": "1",
-             "gyrocompass_stages": "s (start_s, end_s, level_period_s, azimuth_time_constant_s), 1/s (k_velocity), "
-                                   "1/s^2 (k_level, k_azimuth)",
+             "gyrocompass_stages": "s (start_s, end_s, level_period_s, azimuth_time_constant_s: null when the "
+                                   "azimuth is open; growing: it grows by the time spent in the stage)",
              "body_rotation_rad": "rad, the body's net turn over the window (north, east, down)",
              "coarse_disturbance_rad": "rad, the heading shift that turn gives coarse alignment",
              "agreement": "heading difference from kalman (rad) and its ratio to the combined noise limit (1)"}
@@ -227,10 +228,13 @@ class AlignmentComparison(Result):
         window = f"{self.start_s:g} s + {self.duration_s:g} s"
         if self.gyrocompass_design == "kpi":
             loop = f"KPI design, T = {self.time_constant_s:g} s, zeta = {self.damping:g}"
+        elif not self.gyrocompass_stages:
+            loop = "staged design"
         else:
-            azimuth = self.gyrocompass_stages[-1]["azimuth_time_constant_s"] if self.gyrocompass_stages else None
-            loop = (f"staged design, level period {self.gyrocompass_stages[-1]['level_period_s']:.0f} s, final azimuth "
-                    f"time constant {azimuth:.0f} s" if azimuth else "staged design")
+            last = self.gyrocompass_stages[-1]
+            final = last["azimuth_time_constant_s"] + (last["end_s"] - last["start_s"] if last["growing"] else 0.0)
+            loop = (f"staged design, level period {last['level_period_s']:.0f} s, azimuth time constant growing "
+                    f"to {final:.0f} s")
         table = Table(title=f"Self-alignment of {self.source} ({window}, latitude "
                             f"{math.degrees(self.latitude_rad):.4f} deg)",
                       caption=f"' = arcmin; limits: {self.error_model} ({self.error_model_source}); gyrocompass "
