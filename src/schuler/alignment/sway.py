@@ -12,10 +12,10 @@ real base:
     omega_ib^b = omega_nb^b(Euler rates) + C_n^b omega_ie^n,   f^b = C_n^b (a^n - g^n)
 
 with C_b^n = R_z(psi) R_y(theta) R_x(phi) (NED, body x forward / y right / z down) and
-the Coriolis term of the millimetre sway velocities left out (below 1e-7 m/s^2).
-:func:`sway_batch` adds the sway to a batch simulated at rest (sensor errors act on the
-rest inputs only: the sway's share of scale factor and misalignment errors is below
-1e-6 of it).
+the Coriolis term 2 Omega x v of the sway velocity left out (about 1e-6 m/s^2 for
+millimetres at a few hertz, and of zero mean). :func:`sway_batch` adds the sway to a
+batch simulated at rest: the sensor errors act on the rest inputs only, and leave out
+their scale-factor and misalignment share of the sway itself (parts per million of it).
 """
 
 from __future__ import annotations
