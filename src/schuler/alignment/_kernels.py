@@ -291,3 +291,75 @@ def partial_rotations(rates: np.ndarray, lengths: np.ndarray, dt: float, noise: 
                 Q[j] += after @ noise @ after.T * (dt * dt)
             current[:] = after
         R[j] = current
+
+
+@numba.njit(cache=True, nogil=True)
+def staged_gyrocompass_loop(gyro: np.ndarray, accel: np.ndarray, dt: float, attitude: np.ndarray,
+                            earth_rate: np.ndarray, gravity: float, k_velocity: np.ndarray, k_level: np.ndarray,
+                            k_azimuth: np.ndarray, ends: np.ndarray, attitude_out: np.ndarray) -> None:
+    """The staged strapdown gyrocompass: a computed level frame torqued by its own computed velocity.
+
+    Per sample the horizontal velocity v in the computed frame integrates the sensed specific force and is
+    damped, v += (C dv)_h - k1 v dt, and the frame turns at omega_ie + u with
+    u = (k2 v_E / g, -k2 v_N / g, -k3 v_N / g) (see :mod:`~schuler.alignment.staged_gyrocompass`).
+    The gains follow the design's schedule, one value per sample.
+
+    Parameters
+    ----------
+    gyro, accel : ndarray (m, n, 3)
+        Increments, rad and m/s.
+    dt : float
+        s.
+    attitude : ndarray (m, 3, 3)
+        Initial C_b^n, updated to the final one.
+    earth_rate : ndarray (3,)
+        omega_ie^n, rad/s.
+    gravity : float
+        g, m/s^2.
+    k_velocity, k_level, k_azimuth : ndarray (n,)
+        k1 (1/s), k2 (1/s^2) and k3 (1/s^2) over each sample.
+    ends : ndarray (K,) of int
+        Sample counts at which to write ``attitude_out`` (m, K, 3, 3).
+    """
+    m, n = gyro.shape[0], gyro.shape[1]
+    rot = np.empty((3, 3))
+    scratch = np.empty((3, 3))
+    C = np.empty((3, 3))
+    dtheta = np.empty(3)
+    dv = np.empty(3)
+    prev_theta = np.empty(3)
+    prev_v = np.empty(3)
+    nav_dv = np.empty(3)
+    for member in range(m):
+        C[:, :] = attitude[member]
+        prev_theta[:] = 0.0
+        prev_v[:] = 0.0
+        v_n = 0.0
+        v_e = 0.0
+        out = 0
+        for k in range(n):
+            k1, k2, k3 = k_velocity[k], k_level[k], k_azimuth[k]
+            for i in range(3):
+                dtheta[i] = gyro[member, k, i]
+                dv[i] = accel[member, k, i]
+            nav_dv[:] = 0.0
+            _step(C, dtheta, dv, prev_theta, prev_v, rot, scratch, nav_dv)
+            v_n += nav_dv[0] - k1 * v_n * dt
+            v_e += nav_dv[1] - k1 * v_e * dt
+            w0 = (earth_rate[0] + k2 * v_e / gravity) * dt
+            w1 = (earth_rate[1] - k2 * v_n / gravity) * dt
+            w2 = (earth_rate[2] - k3 * v_n / gravity) * dt
+            _rotation(-w0, -w1, -w2, rot)
+            for i in range(3):
+                for j in range(3):
+                    scratch[i, j] = rot[i, 0] * C[0, j] + rot[i, 1] * C[1, j] + rot[i, 2] * C[2, j]
+            for i in range(3):
+                for j in range(3):
+                    C[i, j] = scratch[i, j]
+            for i in range(3):
+                prev_theta[i] = dtheta[i]
+                prev_v[i] = dv[i]
+            if out < ends.size and k + 1 == ends[out]:
+                attitude_out[member, out] = C
+                out += 1
+        attitude[member] = C

@@ -23,6 +23,7 @@ import numpy as np
 from schuler.alignment.attitude import wrap_angle
 from schuler.alignment.calibration_comparison import CalibrationComparison, compare_calibration
 from schuler.alignment.comparison import (
+    GYROCOMPASS_DESIGNS,
     AlignmentComparison,
     AlignmentSettings,
     compare_alignment,
@@ -65,9 +66,12 @@ ALIGN_COMPARE_PARAMETERS = ParameterSet((
     Parameter("heading", "deg", 30.0, "True heading of a simulated record.", minimum=-180, maximum=360),
     Parameter("imu_rate", "Hz", 100.0, "Sample rate of a simulated record.", minimum=0.1, maximum=10000),
     _SEED,
-    Parameter("time_constant", "s", 30.0, "Time constant T of the gyrocompass loop (KPI manual's design).",
+    Parameter("gyrocompass_design", "", "staged", "Design of the gyrocompass loop: staged (levelling, then azimuth, "
+              "driven by velocity; stages from the error model and the window) or kpi (the KPI manual's platform "
+              "design, --time-constant and --damping).", choices=GYROCOMPASS_DESIGNS, kind="choice"),
+    Parameter("time_constant", "s", 30.0, "Time constant T of the gyrocompass loop's KPI design.",
               minimum=1, maximum=1e5),
-    Parameter("damping", "", 0.8, "Damping zeta of the gyrocompass loop.", minimum=0.05, maximum=10),
+    Parameter("damping", "", 0.8, "Damping zeta of the gyrocompass loop's KPI design.", minimum=0.05, maximum=10),
     Parameter("velocity_noise", "m/s", 0.01, "Kalman filter's zero-velocity measurement noise (sway at rest).",
               minimum=0, exclusive_minimum=True, maximum=10),
     Parameter("update_interval", "s", 1.0, "Time between Kalman updates.", minimum=0, exclusive_minimum=True,
@@ -107,7 +111,8 @@ CALIBRATE_COMPARE_PARAMETERS = ParameterSet((
 
 
 def _settings(case) -> AlignmentSettings:
-    return AlignmentSettings(time_constant_s=case["time_constant"], damping=case["damping"],
+    return AlignmentSettings(gyrocompass_design=case["gyrocompass_design"],
+                             time_constant_s=case["time_constant"], damping=case["damping"],
                              velocity_noise=case["velocity_noise"], update_interval_s=case["update_interval"],
                              initial_window_s=case["initial_window"])
 
@@ -121,7 +126,7 @@ def align_compare(**values) -> AlignmentComparison:
         Options of :data:`ALIGN_COMPARE_PARAMETERS` by name, in SI: ``latitude`` and ``heading`` rad;
         ``start``, ``duration``, ``time_constant``, ``update_interval`` and ``initial_window`` s; ``imu_rate`` Hz;
         ``velocity_noise`` m/s; ``damping`` plain number; ``seed`` an integer; ``record`` a file path;
-        ``imu`` a grade. Missing ones take their defaults.
+        ``imu`` a grade; ``gyrocompass_design`` ``staged`` or ``kpi``. Missing ones take their defaults.
 
     Returns
     -------

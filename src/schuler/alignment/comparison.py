@@ -31,6 +31,13 @@ from schuler.alignment.gyrocompass import DEFAULT_DAMPING, DEFAULT_TIME_CONSTANT
 from schuler.alignment.inertial import align_inertial, net_rotation
 from schuler.alignment.kalman import align_kalman
 from schuler.alignment.limits import METHODS, accuracy_limit, horizontal_rate, static_errors
+from schuler.alignment.staged_gyrocompass import (
+    GyrocompassDesign,
+    align_staged_gyrocompass,
+    design_gyrocompass,
+    staged_limit,
+)
+from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.record import ImuRecord
 from schuler.imu.simulate import ImuSimulator, simulate_members, static_truth
@@ -41,6 +48,11 @@ from schuler.results import Result
 AGREEMENT_SIGMAS = 3.0
 """Methods agree when their headings differ by less than this many combined noise sigmas."""
 
+GYROCOMPASS_DESIGNS = ("staged", "kpi")
+"""The gyrocompass loop's designs: levelling then azimuth stages driven by velocity
+(:mod:`~schuler.alignment.staged_gyrocompass`, the default), or the KPI platform design
+(:mod:`~schuler.alignment.gyrocompass`, T and zeta)."""
+
 
 @dataclass(frozen=True)
 class AlignmentSettings:
@@ -49,7 +61,10 @@ class AlignmentSettings:
     Attributes
     ----------
     time_constant_s, damping : float
-        The gyrocompass loop's design (KPI manual: T = 30 s, zeta = 0.8).
+        T and zeta of the KPI design of the gyrocompass loop (KPI manual: T = 30 s, zeta = 0.8).
+    gyrocompass_design : {"staged", "kpi"}
+        The gyrocompass loop's design (:data:`GYROCOMPASS_DESIGNS`); the staged one takes its stages from the
+        error model and the window.
     velocity_noise : float
         The Kalman filter's zero-velocity measurement noise, m/s.
     update_interval_s : float
@@ -66,6 +81,37 @@ class AlignmentSettings:
     update_interval_s: float = 1.0
     initial_window_s: float = 30.0
     history_step_s: float = 1.0
+    gyrocompass_design: str = "staged"
+
+    def __post_init__(self):
+        if self.gyrocompass_design not in GYROCOMPASS_DESIGNS:
+            raise InvalidParameter("gyrocompass_design", f"{self.gyrocompass_design!r} is not one of "
+                                   f"{', '.join(GYROCOMPASS_DESIGNS)}")
+
+
+def staged_design(model: ErrorModel, batch: StaticBatch) -> GyrocompassDesign:
+    """The staged gyrocompass's stages for this error model and window.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The sensors' errors (their white noise sets the level loop's bandwidth).
+    batch : StaticBatch
+        The window: its latitude, duration and gravity are used.
+
+    Returns
+    -------
+    GyrocompassDesign
+    """
+    return design_gyrocompass(model, latitude=batch.latitude_rad, duration=batch.duration_s, gravity=batch.gravity)
+
+
+def _gyrocompass(batch: StaticBatch, model: ErrorModel, settings: AlignmentSettings) -> MethodEstimate:
+    if settings.gyrocompass_design == "kpi":
+        return align_gyrocompass(batch, time_constant_s=settings.time_constant_s, damping=settings.damping,
+                                 initial_window_s=settings.initial_window_s, history_step_s=settings.history_step_s)
+    return align_staged_gyrocompass(batch, staged_design(model, batch), initial_window_s=settings.initial_window_s,
+                                    history_step_s=settings.history_step_s)
 
 
 def run_methods(batch: StaticBatch, model: ErrorModel, settings: AlignmentSettings) -> dict[str, MethodEstimate]:
@@ -91,9 +137,7 @@ def run_methods(batch: StaticBatch, model: ErrorModel, settings: AlignmentSettin
         "kalman": align_kalman(batch, model, velocity_noise=settings.velocity_noise,
                                update_interval_s=settings.update_interval_s,
                                initial_window_s=settings.initial_window_s, history_step_s=settings.history_step_s),
-        "gyrocompass": align_gyrocompass(batch, time_constant_s=settings.time_constant_s, damping=settings.damping,
-                                         initial_window_s=settings.initial_window_s,
-                                         history_step_s=settings.history_step_s),
+        "gyrocompass": _gyrocompass(batch, model, settings),
     }
 
 
@@ -117,10 +161,15 @@ def method_limits(model: ErrorModel, batch: StaticBatch, heading: float, setting
         Method name (:data:`~schuler.alignment.limits.METHODS`) -> its 1-sigma limits, rad.
     """
     c_gamma, c_a = loop_gains(batch.latitude_rad, settings.time_constant_s, settings.damping)
-    return {method: accuracy_limit(method, model, latitude=batch.latitude_rad, heading=heading,
-                                   duration=batch.duration_s, gravity=batch.gravity, c_gamma=c_gamma, c_a=c_a,
-                                   velocity_noise=settings.velocity_noise, update_interval=settings.update_interval_s)
-            for method in METHODS}
+    limits = {method: accuracy_limit(method, model, latitude=batch.latitude_rad, heading=heading,
+                                     duration=batch.duration_s, gravity=batch.gravity, c_gamma=c_gamma, c_a=c_a,
+                                     velocity_noise=settings.velocity_noise, update_interval=settings.update_interval_s)
+              for method in METHODS}
+    if settings.gyrocompass_design == "staged":
+        limits["gyrocompass"] = staged_limit(model, staged_design(model, batch), latitude=batch.latitude_rad,
+                                             heading=heading, gravity=batch.gravity,
+                                             initial_window=settings.initial_window_s)
+    return limits
 
 
 @dataclass
@@ -137,6 +186,10 @@ class AlignmentComparison(Result):
     limits), ``limit_heading_bias_rad`` and ``limit_heading_noise_rad`` (their two
     parts), and, when the truth is known, ``heading_error_rad`` (computed - true) and
     ``predicted_heading_error_rad`` (the static limit's formula with the record's own biases).
+    ``gyrocompass_design`` names the loop's design; ``time_constant_s``, ``damping``, ``c_gamma`` and ``c_a`` are
+    the KPI design's; ``gyrocompass_stages`` lists the staged design's stages (name, span, level loop's natural
+    period, azimuth time constant at the stage's start, and whether it grows with the time spent in the stage),
+    empty for the KPI design.
     """
 
     source: str
@@ -156,9 +209,13 @@ class AlignmentComparison(Result):
     c_gamma: float = 0.0
     c_a: float = 0.0
     notes: list[str] = field(default_factory=list)
+    gyrocompass_design: str = "staged"
+    gyrocompass_stages: list[dict[str, Any]] = field(default_factory=list)
     histories: dict[str, MethodEstimate] = field(default_factory=dict, repr=False)
 
     units = {"latitude_rad": "rad", "c_gamma": "1/s", "c_a": "1/s", "damping": "1",
+             "gyrocompass_stages": "s (start_s, end_s, level_period_s, azimuth_time_constant_s: null when the "
+                                   "azimuth is open; growing: it grows by the time spent in the stage)",
              "body_rotation_rad": "rad, the body's net turn over the window (north, east, down)",
              "coarse_disturbance_rad": "rad, the heading shift that turn gives coarse alignment",
              "agreement": "heading difference from kalman (rad) and its ratio to the combined noise limit (1)"}
@@ -169,10 +226,19 @@ class AlignmentComparison(Result):
 
         deg, arcmin = math.degrees(1.0), math.degrees(1.0) * 60.0
         window = f"{self.start_s:g} s + {self.duration_s:g} s"
+        if self.gyrocompass_design == "kpi":
+            loop = f"KPI design, T = {self.time_constant_s:g} s, zeta = {self.damping:g}"
+        elif not self.gyrocompass_stages:
+            loop = "staged design"
+        else:
+            last = self.gyrocompass_stages[-1]
+            final = last["azimuth_time_constant_s"] + (last["end_s"] - last["start_s"] if last["growing"] else 0.0)
+            loop = (f"staged design, level period {last['level_period_s']:.0f} s, azimuth time constant growing "
+                    f"to {final:.0f} s")
         table = Table(title=f"Self-alignment of {self.source} ({window}, latitude "
                             f"{math.degrees(self.latitude_rad):.4f} deg)",
                       caption=f"' = arcmin; limits: {self.error_model} ({self.error_model_source}); gyrocompass "
-                              f"T = {self.time_constant_s:g} s, zeta = {self.damping:g}")
+                              f"{loop}")
         columns = ["method", "roll deg", "pitch deg", "heading deg", "1-sigma '", "converged s", "limit '"]
         if self.true_attitude_rad is not None:
             columns += ["error '", "predicted '"]
@@ -262,12 +328,17 @@ def compare_alignment(batch: StaticBatch, model: ErrorModel, settings: Alignment
                      f"for Earth rate: that alone moves its heading by {disturbance * deg:+.2f} deg (observed "
                      f"{agreement['coarse']['difference_rad'] * deg:+.2f} deg from Kalman); the inertial-frame "
                      "method, the filter and the loop follow the turn with the gyros")
-    if not agreement["gyrocompass"]["agrees"]:
+    if not agreement["gyrocompass"]["agrees"] and settings.gyrocompass_design == "kpi":
         memory = 4.0 * settings.damping * settings.time_constant_s
         notes.append(f"the gyrocompass loop disagrees: it reads the instantaneous horizontal specific force as tilt, "
                      f"so the body's sway (horizontal accelerations) turns it in azimuth through c_a; it averages "
                      f"over about 4 zeta T = {memory:.0f} s only, where the inertial-frame method and the filter use "
-                     "the integrated specific force over the whole window")
+                     "the integrated specific force over the whole window (the staged design integrates it too: "
+                     "--gyrocompass-design staged)")
+    elif not agreement["gyrocompass"]["agrees"]:
+        notes.append("the gyrocompass loop disagrees beyond its stated noise: the base moved more than its linear "
+                     "error model, driven by the sensors' white noise only, allows for")
+    stages = staged_design(model, batch).as_dicts() if settings.gyrocompass_design == "staged" else []
     return AlignmentComparison(
         source=source, latitude_rad=batch.latitude_rad, start_s=start_s, duration_s=batch.duration_s,
         sample_interval_s=batch.sample_interval_s, error_model=model.name, error_model_source=model_source,
@@ -275,7 +346,8 @@ def compare_alignment(batch: StaticBatch, model: ErrorModel, settings: Alignment
         true_attitude_rad=None if truth is None else (float(truth[0]), float(truth[1]), float(truth[2])),
         time_constant_s=settings.time_constant_s, damping=settings.damping, c_gamma=c_gamma, c_a=c_a,
         body_rotation_rad=(float(rotation[0]), float(rotation[1]), float(rotation[2])),
-        coarse_disturbance_rad=disturbance, notes=notes,
+        coarse_disturbance_rad=disturbance, notes=notes, gyrocompass_design=settings.gyrocompass_design,
+        gyrocompass_stages=stages,
         histories=estimates)
 
 
