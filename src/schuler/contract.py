@@ -35,6 +35,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -438,8 +439,18 @@ class System:
         progress : callable, optional
             ``progress(done, total)`` after each chunk, in members.
         """
+        checked = None if draw is None else partial(self._checked_draw, draw)
         return monte_carlo(self.evaluate, self.outputs, case, members, streams, fidelity,
-                           chunk=self._chunk_size(case), draw=draw, progress=progress)
+                           chunk=self._chunk_size(case), draw=checked, progress=progress)
+
+    def _checked_draw(self, draw: Callable[[np.ndarray], Mapping[str, np.ndarray]],
+                      numbers: np.ndarray) -> dict[str, np.ndarray]:
+        """A draw's values validated like :meth:`evaluate_values`' (a misspelt name is refused, not ignored)."""
+        drawn = self.checked_arrays(draw(numbers))
+        for name, values in drawn.items():
+            if values.size != numbers.size:
+                raise InvalidParameter(name, f"draw gave {values.size} values for {numbers.size} members")
+        return drawn
 
     def _chunk_size(self, case: Case) -> int:
         if self.member_bytes is None:
@@ -463,17 +474,36 @@ class System:
         fidelity : str, optional
             One of :attr:`fidelities`.
         """
-        self.parameters.refuse_unknown(values)
-        lengths = {np.size(v) for v in values.values() if np.ndim(v) > 0}
+        given = self.checked_arrays(values)
+        lengths = {array.size for name, array in given.items() if np.ndim(values[name]) > 0}
         if len(lengths) > 1:
             raise InvalidParameter("cases", f"parameter arrays have different lengths: {sorted(lengths)}")
         n = lengths.pop() if lengths else 1
-        defaults = Cases.from_case(self.parameters.case(), n)
-        arrays = {name: defaults[name] for name in defaults.names}
-        for name, value in values.items():
-            array = np.broadcast_to(np.asarray(value), (n,))
-            arrays[name] = np.asarray(array, dtype=object) if array.dtype.kind in "USO" else np.array(array)
+        arrays = _default_arrays(self.parameters, n)
+        arrays.update({name: np.broadcast_to(array, (n,)) for name, array in given.items()})
         return self.evaluate(Cases(arrays, members=members, random=random, fidelity=self.check_fidelity(fidelity)))
+
+    def checked_arrays(self, values: Mapping[str, Any]) -> dict[str, np.ndarray]:
+        """The given parameter arrays validated as :meth:`run` validates one case (ranges on whole arrays).
+
+        Unknown names (with a suggestion), options that exclude each other,
+        values of the wrong type, non-finite or out of range, empty or
+        multi-dimensional arrays are refused; None means "not set".
+
+        Parameters
+        ----------
+        values : mapping of str to array_like
+            Parameter arrays (or scalars) in SI.
+
+        Returns
+        -------
+        dict of str to ndarray
+            The given (not None) parameters, each a validated 1-D array (a scalar has length 1).
+        """
+        self.parameters.refuse_unknown(values)
+        given = {name: value for name, value in values.items() if value is not None}
+        self.parameters.refuse_conflicts(given)
+        return {name: self.parameters[name].check_array(np.atleast_1d(value), name) for name, value in given.items()}
 
     def output(self, name: str) -> Output:
         """The declared :class:`Output` called ``name`` (KeyError if there is none).
@@ -542,6 +572,22 @@ def monte_carlo(evaluate: Callable[[Cases], dict[str, np.ndarray]], outputs: tup
             progress(int(numbers[-1]) + 1, members)
     return MonteCarloSummary.from_statistics(members, streams.seed, outputs, statistics,
                                              {k: np.concatenate(v) if v else np.empty(0) for k, v in samples.items()})
+
+
+def _default_arrays(parameters: ParameterSet, n: int) -> dict[str, np.ndarray]:
+    """Every parameter's default, ``n`` times (an unset number NaN, an unset text None, as in a sweep's plan).
+
+    Read-only views of one value each: a batch of a million cases costs no copies.
+    """
+    arrays = {}
+    for name, value in parameters.case().items():
+        if value is None:
+            unset = np.nan if parameters[name].kind in ("quantity", "integer") else None
+            one = np.array([unset], dtype=None if unset is not None else object)
+        else:
+            one = np.array([value], dtype=object if isinstance(value, str) else None)
+        arrays[name] = np.broadcast_to(one, (n,))
+    return arrays
 
 
 def _count(value, name: str) -> int:
