@@ -156,3 +156,46 @@ def test_a_batch_with_the_magnitude_unset_parses_each_source_once():
     assert out["final_flat_m"][-1] == pytest.approx(single["final_flat_m"][0], rel=1e-12)
     # 3.5 us per case here (0.07 s); parsing the unset magnitude case by case took 400 us per case (8 s)
     assert seconds < 2.0
+
+
+def test_quantities_may_carry_their_unit_as_text_or_pint():
+    from schuler.units import ureg
+
+    align = get_system("align")
+    assert align.case(latitude="50 deg")["latitude"] == pytest.approx(math.radians(50.0), rel=1e-12, abs=0)
+    assert align.case(latitude=50 * ureg.deg)["latitude"] == pytest.approx(math.radians(50.0), rel=1e-12, abs=0)
+    checked = align.checked_arrays({"latitude": np.array([10.0, 20.0]) * ureg.deg, "drift_east": "0.01 deg/h",
+                                    "duration": "10 min"})
+    assert checked["latitude"] == pytest.approx(np.radians([10.0, 20.0]), rel=1e-12)
+    assert checked["drift_east"][0] == pytest.approx(math.radians(0.01) / 3600.0, rel=1e-12)
+    assert checked["duration"][0] == 600.0
+    by_text = align.evaluate_values({"latitude": ["50 deg"]}, fidelity="closed")
+    by_number = align.evaluate_values({"latitude": [math.radians(50.0)]}, fidelity="closed")
+    assert by_text["azimuth_error_rad"][0] == by_number["azimuth_error_rad"][0]
+
+
+@pytest.mark.parametrize(("value", "reason"), [
+    ("50", "'50' has no unit: write it with one ('50 deg') or give a number in SI (rad)"),
+    ("95 deg", "'95 deg' is outside"),
+    ("3 m", "'3 m' is not an angle"),
+])
+def test_text_without_a_unit_or_of_the_wrong_kind_is_refused(value, reason):
+    with pytest.raises(InvalidParameter, match=f"^latitude: {reason}".replace("(", r"\(").replace(")", r"\)")):
+        get_system("align").case(latitude=value)
+
+
+def test_systems_are_listed_and_the_package_help_names_every_one():
+    import schuler
+
+    assert schuler.list_systems() == list(SYSTEM_MODULES)
+    assert f"{len(SYSTEM_MODULES)} instrument systems" in schuler.__doc__
+    for name, module in SYSTEM_MODULES.items():
+        assert f"``{name}``  :mod:`{module.rsplit('.', 1)[0]}`" in schuler.__doc__
+
+
+def test_an_action_is_reached_by_name_and_a_misspelt_one_is_refused():
+    north = get_system("north")
+    assert north.action("identify") is next(a.function for a in north.actions if a.name == "identify")
+    with pytest.raises(InvalidParameter, match="^action: 'identfy' is not an action of north; did you mean "
+                                               "'identify'\\? choose from identify"):
+        north.action("identfy")

@@ -32,6 +32,7 @@ random term zero.
 
 from __future__ import annotations
 
+import difflib
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
@@ -208,6 +209,28 @@ class System:
         """
         return self.parameters.case(si_values)
 
+    def action(self, name: str) -> Callable[..., Result]:
+        """The function of the system's action ``name`` (``north.action("identify")``), to call from Python.
+
+        Parameters
+        ----------
+        name : str
+            The action's command name (one of :attr:`actions`).
+
+        Raises
+        ------
+        InvalidParameter
+            A name that is not one of the system's actions (the closest suggested).
+        """
+        names = [action.name for action in self.actions]
+        if name not in names:
+            hint = difflib.get_close_matches(str(name), names, n=1)
+            suggestion = f"did you mean {hint[0]!r}? " if hint else ""
+            offered = ", ".join(names) or "none"
+            raise InvalidParameter("action", f"{name!r} is not an action of {self.name}; {suggestion}"
+                                             f"choose from {offered}")
+        return self.actions[names.index(name)].function
+
     def check_fidelity(self, fidelity: str | None) -> str | None:
         """The fidelity to use (the default when None); refuses one the system does not offer.
 
@@ -376,7 +399,7 @@ class System:
         self.parameters.refuse_unknown(values)
         given = {name: value for name, value in values.items() if value is not None}
         self.parameters.refuse_conflicts(given)
-        return {name: self.parameters[name].check_array(np.atleast_1d(value), name) for name, value in given.items()}
+        return {name: self.parameters[name].check_array(value, name) for name, value in given.items()}
 
     def output(self, name: str) -> Output:
         """The declared :class:`Output` called ``name`` (KeyError if there is none).

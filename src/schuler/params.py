@@ -29,13 +29,18 @@ from typing import Any, Literal
 import numpy as np
 
 from schuler.exceptions import InvalidParameter
-from schuler.units import parse_quantity, si_unit, to_unit
+from schuler.units import from_unit, parse_quantity, si_unit, to_unit
 
 Kind = Literal["quantity", "choice", "integer", "flag", "text"]
 
 
 def _fmt(x: float) -> str:
     return f"{x:g}"
+
+
+def _is_quantity(value) -> bool:
+    """Whether ``value`` is a pint Quantity (of any unit registry)."""
+    return hasattr(value, "magnitude") and hasattr(value, "units") and hasattr(value, "to")
 
 
 class _Shown:
@@ -105,8 +110,9 @@ class Parameter:
 
         Parameters
         ----------
-        value : float, int, str, bool or None
-            The value in SI (the parameter's SI unit: :attr:`si_unit`).
+        value : float, int, str, bool, pint Quantity or None
+            The value in SI (the parameter's SI unit: :attr:`si_unit`); a quantity
+            may instead carry its unit, as text (``"50 deg"``) or a pint Quantity.
         label : str, optional
             Name used in error messages (default: the parameter's name).
 
@@ -114,6 +120,10 @@ class Parameter:
         label = label or self.name
         if value is None:
             return None
+        if self.kind == "quantity" and _is_quantity(value):
+            value = self._quantity_si(value, label)
+        elif self.kind == "quantity" and isinstance(value, str) and type(self).check is Parameter.check:
+            return self._text_si(value, label)
         if self.kind == "choice":
             return self.parse(value, label)
         if self.kind == "text":
@@ -234,8 +244,10 @@ class Parameter:
             Not a 1-D array, an empty one, or a value :meth:`check` refuses.
         """
         label = label or self.name
+        if self.kind == "quantity" and _is_quantity(values):
+            values = self._quantity_si(values, label)
         try:
-            array = np.asarray(values)
+            array = np.atleast_1d(np.asarray(values))
         except (ValueError, TypeError):
             raise InvalidParameter(label, "expected a number or a 1-D array of numbers (ragged input)") from None
         if array.ndim != 1:
@@ -248,6 +260,25 @@ class Parameter:
         if self.kind == "flag" and array.dtype.kind == "b":
             return array.astype(bool)
         return self._check_each(array, label)
+
+    def _quantity_si(self, quantity, label: str):
+        """A pint Quantity's magnitude (number or array) in SI, its unit checked as text with a unit is."""
+        per_unit = parse_quantity(f"1 {quantity.units}", self.unit, name=label)
+        magnitude = quantity.magnitude
+        if isinstance(magnitude, (bool, np.bool_)) or np.asarray(magnitude).dtype.kind not in "iuf":
+            raise InvalidParameter(label, f"{quantity!r} is not a number with a unit")
+        return magnitude * per_unit
+
+    def _text_si(self, text: str, label: str) -> float:
+        """A value written with its unit ("50 deg"), as the command line reads it; a bare number must be SI."""
+        try:
+            number = float(text)
+        except ValueError:
+            return self.parse(text, label)
+        if self.unit and not math.isclose(float(from_unit(1.0, self.unit)), 1.0, rel_tol=1e-15):
+            raise InvalidParameter(label, f"{text!r} has no unit: write it with one ('{text} {self.unit}') "
+                                          f"or give a number in SI ({self.si_unit})")
+        return self.check(number, label)
 
     def _check_numbers(self, array: np.ndarray, label: str) -> np.ndarray:
         numbers = array.astype(float)
