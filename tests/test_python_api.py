@@ -116,13 +116,13 @@ def test_none_means_not_set_and_arrays_must_agree_in_length():
         errors.evaluate_values({"speed": [1.0, 2.0], "duration": [10.0, 20.0, 30.0]})
 
 
-def test_exclusive_options_are_refused_as_run_refuses_them():
+def test_exclusive_options_are_refused_by_run_and_ordered_in_a_batch():
     north = get_system("north")
-    values = {"latitude": math.radians(50.0), "omega_h": 4.7e-5}
     with pytest.raises(InvalidParameter, match="^latitude: cannot be combined with omega_h"):
-        north.run(**values)
-    with pytest.raises(InvalidParameter, match="^latitude: cannot be combined with omega_h"):
-        north.evaluate_values(values)
+        north.run(latitude=math.radians(50.0), omega_h=4.7e-5)
+    # a batch may mix cases of either kind: each case's own rule applies (the latitude where it is set)
+    mixed = north.checked_arrays({"latitude": [math.radians(50.0), None], "omega_h": [None, 4.7e-5]})
+    assert np.isnan(mixed["latitude"][1]) and np.isnan(mixed["omega_h"][0])
 
 
 def test_a_misspelt_draw_is_refused_with_a_suggestion():

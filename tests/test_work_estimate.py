@@ -67,7 +67,7 @@ def test_a_scenario_of_a_billion_cases_is_refused_by_its_plan_and_by_run():
 def test_the_refusal_is_one_line_with_exit_code_2_and_the_option_lifts_it(run_cli, monkeypatch):
     outcome = run_cli("north", "run", "--monte-carlo", "1000000000")
     assert outcome.code == 2
-    assert outcome.stderr.count("\n") == 1 and "171 days" in outcome.stderr
+    assert outcome.stderr.count("\n") == 1 and "would take about 22.7 days" in outcome.stderr
     monkeypatch.setenv("SCHULER_TIME_BUDGET", "1e-9 s")
     assert run_cli("errors", "run", "--duration", "60").code == 2
     lifted = run_cli("errors", "run", "--duration", "60", "--no-time-limit", "--json")
@@ -79,9 +79,9 @@ def test_a_sweep_shows_its_estimate_and_is_refused_past_the_budget(tmp_path, run
     scenario.write_text('system = "north"\n[parameters]\nduration = "100 s"\n')
     plan = plan_sweep(parse_scenario(scenario.read_text()), get_system("north"),
                       ["latitude=10:60:10"])
-    # 6 cases of 12 ms + 100 samples x 14 us each (the rates declared in ground_gyrocompass.api)
-    assert plan.estimated_seconds == pytest.approx(6 * (1.2e-2 + 1.4e-5 * 101), rel=1e-6)
-    monkeypatch.setenv("SCHULER_TIME_BUDGET", "0.01 s")
+    # 6 cases of 1.3 ms + 101 samples x 3.3 us each (the rates declared in ground_gyrocompass.api)
+    assert plan.estimated_seconds == pytest.approx(6 * (1.3e-3 + 3.3e-6 * 101), rel=1e-6)
+    monkeypatch.setenv("SCHULER_TIME_BUDGET", "0.001 s")
     refused = run_cli("sweep", scenario, "--param", "latitude=10:60:10", "--out", tmp_path / "out")
     assert refused.code == 2 and "this sweep of 6 cases would take about" in refused.stderr
     assert not (tmp_path / "out").exists()
@@ -102,7 +102,7 @@ def test_every_system_declares_an_estimate_that_grows_with_its_work(name):
         assert system.work_seconds(stretched, 0) > single
 
 
-def test_estimates_are_within_a_factor_of_five_of_the_measured_time():
+def test_estimates_are_within_a_factor_of_ten_of_the_measured_time():
     navigate = get_system("navigate")
     values = {"duration": 600.0, "imu_rate": 100.0}
     case = navigate.case(**values)
@@ -112,8 +112,8 @@ def test_estimates_are_within_a_factor_of_five_of_the_measured_time():
     started = time.perf_counter()
     navigate.evaluate(batch)
     measured = (time.perf_counter() - started) / 10
-    # the rate was measured at 26 ms per member for this case; a loaded or a faster machine stays within 5x
-    assert navigate.member_seconds(case) / 5 < measured < 5 * navigate.member_seconds(case)
+    # the rate was measured at 3.2-4.3 ms per member for this case on a quiet machine and 26 ms under a load of 5
+    assert navigate.member_seconds(case) / 10 < measured < 10 * navigate.member_seconds(case)
 
 
 def test_a_system_without_an_estimate_is_refused_on_its_measured_pace(monkeypatch):
@@ -180,4 +180,4 @@ def test_the_progress_label_carries_the_estimate(monkeypatch, run_cli):
     assert outcome.code == 0, outcome.stderr
     expected = get_system("calibrate").work_seconds(get_system("calibrate").case(), 20)
     assert labels == [f"calibrate Monte Carlo (estimate {format_seconds(expected)})"]
-    assert np.isclose(expected, 1.5e-4 * 4 * 24, rtol=1e-12)
+    assert np.isclose(expected, 4e-5 * 4 * 24, rtol=1e-12)

@@ -54,8 +54,9 @@ MONTE_CARLO_CHUNK = 2_000
 """Members evaluated at once in :meth:`System.run` Monte Carlo (unless the system says otherwise)."""
 
 RUN_CASE_MEMBERS = 4
-"""Members a run in full counts as in a time estimate: its histories cost about 1 to 6 members (measured: north
-1-1.6, mission 4.4, navigate 1.2 with IMU noise and 5.5 without)."""
+"""Members a run in full counts as in a time estimate: its histories cost a few members where the work is large
+(measured: north 1.1-3.2, mission 4.1, navigate 1.2 with IMU noise and 7 without); where members cost well under a
+millisecond (align, calibrate, errors) the run in full is tens of members, still milliseconds."""
 
 MONTE_CARLO_SAMPLES = 100_000
 """Members whose outputs a Monte Carlo summary keeps for histograms."""
@@ -382,9 +383,11 @@ class System:
     def checked_arrays(self, values: Mapping[str, Any]) -> dict[str, np.ndarray]:
         """The given parameter arrays validated as :meth:`run` validates one case (ranges on whole arrays).
 
-        Unknown names (with a suggestion), options that exclude each other,
-        values of the wrong type, non-finite or out of range, empty or
-        multi-dimensional arrays are refused; None means "not set".
+        Unknown names (with a suggestion), values of the wrong type,
+        non-finite or out of range, empty or multi-dimensional arrays are
+        refused; None means "not set". Options that exclude each other may be
+        given together in a batch (each system's own precedence applies: a
+        speed profile replaces the speed).
 
         Parameters
         ----------
@@ -398,7 +401,6 @@ class System:
         """
         self.parameters.refuse_unknown(values)
         given = {name: value for name, value in values.items() if value is not None}
-        self.parameters.refuse_conflicts(given)
         return {name: self.parameters[name].check_array(value, name) for name, value in given.items()}
 
     def output(self, name: str) -> Output:

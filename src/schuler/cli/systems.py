@@ -33,9 +33,6 @@ from schuler.params import Case, ParameterSet
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
-SHOWN_ESTIMATE = 10.0
-"""A run without a progress bar (no Monte Carlo) estimated longer than this, s, says so on stderr first."""
-
 NO_TIME_LIMIT = click.Option(["--no-time-limit"], is_flag=True, default=False,
                              help="Run even when the work is estimated to take longer than the time budget "
                                   "(10 min, or SCHULER_TIME_BUDGET).")
@@ -75,8 +72,6 @@ def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fide
     with options_named(system.parameters + RUN_OPTIONS), no_time_limit(not time_limit):
         estimate = system.work_seconds(case, monte_carlo)
         label = f"{system.name} Monte Carlo" + (f" (estimate {format_seconds(estimate)})" if estimate else "")
-        if estimate is not None and estimate > SHOWN_ESTIMATE and not monte_carlo:
-            click.echo(f"schuler: this {system.name} run takes about {format_seconds(estimate)} (estimate)", err=True)
         with progress_reporter(label, enabled=not as_json) as progress:
             result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
                                 **_given(case))

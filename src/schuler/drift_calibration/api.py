@@ -34,9 +34,9 @@ from schuler.drift_calibration.results import write_files
 from schuler.params import Case
 from schuler.references import PULSE_CALIBRATION
 
-SECONDS_PER_PHASE = 1.5e-4
+SECONDS_PER_PHASE = 4e-5
 """Time of one position of one channel and cycle of a member's procedure, s (the default three-axis procedure,
-2 channels x 2 positions x 1 cycle, 50 members: 0.58 ms per member; one thread of a busy 2-core machine)."""
+2 channels x 2 positions x 1 cycle, 50 members: 0.15 ms per member; one thread, quiet 2-core machine)."""
 
 
 def member_seconds(case: Case) -> float:

@@ -36,9 +36,9 @@ from schuler.ground_gyrocompass.results import write_files
 from schuler.params import Case
 from schuler.references import FEDOROV_2020
 
-SECONDS_PER_FIT = 1.2e-2
-SECONDS_PER_SAMPLE = 1.4e-5
-"""Time of one member, s: its fit and its record's samples (200 s at 1 s: 15 ms; 2000 s: 40 ms; one thread of a busy
+SECONDS_PER_FIT = 1.3e-3
+SECONDS_PER_SAMPLE = 3.3e-6
+"""Time of one member, s: its fit and its record's samples (200 s at 1 s: 2.0 ms; 2000 s: 8.0 ms; one thread of a busy
 2-core machine)."""
 
 

@@ -33,8 +33,8 @@ from schuler.gyro_vertical.results import write_files
 from schuler.params import Case, ParameterSet
 from schuler.references import DROZDOVICH_1959
 
-SECONDS_PER_POINT = 3.5e-5
-"""Time of one output point of one case's simulation, s (48 h at 10 s, 17,281 points: 0.61 s; one thread of a busy
+SECONDS_PER_POINT = 2e-5
+"""Time of one output point of one case's simulation, s (48 h at 10 s, 17,281 points: 0.33 s; one thread of a busy
 2-core machine)."""
 
 

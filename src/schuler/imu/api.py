@@ -24,9 +24,9 @@ from schuler.imu.reproduction import REPRODUCE_PARAMETERS, report, reproduce
 from schuler.imu.run_results import write_files
 from schuler.params import Case
 
-SECONDS_PER_SAMPLE = 2.5e-6
+SECONDS_PER_SAMPLE = 1.4e-6
 """Time of one six-axis sample of a member's record and its analysis, s (1 h at 100 Hz: 0.89 s per member; 600 s at
-1 kHz: 0.81 s; one thread of a busy 2-core machine)."""
+1 kHz: 0.81 s; one thread, quiet 2-core machine)."""
 
 
 def member_seconds(case: Case) -> float:

@@ -19,9 +19,9 @@ from schuler.mission.reproduction import SOURCE, report, reproduce
 from schuler.mission.results import write_files
 from schuler.params import Case
 
-SECONDS_PER_SAMPLE = 2.3e-6
-"""Time of one IMU interval of one member's mission, s (the default 2-h cruise at 2 Hz: 22-33 ms per member over 10 to
-60 members; 4 h: 66 ms; one thread of a busy 2-core machine)."""
+SECONDS_PER_SAMPLE = 8e-7
+"""Time of one IMU interval of one member's mission, s (the default 2-h cruise at 2 Hz: 11 ms per member over 20
+members; 4 h: 23 ms; one thread, quiet 2-core machine)."""
 
 
 def member_seconds(case: Case) -> float:

@@ -30,11 +30,11 @@ from schuler.navigate.results import write_files
 from schuler.params import Case
 from schuler.references import GROVES_2013
 
-SECONDS_PER_SAMPLE = 4.5e-7
-NOISY_SECONDS_PER_SAMPLE = 2.0e-6
+SECONDS_PER_SAMPLE = 6e-8
+NOISY_SECONDS_PER_SAMPLE = 4e-7
 """Time of one IMU interval of one member, s, with an ideal IMU and with an IMU's noise (600 s at 100 Hz, 20
-members: 26 and 118 ms per member; one thread of a busy 2-core machine; benchmarks/bench_navigate.py asks >= 10 M and
->= 3 M member-samples/s)."""
+members: 3.2-4.3 and 23 ms per member; one thread, quiet 2-core machine; benchmarks/bench_navigate.py asks >= 10 M
+and >= 3 M member-samples/s)."""
 
 
 def member_seconds(case: Case) -> float:

@@ -62,9 +62,9 @@ ACTIONS = (
 )
 """The commands of ``schuler errors`` beyond ``run`` and ``reproduce``."""
 
-MEMBER_SECONDS = 2e-5
+MEMBER_SECONDS = 1.5e-5
 """Time of one member, s: the closed forms are vectorised and one simulation serves every member of a grid
-(1000 members of the default case: 19 ms; one thread of a busy 2-core machine)."""
+(1000 members of the default case: 15 ms; one thread, quiet 2-core machine)."""
 
 
 def member_seconds(case: Case) -> float:
