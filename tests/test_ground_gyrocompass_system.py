@@ -162,6 +162,7 @@ def test_unidentifiable_record_nan_in_evaluate_raised_by_run():
 
 
 def test_memory_is_estimated_before_allocating(monkeypatch, tmp_path):
+    monkeypatch.setenv("SCHULER_TIME_BUDGET", "none")  # the time estimate would refuse these first
     huge = SYSTEM.case(duration=1e9, output_step=1e-3)
     assert member_bytes(huge) > 2**40  # estimated, not allocated
     with pytest.raises(MemoryBudgetExceeded, match="--duration or --output-step"):

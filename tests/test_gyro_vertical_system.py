@@ -193,6 +193,7 @@ def test_awkward_grids_give_numbers_not_tracebacks():
 
 def test_memory_is_refused_before_allocating(monkeypatch):
     monkeypatch.setenv("SCHULER_MEMORY_BUDGET", "1 GiB")
+    monkeypatch.setenv("SCHULER_TIME_BUDGET", "none")  # the time estimate would refuse these first
     tracemalloc.start()
     try:
         with pytest.raises(MemoryBudgetExceeded, match="change --duration or --output-step"):

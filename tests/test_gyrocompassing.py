@@ -353,11 +353,11 @@ def test_system_evaluate_is_vectorised_and_matches_run():
     rng = np.random.default_rng(6)
     values = {"latitude": rng.uniform(-1.2, 1.2, n), "azimuth": rng.uniform(0, 2 * np.pi, n),
               "drift_east": rng.normal(0, 0.01 * DEG_PER_H, n), "accel_bias_x": rng.normal(0, 100 * MICRO_G, n),
-              "c_gamma": np.where(np.arange(n) % 2 == 0, np.nan, 0.1)}
+              "c_gamma": np.where(np.arange(n) % 2 == 0, None, 0.1)}
     out = SYSTEM.evaluate_values(values, fidelity="closed")
     assert out["azimuth_error_rad"].shape == (n,)
     for i in (0, 1, 77):
-        single = SYSTEM.run(**{k: float(v[i]) for k, v in values.items() if not np.isnan(v[i])}, duration=1500.0,
+        single = SYSTEM.run(**{k: float(v[i]) for k, v in values.items() if v[i] is not None}, duration=1500.0,
                             fidelity="closed")
         assert out["azimuth_error_rad"][i] == pytest.approx(single.azimuth_error_rad, rel=1e-12)
         assert out["settling_time_s"][i] == pytest.approx(single.settling_time_s, rel=1e-12)
@@ -371,12 +371,12 @@ def test_system_evaluate_is_vectorised_and_matches_run():
 
 
 def test_simulated_fidelity_honours_duration_per_case():
-    values = {"drift_east": np.full(3, 0.01 * DEG_PER_H), "duration": np.array([300.0, 1500.0, np.nan]),
+    values = {"drift_east": np.full(3, 0.01 * DEG_PER_H), "duration": np.array([300.0, 1500.0, None]),
               "output_step": np.array([1.0, 2.0, 1.0])}
     out = SYSTEM.evaluate_values(values)
     np.testing.assert_array_equal(out["simulated_duration_s"], [300.0, 1500.0, 7200.0])
     for i in range(3):
-        given = {k: float(v[i]) for k, v in values.items() if not np.isnan(v[i])}
+        given = {k: float(v[i]) for k, v in values.items() if v[i] is not None}
         single = SYSTEM.run(**given)
         assert out["azimuth_error_rad"][i] == pytest.approx(single.azimuth_error_rad, rel=1e-12)
         assert out["settling_time_simulated_s"][i] == single.settling_time_simulated_s

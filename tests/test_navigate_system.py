@@ -99,13 +99,13 @@ def test_a_batch_is_its_cases_one_by_one():
     """Cases of different trajectories, modes and grids in one evaluate equal each evaluated alone (1e-12)."""
     values = {
         "trajectory": np.array(["stationary", "great-circle", "great-circle", PROFILE], dtype=object),
-        "speed": np.array([np.nan, 200.0, 200.0, np.nan]),
-        "heading": np.array([0.3, 1.0, 1.0, np.nan]),
-        "latitude": np.array([0.5, 0.9, 0.9, np.nan]),
+        "speed": np.array([None, 200.0, 200.0, None]),
+        "heading": np.array([0.3, 1.0, 1.0, None]),
+        "latitude": np.array([0.5, 0.9, 0.9, None]),
         "mode": np.array(["strapdown", "strapdown", "platform", "strapdown"], dtype=object),
         "velocity_error_east": np.array([0.1, 0.2, 0.2, 0.05]),
         "gyro_bias_z": np.array([1e-7, 0.0, 2e-7, 0.0]),
-        "duration": np.array([600.0, 600.0, 600.0, np.nan]),
+        "duration": np.array([600.0, 600.0, 600.0, None]),
         "imu_rate": np.full(4, 10.0), "output_step": np.full(4, 60.0),
     }
     batch = SYSTEM.evaluate_values(values)

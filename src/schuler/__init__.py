@@ -1,29 +1,37 @@
 """schuler: model, simulate and analyse gyroscopic navigation instruments.
 
-Five instrument systems, one subpackage each:
+Each instrument system is a :class:`~schuler.contract.System` (the contract in
+:mod:`schuler.contract`), reached by name with :func:`get_system`; the names
+are :func:`list_systems`::
 
-- :mod:`schuler.navigation_errors`  Schuler-tuned INS error propagation (Bollay).
-- :mod:`schuler.gyro_vertical`      gyro vertical with integral correction (Drozdovich).
-- :mod:`schuler.drift_calibration`  gyro drift calibration by alternating torque pulses.
-- :mod:`schuler.gyrocompassing`     physical gyrocompassing of a platform INS.
-- :mod:`schuler.ground_gyrocompass` ground gyrocompass during rotor run-down.
+    >>> import schuler
+    >>> result = schuler.get_system("align").run(latitude="50 deg", drift_east="0.01 deg/h")
 
-Each is a :class:`~schuler.contract.System` (the contract in
-:mod:`schuler.contract`), reached by name with :func:`get_system`::
-
-    >>> import math, schuler
-    >>> result = schuler.get_system("align").run(latitude=math.radians(50), drift_east=math.radians(0.01) / 3600)
-
-The shared numerical core (Earth constants, the exact linear-systems engine,
-streaming statistics, addressed random numbers) is :mod:`schuler.core`; it
-works in SI units only. Unit parsing lives at the boundary in :mod:`schuler.units`.
+Values are SI (rad, rad/s, m, s), or carry their unit as text (``"50 deg"``)
+or as a pint Quantity. The shared numerical core (Earth constants, the exact
+linear-systems engine, streaming statistics, addressed random numbers) is
+:mod:`schuler.core`; it works in SI units only. Unit parsing lives at the
+boundary in :mod:`schuler.units`.
 """
+
+from schuler.registry import SYSTEM_MODULES as _SYSTEM_MODULES
+from schuler.registry import list_systems
 
 __version__ = "0.2.0"
 
 
+def _systems_listing() -> str:
+    """The registered systems, one line each: command name and subpackage."""
+    lines = [f"- ``{name}``  :mod:`{module.rsplit('.', 1)[0]}`" for name, module in _SYSTEM_MODULES.items()]
+    return f"\n{len(lines)} instrument systems, one subpackage each (``schuler NAME`` on the command line):\n\n" \
+        + "\n".join(lines) + "\n"
+
+
+__doc__ = (__doc__ or "") + _systems_listing()
+
+
 def get_system(name: str):
-    """The system registered under ``name`` (``errors``, ``vertical``, ``calibrate``, ``align``, ``north``).
+    """The system registered under ``name`` (one of :func:`list_systems`: ``errors``, ``align``, ``north`` ...).
 
     Parameters
     ----------
@@ -35,4 +43,4 @@ def get_system(name: str):
     return lookup(name)
 
 
-__all__ = ["__version__", "get_system"]
+__all__ = ["__version__", "get_system", "list_systems"]

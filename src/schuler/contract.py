@@ -32,22 +32,31 @@ random term zero.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Iterator, Mapping
+import difflib
+import time
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from schuler.cases import Cases, default_arrays
 from schuler.core.random import RandomStreams
 from schuler.core.stats import StreamingStatistics
 from schuler.exceptions import InvalidParameter
+from schuler.memory import require_time
 from schuler.params import Case, Parameter, ParameterSet
 from schuler.results import MonteCarloSummary, Result, RunResult
 
 MONTE_CARLO_CHUNK = 2_000
 """Members evaluated at once in :meth:`System.run` Monte Carlo (unless the system says otherwise)."""
+
+RUN_CASE_MEMBERS = 4
+"""Members a run in full counts as in a time estimate: its histories cost a few members where the work is large
+(measured: north 1.1-3.2, mission 4.1, navigate 1.2 with IMU noise and 7 without); where members cost well under a
+millisecond (align, calibrate, errors) the run in full is tens of members, still milliseconds."""
 
 MONTE_CARLO_SAMPLES = 100_000
 """Members whose outputs a Monte Carlo summary keeps for histograms."""
@@ -78,173 +87,6 @@ class Output:
     @property
     def shown_unit(self) -> str:
         return self.display or ("" if self.unit == "1" else self.unit)
-
-
-class Cases:
-    """A batch of validated cases: every parameter an array of length ``n`` (SI).
-
-    Numbers are float arrays (NaN where a parameter is not set and its own rule
-    applies, see :meth:`value_or`), integers int64 arrays, choices and text
-    object arrays (None where not set), flags bool arrays.
-
-    Attributes
-    ----------
-    members : ndarray of int64
-        Global case or member numbers: the addresses of the random draws.
-    random : RandomStreams or None
-        Where random terms come from; None evaluates the nominal case (no noise).
-    fidelity : str or None
-        The system's evaluation fidelity (``"simulated"``, ``"closed"``) or None
-        for its default.
-    """
-
-    def __init__(self, values: Mapping[str, Any], *, members=None, random: RandomStreams | None = None,
-                 fidelity: str | None = None):
-        arrays = {name: np.asarray(value) for name, value in values.items()}
-        lengths = {a.shape[0] for a in arrays.values() if a.ndim == 1}
-        if any(a.ndim != 1 for a in arrays.values()) or len(lengths) > 1:
-            raise InvalidParameter("cases", "every parameter must be a 1-D array of the same length")
-        self.n = lengths.pop() if lengths else 0
-        self._values = arrays
-        self.members = np.arange(self.n, dtype=np.int64) if members is None else np.asarray(members, dtype=np.int64)
-        if self.members.shape != (self.n,):
-            raise InvalidParameter("members", f"expected {self.n} member numbers, got shape {self.members.shape}")
-        self.random = random
-        self.fidelity = fidelity
-
-    @classmethod
-    def from_case(cls, case: Case, n: int = 1, **kwargs) -> Cases:
-        """``n`` copies of one case (a Monte Carlo's members, or a single evaluation).
-
-        Parameters
-        ----------
-        case : Case
-            A validated case (SI values).
-        n : int
-            Number of copies (members).
-        **kwargs
-            ``members``, ``random`` and ``fidelity``, as in :class:`Cases`.
-        """
-        values = {}
-        for name, value in case.items():
-            if value is None:
-                values[name] = np.full(n, None, dtype=object)
-            elif isinstance(value, str):
-                values[name] = np.full(n, value, dtype=object)
-            else:
-                values[name] = np.full(n, value)
-        return cls(values, **kwargs)
-
-    def __len__(self) -> int:
-        return self.n
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        return self._values[name]
-
-    def __contains__(self, name: object) -> bool:
-        return name in self._values
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        return tuple(self._values)
-
-    def float(self, name: str) -> np.ndarray:
-        """A numeric parameter as a float array (NaN where not set).
-
-        Parameters
-        ----------
-        name : str
-            Parameter name; its values are SI (the parameter's SI unit).
-        """
-        array = self._values[name]
-        if array.dtype == object:
-            # numpy's stubs leave out None, which object arrays compare elementwise
-            unset = np.equal(array, None)  # type: ignore[call-overload]
-            return np.where(unset, np.nan, array).astype(float) if unset.any() else array.astype(float)
-        return array.astype(float)
-
-    def value_or(self, name: str, fallback) -> np.ndarray:
-        """A numeric parameter with its "not set" entries replaced by ``fallback`` (scalar or array).
-
-        Parameters
-        ----------
-        name : str
-            Parameter name.
-        fallback : float or ndarray
-            Value of the cases that do not set it, in the parameter's SI unit.
-        """
-        values = self.float(name)
-        return np.where(np.isnan(values), fallback, values)
-
-    def is_set(self, name: str) -> np.ndarray:
-        """Which cases set the parameter (bool array).
-
-        Parameters
-        ----------
-        name : str
-            Parameter name.
-        """
-        array = self._values[name]
-        if array.dtype == object:
-            # numpy's stubs leave out None, which object arrays compare elementwise
-            return ~np.equal(array, None)  # type: ignore[call-overload]
-        if array.dtype.kind == "f":
-            return ~np.isnan(array)
-        return np.ones(self.n, dtype=bool)
-
-    def take(self, index) -> Cases:
-        """The cases at ``index`` (an index array or boolean mask), keeping their member numbers.
-
-        Parameters
-        ----------
-        index : ndarray of int or bool
-            Indices (or a mask of length ``len(self)``) of the cases kept.
-        """
-        return Cases({k: v[index] for k, v in self._values.items()}, members=self.members[index],
-                     random=self.random, fidelity=self.fidelity)
-
-    def groups(self, *names: str) -> Iterator[tuple[np.ndarray, Cases]]:
-        """Split the batch by the distinct values of ``names``: (indices, sub-batch) pairs.
-
-        For parameters that change the shape of a computation (a duration, an
-        output step, a model choice), so each group is evaluated at once.
-
-        Parameters
-        ----------
-        *names : str
-            Parameters whose distinct values define the groups.
-
-        """
-        if not names or self.n == 0:
-            yield np.arange(self.n), self
-            return
-        keys = [tuple(_key(self._values[name][i]) for name in names) for i in range(self.n)]
-        order: dict[tuple, list[int]] = {}
-        for i, key in enumerate(keys):
-            order.setdefault(key, []).append(i)
-        for indices in order.values():
-            index = np.asarray(indices, dtype=np.int64)
-            yield index, self.take(index)
-
-    def case(self, i: int) -> Case:
-        """Case ``i`` as a :class:`Case` (NaN and None become "not set").
-
-        Parameters
-        ----------
-        i : int
-            Index of the case in the batch.
-        """
-        values = {}
-        for name, array in self._values.items():
-            value = array[i]
-            value = value.item() if isinstance(value, np.generic) else value
-            values[name] = None if isinstance(value, float) and math.isnan(value) else value
-        return Case(values, [k for k, v in values.items() if v is not None])
-
-
-def _key(value):
-    value = value.item() if isinstance(value, np.generic) else value
-    return "nan" if isinstance(value, float) and math.isnan(value) else value
 
 
 @dataclass(frozen=True)
@@ -330,6 +172,12 @@ class System:
     member_bytes : callable or None
         ``member_bytes(case) -> int``: memory one member of a Monte Carlo or
         sweep chunk needs while evaluated (sizes the chunks).
+    member_seconds : callable or None
+        ``member_seconds(case) -> float``: time one member of a Monte Carlo or
+        sweep takes, s, from the work it declares (samples, grid points) times
+        a rate measured and stated where it is defined; long work is refused
+        with the estimate before it starts (:meth:`work_seconds`). None: the
+        Monte Carlo's rate is measured on its first chunks instead.
     guide : str
         Name of the system's page in the user guide.
     """
@@ -349,6 +197,7 @@ class System:
     actions: tuple[Action, ...] = ()
     random_terms: bool = False
     member_bytes: Callable[[Case], int] | None = None
+    member_seconds: Callable[[Case], float] | None = None
     guide: str = ""
 
     def case(self, **si_values) -> Case:
@@ -360,6 +209,28 @@ class System:
             Parameters by name, in SI (each parameter's SI unit: rad, rad/s, m, s ...).
         """
         return self.parameters.case(si_values)
+
+    def action(self, name: str) -> Callable[..., Result]:
+        """The function of the system's action ``name`` (``north.action("identify")``), to call from Python.
+
+        Parameters
+        ----------
+        name : str
+            The action's command name (one of :attr:`actions`).
+
+        Raises
+        ------
+        InvalidParameter
+            A name that is not one of the system's actions (the closest suggested).
+        """
+        names = [action.name for action in self.actions]
+        if name not in names:
+            hint = difflib.get_close_matches(str(name), names, n=1)
+            suggestion = f"did you mean {hint[0]!r}? " if hint else ""
+            offered = ", ".join(names) or "none"
+            raise InvalidParameter("action", f"{name!r} is not an action of {self.name}; {suggestion}"
+                                             f"choose from {offered}")
+        return self.actions[names.index(name)].function
 
     def check_fidelity(self, fidelity: str | None) -> str | None:
         """The fidelity to use (the default when None); refuses one the system does not offer.
@@ -412,11 +283,36 @@ class System:
             raise InvalidParameter("monte_carlo", f"{self.name} has no random terms of its own: every member would be "
                                    "the nominal case; draw parameters with a scenario's [monte_carlo] tables")
         streams = RandomStreams(_count(seed, "seed"))
+        estimate = self.work_seconds(case, members)
+        if estimate is not None:
+            what = f"this {self.name} run" + (f" with {members} Monte Carlo members" if members else "")
+            require_time(estimate, what, ("--monte-carlo, " if members else "") + self._work_options())
         result = self.run_case(case, fidelity)
         if members:
             summary = self.monte_carlo(case, members, streams, fidelity, draw=draw, progress=progress)
             result = _with_monte_carlo(result, summary)
         return result
+
+    def work_seconds(self, case: Case, members: int = 0) -> float | None:
+        """Estimated time of :meth:`run` on ``case`` with ``members`` Monte Carlo members, s (None: not declared).
+
+        The run in full (histories for figures) counts as :data:`RUN_CASE_MEMBERS` members.
+
+        Parameters
+        ----------
+        case : Case
+            A validated case (SI values).
+        members : int
+            Monte Carlo members (0: the case alone).
+        """
+        if self.member_seconds is None:
+            return None
+        return float(self.member_seconds(case)) * (members + RUN_CASE_MEMBERS)
+
+    def _work_options(self) -> str:
+        # the options that set a system's amount of work, where it has them
+        names = [p.option for p in self.parameters if p.name in ("duration", "imu_rate", "output_step")]
+        return ", ".join(names[:-1]) + f" or {names[-1]}" if len(names) > 1 else (names or ["the case"])[0]
 
     def monte_carlo(self, case: Case, members: int, streams: RandomStreams, fidelity: str | None = None, *,
                     draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None,
@@ -438,8 +334,20 @@ class System:
         progress : callable, optional
             ``progress(done, total)`` after each chunk, in members.
         """
+        checked = None if draw is None else partial(self._checked_draw, draw)
+        if self.member_seconds is None:
+            progress = _MeasuredPace(members, f"this {self.name} Monte Carlo", progress)
         return monte_carlo(self.evaluate, self.outputs, case, members, streams, fidelity,
-                           chunk=self._chunk_size(case), draw=draw, progress=progress)
+                           chunk=self._chunk_size(case), draw=checked, progress=progress)
+
+    def _checked_draw(self, draw: Callable[[np.ndarray], Mapping[str, np.ndarray]],
+                      numbers: np.ndarray) -> dict[str, np.ndarray]:
+        """A draw's values validated like :meth:`evaluate_values`' (a misspelt name is refused, not ignored)."""
+        drawn = self.checked_arrays(draw(numbers))
+        for name, values in drawn.items():
+            if values.size != numbers.size:
+                raise InvalidParameter(name, f"draw gave {values.size} values for {numbers.size} members")
+        return drawn
 
     def _chunk_size(self, case: Case) -> int:
         if self.member_bytes is None:
@@ -463,17 +371,37 @@ class System:
         fidelity : str, optional
             One of :attr:`fidelities`.
         """
-        self.parameters.refuse_unknown(values)
-        lengths = {np.size(v) for v in values.values() if np.ndim(v) > 0}
+        given = self.checked_arrays(values)
+        lengths = {array.size for name, array in given.items() if np.ndim(values[name]) > 0}
         if len(lengths) > 1:
             raise InvalidParameter("cases", f"parameter arrays have different lengths: {sorted(lengths)}")
         n = lengths.pop() if lengths else 1
-        defaults = Cases.from_case(self.parameters.case(), n)
-        arrays = {name: defaults[name] for name in defaults.names}
-        for name, value in values.items():
-            array = np.broadcast_to(np.asarray(value), (n,))
-            arrays[name] = np.asarray(array, dtype=object) if array.dtype.kind in "USO" else np.array(array)
+        arrays = default_arrays(self.parameters, n)
+        arrays.update({name: np.broadcast_to(array, (n,)) for name, array in given.items()})
         return self.evaluate(Cases(arrays, members=members, random=random, fidelity=self.check_fidelity(fidelity)))
+
+    def checked_arrays(self, values: Mapping[str, Any]) -> dict[str, np.ndarray]:
+        """The given parameter arrays validated as :meth:`run` validates one case (ranges on whole arrays).
+
+        Unknown names (with a suggestion), values of the wrong type,
+        non-finite or out of range, empty or multi-dimensional arrays are
+        refused; None means "not set". Options that exclude each other may be
+        given together in a batch (each system's own precedence applies: a
+        speed profile replaces the speed).
+
+        Parameters
+        ----------
+        values : mapping of str to array_like
+            Parameter arrays (or scalars) in SI.
+
+        Returns
+        -------
+        dict of str to ndarray
+            The given (not None) parameters, each a validated 1-D array (a scalar has length 1).
+        """
+        self.parameters.refuse_unknown(values)
+        given = {name: value for name, value in values.items() if value is not None}
+        return {name: self.parameters[name].check_array(value, name) for name, value in given.items()}
 
     def output(self, name: str) -> Output:
         """The declared :class:`Output` called ``name`` (KeyError if there is none).
@@ -542,6 +470,30 @@ def monte_carlo(evaluate: Callable[[Cases], dict[str, np.ndarray]], outputs: tup
             progress(int(numbers[-1]) + 1, members)
     return MonteCarloSummary.from_statistics(members, streams.seed, outputs, statistics,
                                              {k: np.concatenate(v) if v else np.empty(0) for k, v in samples.items()})
+
+
+class _MeasuredPace:
+    """The time estimate of a system that declares none: the pace of a Monte Carlo's chunks after the first.
+
+    The first chunk is left out (it pays one-off compilation); from the second
+    on, what remains is extrapolated at the pace measured so far, and refused
+    past the time budget — so at most two chunks' time is spent on work refused.
+    """
+
+    def __init__(self, members: int, what: str, progress: Callable[[int, int], None] | None):
+        self.members, self.what, self.progress = members, what, progress
+        self.first: tuple[int, float] | None = None
+
+    def __call__(self, done: int, total: int) -> None:
+        now = time.perf_counter()
+        if self.first is None:
+            self.first = (done, now)
+        elif done > self.first[0] and done < self.members:
+            pace = (now - self.first[1]) / (done - self.first[0])
+            require_time(pace * (self.members - done), f"{self.what} ({self.members} members; pace measured)",
+                         "--monte-carlo")
+        if self.progress is not None:
+            self.progress(done, total)
 
 
 def _count(value, name: str) -> int:

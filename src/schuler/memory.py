@@ -1,4 +1,4 @@
-"""How much memory a command may hold, and a clear refusal before it allocates more.
+"""How much memory a command may hold and how long it may run, and a clear refusal before it starts.
 
 Every command that allocates in proportion to its inputs (time points,
 members, samples) estimates what it will hold and calls :func:`require`
@@ -6,6 +6,13 @@ members, samples) estimates what it will hold and calls :func:`require`
 when the process starts (``MemAvailable`` of ``/proc/meminfo``; 4 GiB where
 that cannot be read), or what the environment variable ``SCHULER_MEMORY_BUDGET``
 says (``"8 GiB"``, ``"500 MB"``, or a number of bytes).
+
+Time works the same way: a command estimates its work (a system's declared
+seconds per member, see :attr:`schuler.contract.System.member_seconds`) and
+calls :func:`require_time` before it starts. The time budget is
+:data:`DEFAULT_TIME_BUDGET` (10 minutes), or what ``SCHULER_TIME_BUDGET`` says
+(``"2 h"``, ``"90 s"``, a number of seconds, or ``"none"``); within
+:func:`no_time_limit` (the CLI's ``--no-time-limit``) there is none.
 
 Examples
 --------
@@ -18,8 +25,12 @@ schuler.memory.MemoryBudgetExceeded: this run would hold 1 EiB, more than the me
 
 from __future__ import annotations
 
+import math
 import os
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from functools import lru_cache
 
 from schuler.exceptions import SchulerError
@@ -30,8 +41,21 @@ _UNITS = {"": 1, "b": 1, "kb": 10**3, "mb": 10**6, "gb": 10**9, "tb": 10**12,
           "kib": 2**10, "mib": 2**20, "gib": 2**30, "tib": 2**40}
 
 
+TIME_ENVIRONMENT = "SCHULER_TIME_BUDGET"
+DEFAULT_TIME_BUDGET = 600.0
+"""Longest run accepted without ``--no-time-limit``, s (10 minutes)."""
+
+_UNLIMITED: ContextVar[bool] = ContextVar("schuler_no_time_limit", default=False)
+_SECONDS = {"": 1.0, "s": 1.0, "sec": 1.0, "min": 60.0, "h": 3600.0, "hour": 3600.0, "hours": 3600.0,
+            "d": 86400.0, "day": 86400.0, "days": 86400.0}
+
+
 class MemoryBudgetExceeded(SchulerError):
     """A command would hold more memory than the budget allows."""
+
+
+class TimeBudgetExceeded(SchulerError):
+    """A command would run longer than the time budget allows."""
 
 
 def parse_bytes(text: str) -> int:
@@ -123,3 +147,85 @@ def chunk_members(member_bytes: int, largest: int = 2_000) -> int:
         Most members per chunk (a count).
     """
     return int(max(1, min(largest, budget() // (4 * max(int(member_bytes), 1)))))
+
+
+def parse_seconds(text: str) -> float:
+    """``"2 h"`` -> 7200.0; ``"90"`` -> 90.0; ``"none"`` -> inf (no limit).
+
+    Parameters
+    ----------
+    text : str
+        A duration with a unit (s, min, h, d) or a bare number of seconds; ``none``, ``off`` or ``inf``: no limit.
+    """
+    spoken = str(text).strip().lower()
+    if spoken in ("none", "off", "inf", "unlimited"):
+        return math.inf
+    match = re.fullmatch(r"([0-9]*\.?[0-9]+(?:e[+-]?[0-9]{1,3})?)\s*([a-z]*)", spoken)
+    if not match or match[2] not in _SECONDS or float(match[1]) <= 0:
+        raise SchulerError(f"{TIME_ENVIRONMENT}: cannot read {text!r} as a duration such as '10 min', '2 h' or 'none'")
+    return float(match[1]) * _SECONDS[match[2]]
+
+
+def time_budget() -> float:
+    """The time budget in seconds (inf within :func:`no_time_limit`; see the module notes)."""
+    if _UNLIMITED.get():
+        return math.inf
+    setting = os.environ.get(TIME_ENVIRONMENT)
+    return parse_seconds(setting) if setting else DEFAULT_TIME_BUDGET
+
+
+@contextmanager
+def no_time_limit(enabled: bool = True) -> Iterator[None]:
+    """Within this block (when ``enabled``), :func:`require_time` accepts any estimate (``--no-time-limit``).
+
+    Parameters
+    ----------
+    enabled : bool
+        Whether to lift the limit (False: the block changes nothing).
+    """
+    token = _UNLIMITED.set(True) if enabled else None
+    try:
+        yield
+    finally:
+        if token is not None:
+            _UNLIMITED.reset(token)
+
+
+def format_seconds(seconds: float) -> str:
+    """``95`` -> ``'1.58 min'``; ``1e9`` -> ``'31.7 years'``: an estimate as people read it.
+
+    Parameters
+    ----------
+    seconds : float
+        A duration, s.
+    """
+    for unit, size in (("years", 365.25 * 86400.0), ("days", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if seconds >= 1.5 * size:
+            return f"{seconds / size:.3g} {unit}"
+    return f"{seconds:.2g} s"
+
+
+def require_time(seconds: float, what: str, change: str) -> None:
+    """Refuse (before starting) when ``what`` would take longer than the time budget.
+
+    Parameters
+    ----------
+    seconds : float
+        Estimated time, s.
+    what : str
+        What would take it (``"this run (1e+09 members)"``).
+    change : str
+        The options that shorten it (``"--monte-carlo or --duration"``).
+
+    Examples
+    --------
+    >>> require_time(1e7, "this run", "--monte-carlo")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    schuler.memory.TimeBudgetExceeded: this run would take about 116 days, more than the time budget of 10 min; ...
+    """
+    limit = time_budget()
+    if seconds > limit:
+        raise TimeBudgetExceeded(
+            f"{what} would take about {format_seconds(seconds)}, more than the time budget of "
+            f"{format_seconds(limit)}; change {change}, or add --no-time-limit (or set {TIME_ENVIRONMENT})")

@@ -29,13 +29,18 @@ from typing import Any, Literal
 import numpy as np
 
 from schuler.exceptions import InvalidParameter
-from schuler.units import parse_quantity, si_unit, to_unit
+from schuler.units import from_unit, parse_quantity, si_unit, to_unit
 
 Kind = Literal["quantity", "choice", "integer", "flag", "text"]
 
 
 def _fmt(x: float) -> str:
     return f"{x:g}"
+
+
+def _is_quantity(value) -> bool:
+    """Whether ``value`` is a pint Quantity (of any unit registry)."""
+    return hasattr(value, "magnitude") and hasattr(value, "units") and hasattr(value, "to")
 
 
 class _Shown:
@@ -105,8 +110,9 @@ class Parameter:
 
         Parameters
         ----------
-        value : float, int, str, bool or None
-            The value in SI (the parameter's SI unit: :attr:`si_unit`).
+        value : float, int, str, bool, pint Quantity or None
+            The value in SI (the parameter's SI unit: :attr:`si_unit`); a quantity
+            may instead carry its unit, as text (``"50 deg"``) or a pint Quantity.
         label : str, optional
             Name used in error messages (default: the parameter's name).
 
@@ -114,6 +120,10 @@ class Parameter:
         label = label or self.name
         if value is None:
             return None
+        if self.kind == "quantity" and _is_quantity(value):
+            value = self._quantity_si(value, label)
+        elif self.kind == "quantity" and isinstance(value, str) and type(self).check is Parameter.check:
+            return self._text_si(value, label)
         if self.kind == "choice":
             return self.parse(value, label)
         if self.kind == "text":
@@ -189,18 +199,122 @@ class Parameter:
         return si
 
     def _check_range(self, shown: float, si, raw, label: str) -> None:
-        # an inclusive bound tolerates the rounding of the unit conversion
-        low_bad = high_bad = False
-        if self.minimum is not None:
-            low_bad = shown < self.minimum or (self.exclusive_minimum and shown <= self.minimum)
-            if low_bad and not self.exclusive_minimum:
-                low_bad = not math.isclose(shown, self.minimum, rel_tol=1e-12, abs_tol=1e-12)
-        if self.maximum is not None:
-            high_bad = shown > self.maximum or (self.exclusive_maximum and shown >= self.maximum)
-            if high_bad and not self.exclusive_maximum:
-                high_bad = not math.isclose(shown, self.maximum, rel_tol=1e-12, abs_tol=1e-12)
-        if low_bad or high_bad:
+        if self._out_of_range(np.asarray([shown], dtype=float))[0]:
             raise InvalidParameter(label, f"{raw!r} is outside {self.range_text()}")
+
+    def _out_of_range(self, shown: np.ndarray) -> np.ndarray:
+        """Which values (in the display unit) lie outside the range (bool array)."""
+        # an inclusive bound tolerates the rounding of the unit conversion
+        bad = np.zeros(shown.shape, dtype=bool)
+        for bound, exclusive, outside in ((self.minimum, self.exclusive_minimum, np.less),
+                                          (self.maximum, self.exclusive_maximum, np.greater)):
+            if bound is None:
+                continue
+            if exclusive:
+                bad |= outside(shown, bound) | (shown == bound)
+            else:
+                near = np.abs(shown - bound) <= np.maximum(1e-12 * np.maximum(np.abs(shown), abs(bound)), 1e-12)
+                bad |= outside(shown, bound) & ~near
+        return bad
+
+    def check_array(self, values, label: str | None = None) -> np.ndarray:
+        """Validate SI values given as a batch (Python API): what :meth:`check` does, on a whole 1-D array.
+
+        Numbers are checked at once (finite, whole where the kind asks it, in
+        range); anything else (text, choices, None for "not set", objects) value
+        by value, once per distinct value. NaN is refused like any non-finite
+        number: "not set" is written None.
+
+        Parameters
+        ----------
+        values : array_like
+            A 1-D array (or list) of values in SI (the parameter's SI unit: :attr:`si_unit`).
+        label : str, optional
+            Name used in error messages (default: the parameter's name).
+
+        Returns
+        -------
+        ndarray
+            float64 for quantities (NaN where not set), int64 for whole numbers,
+            bool for flags, object otherwise (None where not set).
+
+        Raises
+        ------
+        InvalidParameter
+            Not a 1-D array, an empty one, or a value :meth:`check` refuses.
+        """
+        label = label or self.name
+        if self.kind == "quantity" and _is_quantity(values):
+            values = self._quantity_si(values, label)
+        try:
+            array = np.atleast_1d(np.asarray(values))
+        except (ValueError, TypeError):
+            raise InvalidParameter(label, "expected a number or a 1-D array of numbers (ragged input)") from None
+        if array.ndim != 1:
+            raise InvalidParameter(label, f"expected a number or a 1-D array, got an array of shape {array.shape}")
+        if array.size == 0:
+            raise InvalidParameter(label, "expected at least one value, got an empty array")
+        numeric = array.dtype.kind in "iuf" and self.kind in ("quantity", "integer")
+        if numeric and type(self).check is Parameter.check:
+            return self._check_numbers(array, label)
+        if self.kind == "flag" and array.dtype.kind == "b":
+            return array.astype(bool)
+        return self._check_each(array, label)
+
+    def _quantity_si(self, quantity, label: str):
+        """A pint Quantity's magnitude (number or array) in SI, its unit checked as text with a unit is."""
+        per_unit = parse_quantity(f"1 {quantity.units}", self.unit, name=label)
+        magnitude = quantity.magnitude
+        if isinstance(magnitude, (bool, np.bool_)) or np.asarray(magnitude).dtype.kind not in "iuf":
+            raise InvalidParameter(label, f"{quantity!r} is not a number with a unit")
+        return magnitude * per_unit
+
+    def _text_si(self, text: str, label: str) -> float:
+        """A value written with its unit ("50 deg"), as the command line reads it; a bare number must be SI."""
+        try:
+            number = float(text)
+        except ValueError:
+            return self.parse(text, label)
+        if self.unit and not math.isclose(float(from_unit(1.0, self.unit)), 1.0, rel_tol=1e-15):
+            raise InvalidParameter(label, f"{text!r} has no unit: write it with one ('{text} {self.unit}') "
+                                          f"or give a number in SI ({self.si_unit})")
+        return self.check(number, label)
+
+    def _check_numbers(self, array: np.ndarray, label: str) -> np.ndarray:
+        numbers = array.astype(float)
+        finite = np.isfinite(numbers)
+        if not finite.all():
+            raise InvalidParameter(label, f"{numbers[~finite][0]!r} is not a finite number (not set is None)")
+        if self.kind == "integer":
+            whole = numbers == np.round(numbers)
+            if not whole.all():
+                raise InvalidParameter(label, f"{numbers[~whole][0]!r} is not a whole number")
+            bad = self._out_of_range(numbers)
+            if bad.any():
+                raise InvalidParameter(label, f"{int(numbers[bad][0])!r} is outside {self.range_text()}")
+            return array.astype(np.int64)
+        shown = np.asarray(to_unit(numbers, self.unit), dtype=float) if self.unit else numbers
+        bad = self._out_of_range(shown)
+        if bad.any():
+            raise InvalidParameter(label, f"{_Shown(float(shown[bad][0]), self.unit)!r} is outside "
+                                          f"{self.range_text()}")
+        return numbers
+
+    def _check_each(self, array: np.ndarray, label: str) -> np.ndarray:
+        checked: dict[tuple[type, Any], Any] = {}
+        out = np.empty(array.size, dtype=object)
+        for i, value in enumerate(array.tolist()):
+            try:
+                key = (type(value), value)
+                out[i] = checked[key] if key in checked else checked.setdefault(key, self.check(value, label))
+            except TypeError:  # an unhashable value: checked on its own
+                out[i] = self.check(value, label)
+        numbers = [v for v in out if v is not None]
+        if numbers and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in numbers):
+            if self.kind == "integer" and len(numbers) == out.size:
+                return out.astype(np.int64)
+            return np.array([np.nan if v is None else v for v in out], dtype=float)
+        return out
 
     def default_text(self) -> str:
         """The default as ``--help`` shows it: ``50 deg``, ``off``, ``full``, ``not set``."""
@@ -342,7 +456,16 @@ class ParameterSet:
                 allowed = ", ".join(label(n) for n in self.names) or "(none)"
                 raise InvalidParameter(label(name), f"unknown parameter{of}; {suggestion}allowed: {allowed}")
 
-    def _refuse_conflicts(self, given: Iterable[str], label) -> None:
+    def refuse_conflicts(self, given: Iterable[str], label=lambda name: name) -> None:
+        """Raise :class:`InvalidParameter` when two parameters of an exclusive group are both given.
+
+        Parameters
+        ----------
+        given : iterable of str
+            The names given (set, not None).
+        label : callable
+            ``label(name) -> str``: how an error message names a parameter.
+        """
         given = set(given)
         for group in self.exclusive:
             both = [name for name in group if name in given]
@@ -366,7 +489,7 @@ class ParameterSet:
         given = {**(values or {}), **si_values}
         self.refuse_unknown(given)
         given = {name: value for name, value in given.items() if value is not None}
-        self._refuse_conflicts(given, str)
+        self.refuse_conflicts(given, str)
         checked = self.defaults()
         for name, value in given.items():
             checked[name] = self._by_name[name].check(value)
@@ -389,7 +512,7 @@ class ParameterSet:
             if labels == "option" else (lambda name: name)
         given = {name: raw for name, raw in written.items() if raw is not None}
         self.refuse_unknown(given, label)
-        self._refuse_conflicts(given, label)
+        self.refuse_conflicts(given, label)
         values = self.defaults()
         for name, raw in given.items():
             values[name] = self._by_name[name].parse(raw, label(name))

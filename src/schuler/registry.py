@@ -9,9 +9,12 @@ from __future__ import annotations
 
 import difflib
 import importlib
+from typing import TYPE_CHECKING
 
-from schuler.contract import System
 from schuler.exceptions import InvalidParameter
+
+if TYPE_CHECKING:  # the systems are imported on demand, so ``import schuler`` stays light
+    from schuler.contract import System
 
 SYSTEM_MODULES: dict[str, str] = {
     "errors": "schuler.navigation_errors.api",
@@ -24,6 +27,17 @@ SYSTEM_MODULES: dict[str, str] = {
     "mission": "schuler.mission.api",
 }
 """Command name of each system -> module holding its ``SYSTEM``."""
+
+
+def list_systems() -> list[str]:
+    """The names of the registered systems, in the order of the command line (``schuler --help``).
+
+    Examples
+    --------
+    >>> list_systems()[:3]
+    ['errors', 'vertical', 'calibrate']
+    """
+    return list(SYSTEM_MODULES)
 
 
 def get_system(name: str) -> System:

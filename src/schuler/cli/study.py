@@ -23,8 +23,11 @@ from schuler.registry import SYSTEM_MODULES
     default=None,
     help="Folder for figures and data files (default: the scenario's [outputs] directory, if any).",
 )
+@click.option("--no-time-limit", is_flag=True, default=False,
+              help="Run even when the work is estimated to take longer than the time budget (10 min, or "
+                   "SCHULER_TIME_BUDGET).")
 @json_option
-def run_scenario(scenario: Path, out_dir: Path | None, as_json: bool):
+def run_scenario(scenario: Path, out_dir: Path | None, no_time_limit: bool, as_json: bool):
     """Run a scenario file: what `schuler SYSTEM run` does for its parameters.
 
     The file names the system and sets its run options by name
@@ -40,7 +43,7 @@ def run_scenario(scenario: Path, out_dir: Path | None, as_json: bool):
     members = table.cases if table is not None and table.cases else 0
     execute_run(loaded.definition(), loaded.values, monte_carlo=members, seed=table.seed if table else 0,
                 fidelity=loaded.fidelity, out_dir=out_dir or loaded.out_dir, as_json=as_json or loaded.as_json,
-                draw=loaded.draw if members else None)
+                draw=loaded.draw if members else None, time_limit=not no_time_limit)
 
 
 @click.command("report")

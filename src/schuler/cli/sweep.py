@@ -86,9 +86,12 @@ def sweep_command(system: str | None = None) -> click.Command:
                        "system's first).")
     @click.option("--csv/--no-csv", "write_csv", default=True, help="Also write results.csv (large for huge sweeps).")
     @click.option("--progress/--no-progress", default=True, help="Show a progress bar on stderr.")
+    @click.option("--no-time-limit", is_flag=True, default=False,
+                  help="Run even when the sweep is estimated to take longer than the time budget (10 min, or "
+                       "SCHULER_TIME_BUDGET).")
     @json_option
     def sweep(scenario, params, monte_carlo, out_dir, scheduler, workers, chunk_size, fidelity, write_csv, progress,
-              as_json):
+              no_time_limit, as_json):
         """Sweep parameters of a scenario, or run a Monte Carlo, in vectorised chunks.
 
         One row per case in DIR/results.csv and DIR/results.parquet (a column per
@@ -96,21 +99,23 @@ def sweep_command(system: str | None = None) -> click.Command:
         DIR/summary.json and plots DIR/summary_*.png. An interrupted sweep resumes
         where it stopped when run again with the same arguments.
         """
+        from schuler.memory import no_time_limit as unlimited
         from schuler.study.sweep import DEFAULT_CHUNK_SIZE, run_sweep
 
         loaded = scenario_of(scenario, system)
-        summary = run_sweep(
-            loaded,
-            out_dir,
-            params,
-            monte_carlo,
-            chunk_size=chunk_size or DEFAULT_CHUNK_SIZE,
-            scheduler=scheduler,
-            workers=workers,
-            progress=progress and not as_json,
-            write_csv=write_csv,
-            fidelity=fidelity,
-        )
+        with unlimited(no_time_limit):
+            summary = run_sweep(
+                loaded,
+                out_dir,
+                params,
+                monte_carlo,
+                chunk_size=chunk_size or DEFAULT_CHUNK_SIZE,
+                scheduler=scheduler,
+                workers=workers,
+                progress=progress and not as_json,
+                write_csv=write_csv,
+                fidelity=fidelity,
+            )
         emit(summary, as_json, inputs={"scenario": str(scenario), "params": list(params), "monte_carlo": monte_carlo})
 
     return sweep

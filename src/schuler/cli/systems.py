@@ -28,9 +28,15 @@ from schuler.cli.sweep import scenario_of, sweep_command
 from schuler.contract import RUN_OPTIONS, Action, System
 from schuler.exceptions import InvalidParameter
 from schuler.imu.instrument import apply_instrument, instrument_options
+from schuler.memory import format_seconds, no_time_limit
 from schuler.params import Case, ParameterSet
 
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
+
+NO_TIME_LIMIT = click.Option(["--no-time-limit"], is_flag=True, default=False,
+                             help="Run even when the work is estimated to take longer than the time budget "
+                                  "(10 min, or SCHULER_TIME_BUDGET).")
+"""The option that accepts work estimated past the time budget (:func:`schuler.memory.require_time`)."""
 
 
 def system_group(system: System) -> click.Group:
@@ -56,15 +62,19 @@ def _given(case) -> dict:
 
 
 def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fidelity: str | None,
-                out_dir: Path | None, as_json: bool, draw=None, instrument: Case | None = None) -> None:
+                out_dir: Path | None, as_json: bool, draw=None, instrument: Case | None = None,
+                time_limit: bool = True) -> None:
     """What ``schuler NAME run`` and ``schuler run SCENARIO`` do with a parsed case.
 
-    ``instrument``: the ``--imu`` options that set part of the case (shown in the JSON inputs).
+    ``instrument``: the ``--imu`` options that set part of the case (shown in the JSON inputs);
+    ``time_limit``: False for ``--no-time-limit`` (work longer than the time budget accepted).
     """
-    with options_named(system.parameters + RUN_OPTIONS), \
-            progress_reporter(f"{system.name} Monte Carlo", enabled=not as_json) as progress:
-        result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
-                            **_given(case))
+    with options_named(system.parameters + RUN_OPTIONS), no_time_limit(not time_limit):
+        estimate = system.work_seconds(case, monte_carlo)
+        label = f"{system.name} Monte Carlo" + (f" (estimate {format_seconds(estimate)})" if estimate else "")
+        with progress_reporter(label, enabled=not as_json) as progress:
+            result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
+                                **_given(case))
     files = system.write_files(result, out_dir) if out_dir is not None else []
     inputs = dict(case)
     parameters = system.parameters
@@ -109,7 +119,8 @@ def _run_command(system: System) -> click.Command:
     run_options = ParameterSet(RUN_OPTIONS, owner=system.name)
     instrument = instrument_options(system.name)  # --imu where the IMU layer maps to the system
 
-    def run(scenario: Path | None, out_dir: Path | None, as_json: bool, fidelity: str | None = None, **raw):
+    def run(scenario: Path | None, out_dir: Path | None, as_json: bool, no_time_limit: bool,
+            fidelity: str | None = None, **raw):
         options = run_options.parse({k: raw.pop(k) for k in run_options.names}, labels="option")
         imu_options = instrument.parse({k: raw.pop(k) for k in instrument.names}, labels="option")
         case = system.parameters.parse(raw, labels="option")
@@ -126,7 +137,7 @@ def _run_command(system: System) -> click.Command:
             as_json = as_json or loaded.as_json
         case, used = _with_instrument(system, case, imu_options)
         execute_run(system, case, monte_carlo=options["monte_carlo"], seed=options["seed"], fidelity=fidelity,
-                    out_dir=out_dir, as_json=as_json, draw=draw, instrument=used)
+                    out_dir=out_dir, as_json=as_json, draw=draw, instrument=used, time_limit=not no_time_limit)
 
     command = click.Command("run", callback=run, context_settings=_CONTEXT,
                             help=f"One case: {system.title}. The headline numbers; figures and data with --out.\n\n"
@@ -143,6 +154,7 @@ def _run_command(system: System) -> click.Command:
         command.params.append(click.Option(
             ["--fidelity"], type=click.Choice(system.fidelities), default=None,
             help=f"How outputs are computed: {', '.join(system.fidelities)}. [default: {system.fidelities[0]}]"))
+    command.params.append(NO_TIME_LIMIT)
     command.params.extend(_output_params())
     return command
 

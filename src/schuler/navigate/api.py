@@ -23,10 +23,32 @@ Examples
 from __future__ import annotations
 
 from schuler.contract import System
-from schuler.navigate.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case
+from schuler.navigate import imu_noise
+from schuler.navigate.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case, setup
 from schuler.navigate.reproduction import report, reproduce
 from schuler.navigate.results import write_files
+from schuler.params import Case
 from schuler.references import GROVES_2013
+
+SECONDS_PER_SAMPLE = 6e-8
+NOISY_SECONDS_PER_SAMPLE = 4e-7
+"""Time of one IMU interval of one member, s, with an ideal IMU and with an IMU's noise (600 s at 100 Hz, 20
+members: 3.2-4.3 and 23 ms per member; one thread, quiet 2-core machine; benchmarks/bench_navigate.py asks >= 10 M
+and >= 3 M member-samples/s)."""
+
+
+def member_seconds(case: Case) -> float:
+    """Time one member takes, s: its IMU intervals (duration x rate) at the pace of an ideal or a noisy IMU.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI values).
+    """
+    shared = setup(case)
+    noisy = shared.model is not None and imu_noise.has_noise(shared.model)
+    return (NOISY_SECONDS_PER_SAMPLE if noisy else SECONDS_PER_SAMPLE) * shared.duration * shared.imu_rate
+
 
 SYSTEM = System(
     name="navigate",
@@ -41,6 +63,7 @@ SYSTEM = System(
     report=report,
     random_terms=True,
     member_bytes=member_bytes,
+    member_seconds=member_seconds,
     guide="navigate",
 )
 

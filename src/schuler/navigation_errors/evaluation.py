@@ -121,7 +121,10 @@ def _magnitudes(sources: np.ndarray, column: np.ndarray) -> np.ndarray:
         for source in set(sources[unset].tolist()):
             values[unset & (sources == source)] = magnitude_si(str(source), None)
         return values
-    return np.array([magnitude_si(str(source), value) for source, value in zip(sources, column)], dtype=float)
+    # each distinct (source, text) parsed once: unit parsing costs about 1 ms
+    keys = list(zip(sources.tolist(), column.tolist()))
+    resolved = {key: magnitude_si(str(key[0]), key[1]) for key in set(keys)}
+    return np.array([resolved[key] for key in keys], dtype=float)
 
 
 def _batch(cases: Cases) -> dict[str, np.ndarray]:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -19,6 +19,7 @@ import numpy as np
 from schuler.contract import Cases, System
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter, ScenarioError
+from schuler.memory import require_time
 from schuler.params import Parameter
 from schuler.results import json_safe
 from schuler.study.scenario import Distribution, Scenario
@@ -76,6 +77,8 @@ class SweepPlan:
     seed: int = 0
     chunk_size: int = DEFAULT_CHUNK_SIZE
     fidelity: str | None = None
+    estimated_seconds: float | None = None
+    """The work estimate, s (:func:`estimate_seconds`); None where the system declares no ``member_seconds``."""
 
     @property
     def grid_shape(self) -> tuple[int, ...]:
@@ -431,7 +434,44 @@ def plan_sweep(
     )
     if plan.total > MAX_CASES:
         raise ScenarioError(f"the sweep has {plan.total} cases, more than {MAX_CASES}; check the steps")
-    return plan
+    seconds = estimate_seconds(plan, system)
+    if seconds is not None:
+        require_time(seconds, f"this sweep of {plan.total} cases", "the --param steps, --monte-carlo or the "
+                     "scenario's [monte_carlo] cases")
+    return replace(plan, estimated_seconds=seconds)
+
+
+def estimate_seconds(plan: SweepPlan, system: System) -> float | None:
+    """Time the plan's cases take, s: the system's seconds per member at the grid's corners, times the cases.
+
+    The first and the last case of the plan (every axis at its first, then at
+    its last value) are estimated and the larger counts for every case, so an
+    axis that lengthens the work (a duration, a rate) is counted at its end.
+
+    Parameters
+    ----------
+    plan : SweepPlan
+        The sweep's plan.
+    system : System
+        The system swept.
+
+    Returns
+    -------
+    float or None
+        Estimated seconds; None where the system declares no ``member_seconds``.
+    """
+    if system.member_seconds is None or plan.total == 0:
+        return None
+    corners = []
+    for number in (0, plan.total - 1):
+        values = {name: array[0] for name, array in plan.case_values(number, number + 1).items()}
+        given = {name: _plain(value) for name, value in values.items() if not _unset(value)}
+        corners.append(float(system.member_seconds(system.parameters.case(given))))
+    return max(corners) * plan.total
+
+
+def _unset(value) -> bool:
+    return value is None or (isinstance(value, float) and math.isnan(value))
 
 
 

@@ -49,7 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from schuler.io import remove_stale_parts, write_json
-from schuler.memory import format_bytes
+from schuler.memory import format_bytes, format_seconds
 from schuler.results import json_safe
 from schuler.study.executors import InProcess, make_executor
 from schuler.study.plan import DEFAULT_CHUNK_SIZE, SweepPlan, plan_sweep
@@ -230,7 +230,8 @@ class _progress_bar:
         from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
         self.progress = Progress(
-            TextColumn(f"{self.plan.system} sweep"),
+            TextColumn(f"{self.plan.system} sweep" + (f" (estimate {format_seconds(self.plan.estimated_seconds)})"
+                                                      if self.plan.estimated_seconds else "")),
             BarColumn(),
             MofNCompleteColumn(),
             TextColumn("cases"),

@@ -7,7 +7,8 @@ missing third-party module it needs, is a real error and propagates.
 
 from __future__ import annotations
 
-from schuler.registry import SYSTEM_MODULES, System, get_system
+from schuler.contract import System
+from schuler.registry import SYSTEM_MODULES, get_system
 
 
 def load_system(name: str) -> System | None:
