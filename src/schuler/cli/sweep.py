@@ -104,7 +104,7 @@ def sweep_command(system: str | None = None) -> click.Command:
             out_dir,
             params,
             monte_carlo,
-            chunk_size=chunk_size or DEFAULT_CHUNK_SIZE,
+            chunk_size=DEFAULT_CHUNK_SIZE if chunk_size is None else chunk_size,
             scheduler=scheduler,
             workers=workers,
             progress=progress and not as_json,

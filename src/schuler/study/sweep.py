@@ -48,7 +48,7 @@ from pathlib import Path
 
 import numpy as np
 
-from schuler.io import remove_stale_parts, write_json
+from schuler.io import remove_stale_parts, signals_deferred, write_json
 from schuler.memory import format_bytes
 from schuler.results import json_safe
 from schuler.study.executors import InProcess, make_executor
@@ -128,29 +128,41 @@ def run_sweep(
     tasks = (ChunkTask(plan, index, system.evaluate) for index in todo)
     started = began = time.perf_counter()
     caught: dict = {}
-    executor = make_executor(scheduler, workers) if todo else InProcess()
+    # a pool cannot share out a single chunk: its start-up would be pure cost
+    executor = make_executor(scheduler, workers) if len(todo) > 1 or (todo and scheduler) else InProcess()
+    stored = len(done)
     try:
-        with _progress_bar(plan, done, enabled=progress) as advance:
-            for result in executor.map(evaluate_chunk, tasks):
-                _write_chunk(result, out_dir)
-                caught.update(dict.fromkeys(result.warnings))
-                advance(result.cases)
-                if on_chunk is not None:
-                    on_chunk(result.index)
-    finally:
+        try:
+            with _progress_bar(plan, done, enabled=progress) as advance:
+                for result in executor.map(evaluate_chunk, tasks):
+                    _write_chunk(result, out_dir)
+                    stored += 1
+                    caught.update(dict.fromkeys(result.warnings))
+                    advance(result.cases)
+                    if on_chunk is not None:
+                        on_chunk(result.index)
+        except BaseException:
+            # the chunks in flight are lost anyway: stop the workers now rather than after their chunks;
+            # a second Ctrl-C while they are terminated must not leave them running
+            with signals_deferred(deliver=False):
+                executor.close(abort=True)
+            raise
         executor.close()
         _report_warnings(caught)
-    seconds = time.perf_counter() - began
-    if write_csv:
-        _warn_about_csv_size(plan, system)
-    statistics, per_axis, files = gather(plan, out_dir, write_csv=write_csv)
-    per_value = _per_value(plan, per_axis)
-    files.append(write_json(out_dir / "summary.json", json_safe(
-        {"manifest": plan.manifest(), "statistics": statistics, "per_value": per_value})))
-    display = {output.name: output.display for output in system.outputs if output.display}
-    if plots:
-        files.extend(plot_sweep_summary(plan, statistics, per_axis, histograms(plan, out_dir, statistics), out_dir,
-                                        display))
+        seconds = time.perf_counter() - began
+        if write_csv:
+            _warn_about_csv_size(plan, system)
+        statistics, per_axis, files = gather(plan, out_dir, write_csv=write_csv)
+        per_value = _per_value(plan, per_axis)
+        files.append(write_json(out_dir / "summary.json", json_safe(
+            {"manifest": plan.manifest(), "statistics": statistics, "per_value": per_value})))
+        display = {output.name: output.display for output in system.outputs if output.display}
+        if plots:
+            files.extend(plot_sweep_summary(plan, statistics, per_axis, histograms(plan, out_dir, statistics),
+                                            out_dir, display))
+    except KeyboardInterrupt:
+        raise KeyboardInterrupt(f"{stored} of {plan.chunks} chunks are stored in {out_dir}; "
+                                "the same command resumes from them") from None
     computed_cases = sum(plan.chunk_range(i)[1] - plan.chunk_range(i)[0] for i in todo)
     return SweepSummary(
         system=plan.system,
