@@ -104,9 +104,9 @@ def main(argv=None) -> None:
         # a command that keeps what it finished says so in the interrupt's message (a sweep's chunks);
         # click turns a KeyboardInterrupt into an Abort raised from it
         interrupt = stop if isinstance(stop, KeyboardInterrupt) else stop.__cause__
-        kept = str(interrupt) if isinstance(interrupt, KeyboardInterrupt) and str(interrupt) else \
-            "partial files were removed"
-        print(f"schuler: error: {'terminated (SIGTERM)' if terminated else 'interrupted'}; {kept}", file=sys.stderr)
+        kept = f"; {interrupt}" if isinstance(interrupt, KeyboardInterrupt) and str(interrupt) else ""
+        print(f"schuler: error: {'terminated (SIGTERM)' if terminated else 'interrupted'}; "
+              f"partial files were removed{kept}", file=sys.stderr)
         code = 128 + (signal.SIGTERM if terminated else signal.SIGINT)
     except click.ClickException as error:
         print(f"schuler: error: {error.format_message()}", file=sys.stderr)

@@ -161,8 +161,8 @@ def run_sweep(
             files.extend(plot_sweep_summary(plan, statistics, per_axis, histograms(plan, out_dir, statistics),
                                             out_dir, display))
     except KeyboardInterrupt:
-        raise KeyboardInterrupt(f"{stored} of {plan.chunks} chunks are stored in {out_dir}; "
-                                "the same command resumes from them") from None
+        raise KeyboardInterrupt(f"{stored} of {plan.chunks} chunks are kept in {out_dir}, "
+                                "from which the same command resumes") from None
     computed_cases = sum(plan.chunk_range(i)[1] - plan.chunk_range(i)[0] for i in todo)
     return SweepSummary(
         system=plan.system,
