@@ -114,6 +114,9 @@ class LocalProcesses:
     def map(self, function, tasks: Iterable) -> Iterator:
         """Results of ``function`` on each task as they complete (any order), twice ``workers`` tasks in flight.
 
+        Until the first worker delivers a result (the workers are still starting: each imports the toolkit),
+        this process evaluates tasks too, so that the start-up costs a small sweep nothing.
+
         Parameters
         ----------
         function : callable
@@ -126,7 +129,20 @@ class LocalProcesses:
         iterator
             The results, one per task, in order of completion.
         """
-        yield from _windowed(lambda task: self.pool.submit(function, task), tasks, 2 * self.workers, _wait_futures)
+        window = 2 * self.workers
+        pending: set = set()
+        started = False
+        for task in tasks:
+            if len(pending) >= window and not started:
+                started = any(future.done() for future in pending)
+                if not started:
+                    yield function(task)
+                    continue
+            pending.add(self.pool.submit(function, task))
+            if len(pending) >= window and started:
+                yield from _wait_futures(pending)
+        while pending:
+            yield from _wait_futures(pending)
 
     def close(self, abort: bool = False) -> None:
         """Shut the pool down: after the running chunks (default), or at once, terminating the workers.
