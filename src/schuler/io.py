@@ -173,14 +173,14 @@ def signals_deferred(deliver: bool = True):
         yield
         return
     held: list[int] = []
-    previous = {number: signal.getsignal(number) for number in _STOP_SIGNALS}
+    previous: dict[int, object] = {number: signal.getsignal(number) for number in _STOP_SIGNALS}
     for number in _STOP_SIGNALS:
         signal.signal(number, lambda number, frame: held.append(number))
     try:
         yield
     finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler if handler is not None else signal.SIG_DFL)
+        for restored, handler in previous.items():
+            signal.signal(restored, handler if handler is not None else signal.SIG_DFL)  # type: ignore[arg-type]
     if deliver and held:
         handler = previous[held[0]]
         if callable(handler):
