@@ -22,6 +22,9 @@ installed; the chunk files are written by the client, on its own disk.
 ``DIR/chunks/chunk-NNNNNN.parquet`` as soon as it arrives, so an interrupted
 sweep, or a Dask worker that dies, loses only chunks still being computed;
 re-running the same sweep into the same folder skips every chunk on disk.
+Ctrl-C or SIGTERM stops a sweep at once: the worker processes of a local pool
+are terminated (they ignore SIGINT themselves), and the KeyboardInterrupt says
+how many chunks are kept.
 ``DIR/sweep.json`` records the plan, and a different plan is refused there.
 
 **Reproducible.** Random draws depend only on the seed, the parameter name and
