@@ -115,7 +115,7 @@ class LocalProcesses:
         """Results of ``function`` on each task as they complete (any order), twice ``workers`` tasks in flight.
 
         Until the first worker delivers a result (the workers are still starting: each imports the toolkit),
-        this process evaluates tasks too, so that the start-up costs a small sweep nothing.
+        this process evaluates tasks too, rather than wait idle for them.
 
         Parameters
         ----------
