@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import re
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -71,10 +72,66 @@ def test_report_of_a_system_and_of_missing_ones(tmp_path, request):
     assert 'href="figures/fake_azimuth.svg"' in text
     assert "Test fixture &lt;not a real source&gt; &amp; co" in text  # escaped
     assert text.count("Not yet available in this installation") == 2
-    assert "<h3>Reproduction (1 agrees, 1 erratum)</h3>" in text
-    assert '<td class="erratum">erratum</td><td>the source drops a factor</td>' in text
+    assert ('<h3>Reproduction (<span class="verdict agrees">1 agrees</span>, '
+            '<span class="verdict erratum">1 erratum</span>)</h3>') in text
+    assert '<td class="verdict erratum">erratum</td><td>the source drops a factor</td>' in text
     assert "schuler fake run --latitude 50" in text and "An erratum, explained." in text
     assert "<code>--drift-east</code>" in text  # parameters table
+
+
+class Verdicts(HTMLParser):
+    """The verdict cells of a page (class, text), its legend's kinds and its style sheet."""
+
+    def __init__(self, text: str):
+        super().__init__()
+        self.cells: list[tuple[str, str]] = []
+        self.legend: list[str] = []
+        self.css = ""
+        self._in: str | None = None
+        self.feed(text)
+
+    def handle_starttag(self, tag, attrs):
+        classes = (dict(attrs).get("class") or "").split()
+        if tag == "td" and "verdict" in classes:
+            self._in = "cell"
+            self.cells.append((classes[1], ""))
+        elif tag == "span" and "verdict" in classes and self._in == "legend":
+            self.legend.append(classes[1])
+        elif tag == "div" and "legend" in classes:
+            self._in = "legend"
+        elif tag == "style":
+            self._in = "style"
+
+    def handle_endtag(self, tag):
+        if tag in ("td", "div", "style"):
+            self._in = None
+
+    def handle_data(self, data):
+        if self._in == "cell":
+            self.cells[-1] = (self.cells[-1][0], self.cells[-1][1] + data)
+        elif self._in == "style":
+            self.css += data
+
+
+def test_each_kind_of_verdict_has_its_own_colour_and_a_legend():
+    from schuler.contract import ReportSection
+    from schuler.reproduction import Tolerance, compare
+    from schuler.study.report import SystemEntry, render_html
+
+    rows = [compare("a", 1.0, "m", printed="1.0", where="p. 1"),
+            compare("b", 1.0, "m", printed="1.0", where="p. 2", tuned="the gain was chosen"),
+            compare("c", 2.0, "m", printed="1.0", where="p. 3", erratum="a factor 2 dropped"),
+            compare("d", 2.0, "m"),
+            compare("e", 3.0, "m", printed="1.0", where="p. 4", tolerance=Tolerance(relative=0.01))]
+    section = ReportSection(system="fake", title="Fake", source="A source.", summary="Five verdicts.", rows=rows)
+    page = Verdicts(render_html([SystemEntry("fake", fake.SYSTEM, section)], seconds=0.1))
+    assert page.cells == [("agrees", "agrees within 0.5 %"), ("tuned", "tuned to match within 0.5 %"),
+                          ("erratum", "erratum"), ("not-printed", "not printed in the source"),
+                          ("differs", "differs by 200 %")]
+    colours = dict(re.findall(r"\.verdict\.([a-z-]+) \{ color: (#[0-9a-f]{6});", page.css))
+    assert sorted(colours) == sorted(kind for kind, _ in page.cells)  # every kind styled ...
+    assert len(set(colours.values())) == 5  # ... in a colour of its own
+    assert page.legend == ["agrees", "tuned", "erratum", "not-printed", "differs"]
 
 
 def test_a_system_that_fails_to_import_is_an_error_not_a_missing_system(tmp_path, monkeypatch, request):

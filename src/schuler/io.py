@@ -8,6 +8,14 @@ mode of the file it replaces). A symbolic link is followed: the file it points
 to is replaced, the link stays. A FIFO, a character device (``/dev/stdout``) or
 ``-`` (standard output) is written directly, never replaced. Errors name the
 path the user gave, never the temporary file.
+
+A run's set of files (:func:`write_file_set`) is written into a hidden
+temporary folder inside the output folder and moved into place at the end,
+with SIGINT and SIGTERM held back meanwhile: the folder shows either the whole
+new set or none of it. A record in the folder (:data:`FILE_SET_RECORD`) lists
+each command's files, so a new run removes the files of the previous run of the
+same command that it does not write again (an old figure never sits beside new
+data), and leaves every other file alone.
 """
 
 from __future__ import annotations
@@ -16,8 +24,12 @@ import contextlib
 import errno
 import json
 import os
+import shutil
+import signal
 import stat
 import tempfile
+import threading
+from collections.abc import Callable
 from pathlib import Path
 
 PART_SUFFIX = ".part"
@@ -97,7 +109,7 @@ def atomic_path(path):
 
 
 def remove_stale_parts(folder) -> list[Path]:
-    """Delete temporary files (``.*.part``) an interrupted run left in ``folder`` and its subfolders.
+    """Delete temporary files and folders (``.*.part``) an interrupted run left in ``folder`` and its subfolders.
 
     Parameters
     ----------
@@ -105,10 +117,14 @@ def remove_stale_parts(folder) -> list[Path]:
         Output folder.
     """
     removed = []
-    for part in Path(folder).rglob(f".*{PART_SUFFIX}"):
-        if part.is_file():
+    for part in sorted(Path(folder).rglob(f".*{PART_SUFFIX}")):
+        if part.is_symlink() or not part.exists():  # a link is never ours; a folder removed above took it along
+            continue
+        if part.is_dir():
+            shutil.rmtree(part, ignore_errors=True)
+        else:
             part.unlink()
-            removed.append(part)
+        removed.append(part)
     return removed
 
 
@@ -138,6 +154,124 @@ def write_json(path, data) -> Path:
         JSON-safe data (:func:`schuler.results.json_safe`).
     """
     return write_text(path, json.dumps(data, indent=2) + "\n")
+
+
+_STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextlib.contextmanager
+def signals_deferred(deliver: bool = True):
+    """Hold SIGINT and SIGTERM back until the block ends (a no-op outside the main thread).
+
+    Parameters
+    ----------
+    deliver : bool
+        After a block that ended normally, act on the first signal held back as its handler would have
+        (a Ctrl-C raises KeyboardInterrupt); False: drop the signals (the block is already stopping the work).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+    previous: dict[int, object] = {number: signal.getsignal(number) for number in _STOP_SIGNALS}
+    for number in _STOP_SIGNALS:
+        signal.signal(number, lambda number, frame: held.append(number))
+    try:
+        yield
+    finally:
+        for restored, handler in previous.items():
+            signal.signal(restored, handler if handler is not None else signal.SIG_DFL)  # type: ignore[arg-type]
+    if deliver and held:
+        handler = previous[held[0]]
+        if callable(handler):
+            handler(held[0], None)
+        elif handler in (signal.SIG_DFL, None):
+            os.kill(os.getpid(), held[0])
+
+
+FILE_SET_RECORD = ".schuler-files.json"
+"""The record, in an output folder, of the files each command wrote there last (names relative to the folder)."""
+
+
+def write_file_set(out_dir, write: Callable[[Path], list[Path]], command: str) -> list[Path]:
+    """Write a run's files so that ``out_dir`` shows the whole new set or none of it (module notes).
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        The output folder (created if missing; removed again if a failed write leaves it empty).
+    write : callable
+        ``write(folder) -> [paths]``: writes the files into ``folder`` (a temporary folder) and returns them.
+    command : str
+        What writes the set (``"align run"``): the files its previous run left in ``out_dir`` and this one does
+        not write are removed.
+
+    Returns
+    -------
+    list of Path
+        The files written, in ``out_dir``, in the order ``write`` returned them.
+    """
+    shown = Path(out_dir)
+    folder = Path(os.path.realpath(shown))
+    created = not folder.exists()
+    with _naming(None, shown):
+        folder.mkdir(parents=True, exist_ok=True)
+        staging = Path(tempfile.mkdtemp(prefix=".files.", suffix=PART_SUFFIX, dir=folder))
+    try:
+        written = [Path(path) for path in write(staging)]
+        names = [path.relative_to(staging) if path.is_relative_to(staging) else None for path in written]
+        present = {path.relative_to(staging) for path in staging.rglob("*") if path.is_file()}
+        ordered = [name for name in names if name is not None] + sorted(present - set(names))
+        with signals_deferred():
+            for name in dict.fromkeys(ordered):
+                _move_into_place(staging / name, shown / name)
+            _record(shown, command, [str(name) for name in dict.fromkeys(ordered)])
+    except BaseException:
+        if created and folder.exists() and not any(path != staging for path in folder.iterdir()):
+            shutil.rmtree(folder, ignore_errors=True)
+        raise
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return [shown / name if name is not None else path for name, path in zip(names, written, strict=True)]
+
+
+def _move_into_place(source: Path, path: Path) -> None:
+    """``source`` becomes ``path`` under the rules of :func:`atomic_path` (links followed, mode kept)."""
+    target = Path(os.path.realpath(path))
+    if not _streamed(target):
+        with _naming(source, path):
+            target.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                mode = stat.S_IMODE(os.stat(target).st_mode)
+            except FileNotFoundError:
+                mode = 0o666 & ~_umask()
+            os.chmod(source, mode)
+            try:
+                os.replace(source, target)
+                return
+            except OSError as error:
+                if error.errno != errno.EXDEV:
+                    raise
+    # a device, or a link to another file system: copied through an atomic write there
+    with atomic_path(path) as tmp:
+        shutil.copyfile(source, tmp)
+
+
+def _record(folder: Path, command: str, names: list[str]) -> None:
+    """Remember ``command``'s files in ``folder``; remove those of its previous run that it no longer writes."""
+    record = folder / FILE_SET_RECORD
+    try:
+        sets = json.loads(record.read_text(encoding="utf-8"))
+        sets = sets if isinstance(sets, dict) else {}
+    except (OSError, ValueError):  # no record yet, or one that is not ours
+        sets = {}
+    previous = sets.get(command, [])
+    for name in previous if isinstance(previous, list) else []:
+        old = folder / str(name)
+        if name not in names and old.is_file() and not old.is_symlink():  # a link is the user's: left alone
+            old.unlink()
+    sets[command] = names
+    write_json(record, sets)
 
 
 MIN_FONT_KEY = "schuler-min-font-px"

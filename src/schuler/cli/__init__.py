@@ -99,10 +99,14 @@ def main(argv=None) -> None:
         code = cli.main(args=argv, prog_name="schuler", standalone_mode=False)
     except click.exceptions.Exit as exit_:
         code = exit_.exit_code
-    except (click.exceptions.Abort, KeyboardInterrupt):
+    except (click.exceptions.Abort, KeyboardInterrupt) as stop:
         terminated = bool(_SIGNALLED)
+        # a command that keeps what it finished says so in the interrupt's message (a sweep's chunks);
+        # click turns a KeyboardInterrupt into an Abort raised from it
+        interrupt = stop if isinstance(stop, KeyboardInterrupt) else stop.__cause__
+        kept = f"; {interrupt}" if isinstance(interrupt, KeyboardInterrupt) and str(interrupt) else ""
         print(f"schuler: error: {'terminated (SIGTERM)' if terminated else 'interrupted'}; "
-              "partial files were removed", file=sys.stderr)
+              f"partial files were removed{kept}", file=sys.stderr)
         code = 128 + (signal.SIGTERM if terminated else signal.SIGINT)
     except click.ClickException as error:
         print(f"schuler: error: {error.format_message()}", file=sys.stderr)

@@ -78,7 +78,8 @@ def sweep_command(system: str | None = None) -> click.Command:
         type=int,
         default=None,
         metavar="N",
-        help="Local worker processes (without --scheduler), or LocalCluster workers (default 2).",
+        help="Local worker processes (without --scheduler), sharing the cores' threads among them; or "
+        "LocalCluster workers (default 2).",
     )
     @click.option("--chunk-size", type=int, default=None, metavar="N", help="Cases per chunk (default 50000).")
     @click.option("--fidelity", default=None, metavar="NAME",
@@ -109,7 +110,7 @@ def sweep_command(system: str | None = None) -> click.Command:
                 out_dir,
                 params,
                 monte_carlo,
-                chunk_size=chunk_size or DEFAULT_CHUNK_SIZE,
+                chunk_size=DEFAULT_CHUNK_SIZE if chunk_size is None else chunk_size,
                 scheduler=scheduler,
                 workers=workers,
                 progress=progress and not as_json,

@@ -75,7 +75,7 @@ def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fide
         with progress_reporter(label, enabled=not as_json) as progress:
             result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
                                 **_given(case))
-    files = system.write_files(result, out_dir) if out_dir is not None else []
+    files = _write_files(system.write_files, result, out_dir, f"{system.name} run")
     inputs = dict(case)
     parameters = system.parameters
     if instrument is not None:
@@ -86,6 +86,13 @@ def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fide
     if system.fidelities:
         inputs["fidelity"] = system.check_fidelity(fidelity)
     emit(result, as_json, inputs=inputs, parameters=parameters, files=files)
+
+
+def _write_files(writer, result, out_dir: Path | None, command: str) -> list:
+    """The run's files in ``out_dir`` as one set, complete or absent (:func:`schuler.io.write_file_set`)."""
+    from schuler.io import write_file_set
+
+    return write_file_set(out_dir, lambda folder: writer(result, folder), command) if out_dir is not None else []
 
 
 def _with_instrument(system: System, case: Case, options: Case) -> tuple[Case, Case | None]:
@@ -169,7 +176,7 @@ def _reproduce_command(system: System) -> click.Command:
         case = system.reproduce_parameters.parse(raw, labels="option")
         with options_named(system.reproduce_parameters):
             result = system.reproduce(**case)
-        files = system.write_files(result, out_dir) if out_dir is not None else []
+        files = _write_files(system.write_files, result, out_dir, f"{system.name} reproduce")
         emit(result, as_json, inputs=dict(case), parameters=system.reproduce_parameters, files=files)
 
     return _command("reproduce", reproduce, system.reproduce_parameters,
@@ -185,7 +192,7 @@ def _action_command(system: System, action: Action) -> click.Command:
         with options_named(action.parameters):
             result = action.function(**files_in, **case)
         writer = action.write_files or system.write_files
-        files = writer(result, out_dir) if out_dir is not None else []
+        files = _write_files(writer, result, out_dir, f"{system.name} {action.name}")
         written = getattr(result, "files", None) or []
         emit(result, as_json, inputs={**{k: str(v) for k, v in files_in.items()}, **case},
              parameters=action.parameters, files=[*written, *files])

@@ -3,14 +3,29 @@
 Each executor maps a function over chunk tasks and yields results as they
 complete, with only a few chunks in flight at once (bounded memory). The
 workers of an existing Dask cluster need the same version of schuler installed.
+
+Local worker processes share the machine's cores: each gets ``cores // workers``
+threads for BLAS, OpenMP and numba (at least one), because a chunk's small
+batched matrix products run several times slower when every worker also starts
+a BLAS thread per core. Workers ignore SIGINT (a Ctrl-C reaches the whole
+process group): the parent alone stops, terminating the pool.
 """
 
 from __future__ import annotations
 
+import os
+import signal
 from collections.abc import Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 
 from schuler.exceptions import ScenarioError
+
+THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
+"""Environment variables that set a worker's thread pools (BLAS, OpenMP, numba); one that is set is kept."""
+
+TERMINATE_SECONDS = 2.0
+"""How long an interrupted sweep waits for each terminated worker process to end, s."""
 
 
 class InProcess:
@@ -36,12 +51,52 @@ class InProcess:
         for task in tasks:
             yield function(task)
 
-    def close(self) -> None:
-        """Nothing to release."""
+    def close(self, abort: bool = False) -> None:
+        """Nothing to release.
+
+        Parameters
+        ----------
+        abort : bool
+            Unused (nothing runs in the background).
+        """
+
+
+def available_cores() -> int:
+    """The CPU cores this process may run on, number of (at least 1)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def worker_environment(workers: int, environ=None) -> dict[str, str]:
+    """The thread settings a local worker process gets: the cores shared among the workers.
+
+    Parameters
+    ----------
+    workers : int
+        Worker processes, number of, at least 1.
+    environ : mapping, optional
+        The environment to complete (default: this process's); a variable it sets is kept.
+
+    Returns
+    -------
+    dict
+        The variables of :data:`THREAD_VARIABLES` that ``environ`` does not set, each ``cores // workers``
+        (at least 1) as text.
+    """
+    environ = os.environ if environ is None else environ
+    threads = str(max(1, available_cores() // workers))
+    return {name: threads for name in THREAD_VARIABLES if name not in environ}
+
+
+def _ignore_interrupts() -> None:
+    # a Ctrl-C goes to the whole process group; the parent alone decides to stop (and terminates the pool)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 class LocalProcesses:
-    """A pool of local worker processes (spawned: safe beside threads)."""
+    """A pool of local worker processes (spawned: safe beside threads), sharing the cores (module notes)."""
 
     name = "processes"
 
@@ -49,10 +104,18 @@ class LocalProcesses:
         import multiprocessing
 
         self.workers = workers
-        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+        # spawned children copy os.environ when they start, which the pool does on demand while tasks are
+        # submitted: the thread settings stay in this process's environment until the pool is closed
+        self._added = worker_environment(workers)
+        os.environ.update(self._added)
+        self.pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                                        initializer=_ignore_interrupts)
 
     def map(self, function, tasks: Iterable) -> Iterator:
         """Results of ``function`` on each task as they complete (any order), twice ``workers`` tasks in flight.
+
+        Until the first worker delivers a result (the workers are still starting: each imports the toolkit),
+        this process evaluates tasks too, rather than wait idle for them.
 
         Parameters
         ----------
@@ -66,10 +129,42 @@ class LocalProcesses:
         iterator
             The results, one per task, in order of completion.
         """
-        yield from _windowed(lambda task: self.pool.submit(function, task), tasks, 2 * self.workers, _wait_futures)
+        window = 2 * self.workers
+        pending: set = set()
+        started = False
+        for task in tasks:
+            if len(pending) >= window and not started:
+                started = any(future.done() for future in pending)
+                if not started:
+                    yield function(task)
+                    continue
+            pending.add(self.pool.submit(function, task))
+            if len(pending) >= window and started:
+                yield from _wait_futures(pending)
+        while pending:
+            yield from _wait_futures(pending)
 
-    def close(self) -> None:
-        self.pool.shutdown(wait=True, cancel_futures=True)
+    def close(self, abort: bool = False) -> None:
+        """Shut the pool down: after the running chunks (default), or at once, terminating the workers.
+
+        Parameters
+        ----------
+        abort : bool
+            Terminate the worker processes (an interrupted sweep), waiting at most :data:`TERMINATE_SECONDS`
+            for each.
+        """
+        try:
+            if abort:
+                # ProcessPoolExecutor offers no public way to stop running tasks before Python 3.14
+                processes = list((getattr(self.pool, "_processes", None) or {}).values())
+                for process in processes:
+                    process.terminate()
+                for process in processes:
+                    process.join(TERMINATE_SECONDS)
+            self.pool.shutdown(wait=True, cancel_futures=True)
+        finally:
+            for name in self._added:
+                os.environ.pop(name, None)
 
 
 class DaskCluster:
@@ -134,7 +229,14 @@ class DaskCluster:
 
         yield from _windowed(submit, tasks, 2 * threads, next_done)
 
-    def close(self) -> None:
+    def close(self, abort: bool = False) -> None:
+        """Close the client, and the LocalCluster started here.
+
+        Parameters
+        ----------
+        abort : bool
+            Unused: closing the client releases its chunks still on the cluster either way.
+        """
         self.client.close()
         if self.cluster is not None:
             self.cluster.close()
@@ -143,7 +245,11 @@ class DaskCluster:
 def _wait_futures(pending: set) -> list:
     done, _ = wait(pending, return_when=FIRST_COMPLETED)
     pending -= done
-    return [future.result() for future in done]
+    try:
+        return [future.result() for future in done]
+    except BrokenProcessPool:
+        raise ScenarioError("--workers: a worker process ended abruptly (out of memory?); "
+                            "the same command resumes from the chunks stored") from None
 
 
 def _windowed(submit, tasks: Iterable, window: int, next_done) -> Iterator:

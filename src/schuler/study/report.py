@@ -145,7 +145,7 @@ def render_html(entries: list[SystemEntry], seconds: float, figures_dir: Path | 
         '<meta charset="utf-8">',
         '<meta name="viewport" content="width=device-width, initial-scale=1">',
         "<title>schuler: report of the gyroscopic navigation instruments</title>",
-        f"<style>{_CSS}</style>",
+        f"<style>{_CSS}{_verdict_css()}\n</style>",
         "</head>",
         "<body>",
         "<main>",
@@ -174,6 +174,7 @@ ends with the commands that reproduce it; <code>schuler SYSTEM run --help</code>
 lists every parameter, and <code>schuler run SCENARIO.toml</code> and
 <code>schuler sweep</code> turn a case into a study.</p>
 <p>{sum(e.section is not None for e in entries)} of {len(entries)} systems are in this report.</p>
+{_legend()}
 </header>"""
 
 
@@ -287,18 +288,64 @@ def _number(value) -> str:
     return html.escape(str(value))
 
 
+VERDICTS = {
+    "agrees": ("#116329", "#dafbe1", "the computed value is within the stated tolerance of the printed one"),
+    "tuned": ("#0550ae", "#ddf4ff", "it agrees, but an input was chosen so that it does (the note says which)"),
+    "erratum": ("#6639ba", "#fbefff", "it does not agree, and the note explains the source's mistake"),
+    "not-printed": ("#57606a", "#f3f4f6", "a computed value the source does not give"),
+    "differs": ("#a40e26", "#ffebe9", "it does not agree and nothing explains it"),
+}
+"""Each kind of verdict (:mod:`schuler.reproduction`): its text colour, its background and what it means."""
+
+
+def verdict_kind(verdict: str) -> str:
+    """The kind of a reproduction verdict: a key of :data:`VERDICTS` (its colour in the report).
+
+    Parameters
+    ----------
+    verdict : str
+        A row's verdict, as :func:`schuler.reproduction.compare` writes it (``"agrees within 0.5 %"``).
+
+    Returns
+    -------
+    str
+        ``"agrees"``, ``"tuned"``, ``"erratum"``, ``"not-printed"`` or ``"differs"`` (anything else).
+
+    Examples
+    --------
+    >>> verdict_kind("tuned to match within 1 %"), verdict_kind("not printed in the source")
+    ('tuned', 'not-printed')
+    """
+    for prefix, kind in (("agrees", "agrees"), ("tuned", "tuned"), ("erratum", "erratum"),
+                         ("not printed", "not-printed")):
+        if verdict.startswith(prefix):
+            return kind
+    return "differs"
+
+
+def _legend() -> str:
+    items = "".join(f'<li><span class="verdict {kind}">{kind.replace("-", " ")}</span>: {html.escape(meaning)}</li>'
+                    for kind, (_, _, meaning) in VERDICTS.items())
+    return f'<div class="legend"><strong>Verdicts</strong> of the reproduction tables:<ul>{items}</ul></div>'
+
+
+def _verdict_css() -> str:
+    return "\n".join(f".verdict.{kind} {{ color: {colour}; background: {background}; }}"
+                     for kind, (colour, background, _) in VERDICTS.items())
+
+
 def _reproduction_table(section: ReportSection) -> str:
     rows = []
     for row in section.rows:
-        kind = "differs" if row.failed else "erratum" if row.verdict == "erratum" else "ok"
         rows.append(
             f"<tr><td>{html.escape(row.quantity)}</td><td>{html.escape(row.printed or '-')}</td>"
             f"<td>{html.escape(row.where)}</td><td>{_number(row.computed)}</td><td>{html.escape(row.unit)}</td>"
-            f'<td class="{kind}">{html.escape(row.verdict)}</td><td>{html.escape(row.note)}</td></tr>'
+            f'<td class="verdict {verdict_kind(row.verdict)}">{html.escape(row.verdict)}</td>'
+            f"<td>{html.escape(row.note)}</td></tr>"
         )
-    counts = {verdict: sum(row.verdict.startswith(verdict) for row in section.rows)
-              for verdict in ("agrees", "tuned", "erratum", "not printed", "differs")}
-    summary = ", ".join(f"{n} {verdict}" for verdict, n in counts.items() if n)
+    counts = {kind: sum(verdict_kind(row.verdict) == kind for row in section.rows) for kind in VERDICTS}
+    summary = ", ".join(f'<span class="verdict {kind}">{n} {kind.replace("-", " ")}</span>'
+                        for kind, n in counts.items() if n)
     return (
         f"<h3>Reproduction ({summary})</h3>"
         "<table class=\"reproduction\"><thead><tr><th>quantity</th><th>printed</th><th>where</th><th>computed</th>"
@@ -335,9 +382,8 @@ section.missing h2 { color: #8c959f; }
 table { border-collapse: collapse; width: 100%; margin: 0.8rem 0; font-size: 0.9rem; }
 th, td { border: 1px solid #d0d7de; padding: 0.3rem 0.5rem; text-align: left; vertical-align: top; }
 thead th { background: #eef1f4; }
-td.ok { color: #116329; font-weight: 600; }
-td.differs { color: #9a3412; font-weight: 600; }
-td.erratum { color: #7c4a03; font-weight: 600; }
+.verdict { font-weight: 600; padding: 0 0.25rem; border-radius: 3px; }
+.legend ul { margin: 0.2rem 0; padding-left: 1.2rem; }
 .figures { display: grid; grid-template-columns: repeat(auto-fill, minmax(500px, 1fr)); gap: 1rem; }
 figure { margin: 0; background: #fff; border: 1px solid #d0d7de; padding: 0.5rem; }
 figure.wide { grid-column: 1 / -1; }

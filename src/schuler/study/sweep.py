@@ -22,6 +22,9 @@ installed; the chunk files are written by the client, on its own disk.
 ``DIR/chunks/chunk-NNNNNN.parquet`` as soon as it arrives, so an interrupted
 sweep, or a Dask worker that dies, loses only chunks still being computed;
 re-running the same sweep into the same folder skips every chunk on disk.
+Ctrl-C or SIGTERM stops a sweep at once: the worker processes of a local pool
+are terminated (they ignore SIGINT themselves), and the KeyboardInterrupt says
+how many chunks are kept.
 ``DIR/sweep.json`` records the plan, and a different plan is refused there.
 
 **Reproducible.** Random draws depend only on the seed, the parameter name and
@@ -48,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from schuler.io import remove_stale_parts, write_json
+from schuler.io import remove_stale_parts, signals_deferred, write_json
 from schuler.memory import format_bytes, format_seconds
 from schuler.results import json_safe
 from schuler.study.executors import InProcess, make_executor
@@ -128,29 +131,41 @@ def run_sweep(
     tasks = (ChunkTask(plan, index, system.evaluate) for index in todo)
     started = began = time.perf_counter()
     caught: dict = {}
-    executor = make_executor(scheduler, workers) if todo else InProcess()
+    # a pool cannot share out a single chunk: its start-up would be pure cost
+    executor = make_executor(scheduler, workers) if len(todo) > 1 or (todo and scheduler) else InProcess()
+    stored = len(done)
     try:
-        with _progress_bar(plan, done, enabled=progress) as advance:
-            for result in executor.map(evaluate_chunk, tasks):
-                _write_chunk(result, out_dir)
-                caught.update(dict.fromkeys(result.warnings))
-                advance(result.cases)
-                if on_chunk is not None:
-                    on_chunk(result.index)
-    finally:
+        try:
+            with _progress_bar(plan, done, enabled=progress) as advance:
+                for result in executor.map(evaluate_chunk, tasks):
+                    _write_chunk(result, out_dir)
+                    stored += 1
+                    caught.update(dict.fromkeys(result.warnings))
+                    advance(result.cases)
+                    if on_chunk is not None:
+                        on_chunk(result.index)
+        except BaseException:
+            # the chunks in flight are lost anyway: stop the workers now rather than after their chunks;
+            # a second Ctrl-C while they are terminated must not leave them running
+            with signals_deferred(deliver=False):
+                executor.close(abort=True)
+            raise
         executor.close()
         _report_warnings(caught)
-    seconds = time.perf_counter() - began
-    if write_csv:
-        _warn_about_csv_size(plan, system)
-    statistics, per_axis, files = gather(plan, out_dir, write_csv=write_csv)
-    per_value = _per_value(plan, per_axis)
-    files.append(write_json(out_dir / "summary.json", json_safe(
-        {"manifest": plan.manifest(), "statistics": statistics, "per_value": per_value})))
-    display = {output.name: output.display for output in system.outputs if output.display}
-    if plots:
-        files.extend(plot_sweep_summary(plan, statistics, per_axis, histograms(plan, out_dir, statistics), out_dir,
-                                        display))
+        seconds = time.perf_counter() - began
+        if write_csv:
+            _warn_about_csv_size(plan, system)
+        statistics, per_axis, files = gather(plan, out_dir, write_csv=write_csv)
+        per_value = _per_value(plan, per_axis)
+        files.append(write_json(out_dir / "summary.json", json_safe(
+            {"manifest": plan.manifest(), "statistics": statistics, "per_value": per_value})))
+        display = {output.name: output.display for output in system.outputs if output.display}
+        if plots:
+            files.extend(plot_sweep_summary(plan, statistics, per_axis, histograms(plan, out_dir, statistics),
+                                            out_dir, display))
+    except KeyboardInterrupt:
+        raise KeyboardInterrupt(f"{stored} of {plan.chunks} chunks are kept in {out_dir}, "
+                                "from which the same command resumes") from None
     computed_cases = sum(plan.chunk_range(i)[1] - plan.chunk_range(i)[0] for i in todo)
     return SweepSummary(
         system=plan.system,
