@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from schuler import get_system
-from schuler.results import MonteCarloSummary, MonteCarloStatistics
+from schuler.results import MonteCarloStatistics, MonteCarloSummary
 from test_contract import NAMES, light
 
 
