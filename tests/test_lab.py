@@ -144,47 +144,52 @@ def test_closing_the_lab_removes_its_job_cache():
     assert not bench.cache_dir.exists()
 
 
-FORKED_JOB = """
-import multiprocessing, os, signal, socket, sys, threading, time
-from schuler.lab.server import LabServer, serve_until_signal
+def long_job(bench):
+    """A job of the align page's run: a Monte Carlo of 2,000,000 members (minutes), started as the page does."""
+    from dash.background_callback.managers import BaseBackgroundCallbackManager
 
-sock = socket.socket()
-sock.bind(("127.0.0.1", 0))
-sock.listen()
-server = LabServer(lambda environ, start: [], sock)
-
-def job_gets_sigterm():
-    time.sleep(0.3)
-    job = multiprocessing.get_context("fork").Process(target=time.sleep, args=(60,))  # as Dash starts a job
-    job.start()
-    time.sleep(0.3)
-    os.kill(job.pid, signal.SIGTERM)
-    job.join(10)
-    print("job", "ended" if job.exitcode is not None else "alive", job.exitcode, flush=True)
-    if job.exitcode is None:
-        job.kill()
-    os.kill(os.getpid(), signal.SIGTERM)
-
-threading.Thread(target=job_gets_sigterm).start()
-print("server", serve_until_signal(server), flush=True)
-"""
+    key = next(key for key, fn, _ in BaseBackgroundCallbackManager.functions
+               if fn.__module__ == system_page.__name__ and fn.__name__ == "run")
+    parameters = system_page.page_parameters(ALIGN)
+    ids = [{"type": controls.PARAM, "name": p.name} for p in parameters]
+    values = [("2000000" if p.name == "monte_carlo" else controls.initial_text(p)) for p in parameters]
+    return bench.jobs.call_job_fn("long-job", key, [values, 0, ids, "align", "session"], {})
 
 
-def test_a_job_forked_from_the_server_ends_on_sigterm():
-    # the server's SIGTERM handler is inherited by the jobs it forks: there it must end the job, not the server
-    out = subprocess.run([sys.executable, "-c", FORKED_JOB], capture_output=True, text=True, timeout=60)
-    assert out.stdout.split("\n")[:2] == [f"job ended {-signal.SIGTERM}", "server SIGTERM"], out.stderr
+def gone_within(pid: int, seconds: float) -> bool:
+    import psutil
+
+    try:
+        psutil.Process(pid).wait(seconds)
+    except psutil.NoSuchProcess:
+        pass
+    except psutil.TimeoutExpired:
+        return False
+    return True
 
 
-def test_closing_the_lab_ends_a_job_that_ignores_sigterm():
+def test_jobs_are_forked_by_a_job_server_without_threads_and_end_on_cancel_sigterm_and_close():
+    import psutil
+
     bench = create_app()
-    stubborn = subprocess.Popen([sys.executable, "-c", "import signal, time; "
-                                 "signal.signal(signal.SIGTERM, signal.SIG_IGN); print(1, flush=True); time.sleep(60)"],
-                                stdout=subprocess.PIPE, text=True)
-    stubborn.stdout.readline()  # its handler is in place
-    bench.close()
-    # gone well before its 60 s (close reaps it, so its exit status is not left for Popen to read)
-    stubborn.wait(timeout=5)
+    try:
+        server = psutil.Process(bench.jobs.server_pid)
+        cancelled = long_job(bench)
+        assert psutil.Process(cancelled).ppid() == server.pid != os.getpid()
+        assert server.num_threads() == 1 and bench.jobs.job_running(cancelled)
+        bench.jobs.terminate_job(cancelled)  # the page's Cancel
+        assert gone_within(cancelled, 5) and not bench.jobs.job_running(cancelled)
+        bench.jobs.terminate_job(cancelled)  # a job already gone: nothing to do, no error
+        bench.jobs.terminate_job(os.getpid())  # not a job of the lab: left alone
+        terminated = long_job(bench)
+        os.kill(terminated, signal.SIGTERM)
+        assert gone_within(terminated, 5)
+        left_running = long_job(bench)
+        assert server.num_threads() == 1
+    finally:
+        bench.close()
+    assert gone_within(left_running, 5) and gone_within(server.pid, 5)
+    assert not bench.cache_dir.exists()
 
 
 # --- requests: size limit, assets, headers ----------------------------------------------------------------------

@@ -185,9 +185,6 @@ def test_the_reproduction_table_is_one_click_away(server, browser):
     assert watched.close() == {"console": [], "page": [], "failed": [], "outside": []}
 
 
-# slow: in about one run in three on a loaded 2-core machine a job forked while the other session's request
-# thread holds a lock hangs (seen waiting on an import lock); the lab's known open defect, run by make test-slow
-@pytest.mark.slow
 def test_two_sessions_do_not_disturb_each_other(server, browser):
     first, second = Watched(browser, server), Watched(browser, server)
     for watched in (first, second):

@@ -5,14 +5,13 @@ anything but a loopback address unless remote access is asked for explicitly
 (the lab has no authentication: anyone who can reach the port can run
 computations). :class:`LabServer` serves the WSGI application with Werkzeug's
 threaded server (one thread per request; computations run in background job
-processes, see :mod:`schuler.lab.app`) and stops cleanly on Ctrl-C or SIGTERM:
+processes, see :mod:`schuler.lab.jobs`) and stops cleanly on Ctrl-C or SIGTERM:
 the listening socket is closed, running jobs are ended, the job cache is removed.
 """
 
 from __future__ import annotations
 
 import ipaddress
-import os
 import signal
 import socket
 import threading
@@ -253,14 +252,8 @@ def serve_until_signal(server: LabServer) -> str:
         ``"Ctrl-C"`` or ``"SIGTERM"``; ``"shutdown"`` when the server stopped for another reason.
     """
     received: list[str] = []
-    serving_pid = os.getpid()
 
     def stop(signum, frame):
-        if os.getpid() != serving_pid:
-            # a background job forked from the server inherits this handler: there the signal must end the job
-            signal.signal(signum, signal.SIG_DFL)
-            os.kill(os.getpid(), signum)
-            return
         received.append("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
         server.stop()
 
