@@ -24,7 +24,7 @@ import test_study_fake_system as fake
 from schuler.exceptions import InvalidParameter
 from schuler.lab import compare_page, controls, figures, system_page, tasks, views
 from schuler.lab.app import MAX_REQUEST_BYTES, create_app, systems_available
-from schuler.lab.server import check_host, check_port
+from schuler.lab.server import check_host, check_port, host_allowed
 from schuler.registry import get_system
 
 ALIGN = get_system("align")
@@ -198,6 +198,49 @@ def test_large_requests_are_refused_before_they_are_read(client):
     body = b"{" + b" " * (MAX_REQUEST_BYTES + 1) + b"}"
     response = client.post("/_dash-update-component", data=body, content_type="application/json")
     assert response.status_code == 413
+
+
+@pytest.mark.parametrize("host", ["evil.example", "evil.example:8050", "127.0.0.1.evil.example", "192.168.1.20:8050"])
+def test_a_foreign_host_header_is_refused(host):
+    bench = create_app("127.0.0.1", 8050)
+    try:
+        client = bench.server.test_client()
+        assert client.get("/", headers={"Host": host}).status_code == 400
+        assert client.post("/_dash-update-component", json={}, headers={"Host": host}).status_code == 400
+        for own in ("127.0.0.1:8050", "localhost:8050", "[::1]:8050"):
+            assert client.get("/", headers={"Host": own}).status_code == 200, own
+        assert client.get("/", headers={"Host": "127.0.0.1:9999"}).status_code == 400  # another port
+    finally:
+        bench.close()
+
+
+@pytest.mark.parametrize("header, bound, port, allowed", [
+    ("192.168.1.20:8050", "192.168.1.20", 8050, True), ("192.168.1.21:8050", "192.168.1.20", 8050, False),
+    ("10.0.0.5:8050", "0.0.0.0", 8050, True), ("lab.example:8050", "0.0.0.0", 8050, False),
+    ("[::1]:8050", "::", 8050, True), ("localhost", "127.0.0.1", 80, True), ("", "127.0.0.1", 8050, False),
+])
+def test_with_remote_access_only_the_bound_address_is_accepted(header, bound, port, allowed):
+    assert host_allowed(header, bound, port) is allowed
+
+
+def test_remote_access_says_where_the_lab_listens_and_that_it_has_no_login():
+    process = subprocess.Popen([sys.executable, "-m", "schuler", "lab", "--host", "0.0.0.0", "--allow-remote",
+                                "--port", "0", "--no-browser"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    try:
+        process.stdout.readline()
+        warning = process.stderr.readline()
+    finally:
+        process.terminate()
+        process.wait(timeout=30)
+    assert warning.startswith("schuler lab: warning: listening on every address of this machine (0.0.0.0), port ")
+    assert "the lab has no login" in warning
+
+
+@pytest.mark.parametrize("path", ["/_dash-component-suites/dash/../x.js", "/_dash-component-suites/nope/x.js",
+                                  "/_dash-component-suites/dash/../../etc/passwd", "/_dash-component-suites/..%2fx"])
+def test_an_asset_that_does_not_exist_is_404(client, path):
+    assert client.get(path).status_code == 404
 
 
 def test_every_asset_of_a_page_is_served_by_the_lab_itself(client):

@@ -102,8 +102,16 @@ class Lab:
             time.sleep(0.2)
 
 
-def create_app() -> Lab:
-    """Build the lab (pages for every registered system, the KPI tasks, limits and headers)."""
+def create_app(host: str = "127.0.0.1", port: int | None = None) -> Lab:
+    """Build the lab (pages for every registered system, the KPI tasks, limits and headers).
+
+    Parameters
+    ----------
+    host : str
+        The address the lab listens on (requests whose ``Host`` names another are refused).
+    port : int, optional
+        The TCP port it serves (requests for another are refused); None accepts any port.
+    """
     cache_dir = Path(tempfile.mkdtemp(prefix="schuler-lab-jobs-"))
     manager = JobServerManager(cache_dir)  # spawned first: it imports and warms while the pages are built
     app = Dash(
@@ -120,7 +128,7 @@ def create_app() -> Lab:
     available = systems_available()
     app.layout = lambda: _shell(available)
     _routing(app, {a.name: a for a in available}, register_pages(app))
-    _limits(app)
+    _limits(app, host, port)
     return Lab(app, cache_dir, manager)
 
 
@@ -196,18 +204,28 @@ def _not_found(pathname: str) -> html.Div:
                      dcc.Link("the list of pages", href="/")])
 
 
-def _limits(app: Dash) -> None:
-    """Refuse large requests before reading them; headers that keep the page to its own origin."""
+def _limits(app: Dash, host: str, port: int | None) -> None:
+    """Refuse foreign Host headers and large requests before reading them; an asset that does not exist is
+    404; headers that keep the page to its own origin."""
+    from dash.exceptions import DependencyException
     from flask import abort, request
+
+    from schuler.lab.server import host_allowed
 
     server = app.server
     server.config["MAX_CONTENT_LENGTH"] = MAX_REQUEST_BYTES
     policy = f"{CONTENT_SECURITY_POLICY}; script-src 'self' {' '.join(app.csp_hashes())}"
 
     @server.before_request
-    def refuse_large():
+    def refuse_foreign_or_large():
+        if not host_allowed(request.host, host, port):
+            abort(400)  # a page elsewhere reaching the lab under its own name (DNS rebinding)
         if request.content_length is not None and request.content_length > MAX_REQUEST_BYTES:
             abort(413)
+
+    @server.errorhandler(DependencyException)
+    def no_such_asset(error):
+        return "not found", 404
 
     @server.after_request
     def headers(response):
