@@ -18,14 +18,18 @@ server dies, the job server reads the end of its pipe and ends its jobs.
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import signal
+import socket
+import subprocess
+import sys
 import threading
 from multiprocessing.connection import Connection
 from pathlib import Path
 
 from dash import DiskcacheManager
+
+import schuler
 
 FIRST_WARMED = "align"
 """The system warmed first (the lab's most used page); the others follow in the registry's order."""
@@ -53,20 +57,25 @@ class JobServerManager(DiskcacheManager):
 
         self.cache_dir = Path(cache_dir)
         self._lock = threading.Lock()  # one request at a time on the pipe (the web server has a thread per request)
-        self._process: multiprocessing.process.BaseProcess | None = None
+        self._process: subprocess.Popen | None = None
         self._connection: Connection | None = None
         super().__init__(diskcache.Cache(str(self.cache_dir)))
         self._start()
 
     def _start(self) -> None:
-        # pandas loads pyarrow, whose allocator would start a background thread in the job server
-        os.environ.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
-        context = multiprocessing.get_context("spawn")  # a fresh interpreter: no thread, no lock inherited
-        self._connection, theirs = context.Pipe()
-        self._process = context.Process(target=serve_jobs, args=(theirs, str(self.cache_dir)), daemon=True,
-                                        name="schuler-lab-jobs")
-        self._process.start()
+        ours, theirs = socket.socketpair()
+        environment = {
+            **os.environ,
+            # the job server imports schuler from where this process did (a script may have set its own path)
+            "PYTHONPATH": os.pathsep.join([str(Path(schuler.__file__).parents[1]), os.environ.get("PYTHONPATH", "")]),
+            # pandas loads pyarrow, whose allocator would start a background thread in the job server
+            "JE_ARROW_MALLOC_CONF": os.environ.get("JE_ARROW_MALLOC_CONF", "background_thread:false"),
+        }
+        # a fresh interpreter (not multiprocessing's spawn, which would run the caller's main script again)
+        self._process = subprocess.Popen([sys.executable, "-m", __name__, str(theirs.fileno()), str(self.cache_dir)],
+                                         pass_fds=(theirs.fileno(),), env=environment, stdin=subprocess.DEVNULL)
         theirs.close()
+        self._connection = Connection(ours.detach())
 
     @property
     def server_pid(self) -> int | None:
@@ -104,7 +113,7 @@ class JobServerManager(DiskcacheManager):
         request = ("start", job_fn, key, self._make_progress_key(key), args, dict(context))
         with self._lock:
             for attempt in (1, 2):
-                if self._process is None or not self._process.is_alive():
+                if self._process is None or self._process.poll() is not None:
                     self._start()  # ended by a signal from outside: a new one (it warms again)
                 try:
                     self._connection.send(request)
@@ -183,13 +192,14 @@ class JobServerManager(DiskcacheManager):
             if self._connection is not None:
                 self._connection.close()
             if process is not None:
-                process.join(3)
-                if process.is_alive():
-                    process.terminate()
-                    process.join(3)
-                if process.is_alive():
-                    process.kill()
-                    process.join(3)
+                for stop in (None, process.terminate, process.kill):
+                    if stop is not None:
+                        stop()
+                    try:
+                        process.wait(3)
+                        break
+                    except subprocess.TimeoutExpired:
+                        continue
             for leftover in tree:  # a job forked while the pipe closed
                 try:
                     leftover.kill()
@@ -331,3 +341,7 @@ def _run_job(function, cache_dir: str, result_key: str, progress_key: str, args,
         code = 0
     finally:
         os._exit(code)  # never return into the job server's loop
+
+
+if __name__ == "__main__":
+    serve_jobs(Connection(int(sys.argv[1])), sys.argv[2])
