@@ -368,6 +368,24 @@ def test_headline_numbers_show_the_display_unit():
     assert spans == {"azimuth_error_rad": "3.556 arcmin", "settling_time_s": "3600 s"}
 
 
+def test_rounding_noise_is_shown_as_zero_and_a_flag_as_yes_or_no():
+    result = system_page.run_typed(ALIGN, {})  # no drift: every angle error is the arithmetic's noise (1e-86 rad)
+    values = {o.name: getattr(result, o.name) for o in ALIGN.outputs}
+    assert 0 < abs(values["azimuth_error_rad"]) < 1e-80
+    shown = dict(zip([o.name for o in ALIGN.outputs], views.headline_texts(ALIGN, values)))
+    assert shown["azimuth_error_rad"] == "0 arcmin" and shown["level_error_beta_rad"] == "0 arcmin"
+    assert shown["azimuth_error_sigma_rad"] == "3.579 arcmin"  # a real number of the same case stays
+    assert shown["constraints_ok"] == "yes"
+    assert views.quantity_text(False, ALIGN.outputs[-2]) == "no"
+    north = get_system("north")
+    result = system_page.run_typed(north, {})
+    texts = views.headline_texts(north, {o.name: getattr(result, o.name) for o in north.outputs})
+    # a north error of 1e-18 rad beside a north of 0.02 rad is noise, a genuine small value is not
+    assert texts[0] == "-1.23 deg" and texts[1] == "0 arcsec"
+    assert views.quantity_text(1e-12, north.outputs[1], views.resolutions(north, {"north_error_rad": 1e-12})[
+        "north_error_rad"]) == "2.063e-07 arcsec"
+
+
 def test_only_values_changed_from_the_defaults_count_as_typed():
     ids = [{"type": controls.PARAM, "name": n} for n in ("latitude", "drift_east", "gain", "unknown")]
     typed = controls.typed_values(fake.PARAMETERS, ids, ["50", " 0.02 ", "", "3"])
