@@ -110,7 +110,7 @@ def create_app(host: str = "127.0.0.1", port: int | None = None) -> Lab:
     host : str
         The address the lab listens on (requests whose ``Host`` names another are refused).
     port : int, optional
-        The TCP port it serves (requests for another are refused); None accepts any port.
+        TCP port served, a plain number from 0 to 65535 (requests for another are refused); None accepts any.
     """
     cache_dir = Path(tempfile.mkdtemp(prefix="schuler-lab-jobs-"))
     manager = JobServerManager(cache_dir)  # spawned first: it imports and warms while the pages are built

@@ -24,7 +24,7 @@ import socket
 import subprocess
 import sys
 import threading
-from multiprocessing.connection import Connection
+from multiprocessing.connection import Connection, wait
 from pathlib import Path
 
 from dash import DiskcacheManager
@@ -224,54 +224,81 @@ def job_functions() -> dict:
     return {key: (fn, progress) for key, fn, progress in BaseBackgroundCallbackManager.functions}
 
 
-def warm_steps():
-    """Run each system's starting case once here, one system per step, so that jobs forked afterwards find
-    its kernels compiled (a generator: the job server serves the jobs asked for between two steps).
+class Warming:
+    """Runs each system's starting case once in the job server, so that jobs forked later find its kernels
+    compiled and loaded.
 
     A case whose run starts threads (a parallel kernel's thread pool) is not run
-    here: this process must stay single-threaded to fork safely. Each case is
-    first tried in a forked probe, which reports the threads it ends with.
-
-    Yields
-    ------
-    str
-        The name of each system warmed.
+    here: this process must stay single-threaded to fork safely. So each case is
+    first run in a forked *probe* (it compiles into numba's disk cache and
+    reports the threads it ends with) while the job server goes on serving; only
+    then, and only while no job runs, the case runs here (loading from the cache).
+    Systems are warmed in the registry's order, :data:`FIRST_WARMED` first.
     """
+
+    def __init__(self):
+        from schuler.registry import SYSTEM_MODULES
+
+        self._names = sorted(SYSTEM_MODULES, key=lambda name: name != FIRST_WARMED)
+        self._probe: tuple[int, int, str] | None = None  # process id, pipe to read, system
+        self.warmed: list[str] = []
+
+    @property
+    def done(self) -> bool:
+        return not self._names and self._probe is None
+
+    @property
+    def probe_fd(self) -> int | None:
+        """The pipe the running probe answers on (None: no probe runs)."""
+        return None if self._probe is None else self._probe[1]
+
+    def start_probe(self) -> None:
+        """Fork a probe for the next system (nothing when one runs or none is left)."""
+        if self._probe is not None or not self._names:
+            return
+        name = self._names.pop(0)
+        read, write = os.pipe()
+        pid = os.fork()
+        if pid == 0:
+            os.close(read)
+            signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+            try:
+                _run_case(name)
+                single = os_threads() == 1
+            except BaseException:
+                single = False
+            try:
+                os.write(write, b"1" if single else b"0")
+            finally:
+                os._exit(0)  # the job server may have closed meanwhile (its end of the pipe gone)
+        os.close(write)
+        self._probe = (pid, read, name)
+
+    def finish_probe(self) -> None:
+        """Read the probe's answer; warm its system here when it stayed single-threaded."""
+        if self._probe is None:
+            return
+        pid, read, name = self._probe
+        self._probe = None
+        with os.fdopen(read, "rb") as answer:
+            single = answer.read(1) == b"1"
+        os.waitpid(pid, 0)
+        if single:
+            try:
+                _run_case(name)
+                self.warmed.append(name)
+            except Exception:  # not importable, or a failing starting case: its page says why when a job runs it
+                pass
+
+
+def _run_case(name: str) -> None:
     from schuler.lab import figures, system_page
-    from schuler.registry import SYSTEM_MODULES, get_system
+    from schuler.registry import get_system
 
-    for name in sorted(SYSTEM_MODULES, key=lambda name: name != FIRST_WARMED):
-        try:
-            system = get_system(name)
-            if _single_threaded_in_probe(lambda system=system: _run_case(system, system_page, figures)):
-                _run_case(system, system_page, figures)
-                yield name
-        except Exception:  # not importable, or a failing starting case: its page says why when a job runs it
-            continue
-
-
-def _run_case(system, system_page, figures) -> None:
-    figures.interactive_figures(system, system_page.run_typed(system, {}))
-
-
-def _single_threaded_in_probe(work) -> bool:
-    """Whether ``work()``, run in a forked child, leaves that child with one thread."""
-    read, write = os.pipe()
-    pid = os.fork()
-    if pid == 0:
-        os.close(read)
-        try:
-            work()
-            single = os_threads() == 1
-        except BaseException:
-            single = False
-        os.write(write, b"1" if single else b"0")
-        os._exit(0)
-    os.close(write)
-    with os.fdopen(read, "rb") as answer:
-        single = answer.read(1) == b"1"
-    os.waitpid(pid, 0)
-    return single
+    system = get_system(name)
+    result = system_page.run_typed(system, {})
+    if figures.interactive_figures(system, result) is None:
+        figures.file_figures(system, result)  # the page shows the system's own figures (matplotlib)
 
 
 def serve_jobs(connection, cache_dir: str) -> None:
@@ -299,11 +326,19 @@ def serve_jobs(connection, cache_dir: str) -> None:
                 jobs.discard(pid)
 
     signal.signal(signal.SIGCHLD, reap)  # an ended job disappears at once: the web server sees it is not running
-    warming = warm_steps()
+    warming = Warming()
     try:
         while True:
-            if warming is not None and not connection.poll(0):
-                warming = None if next(warming, None) is None else warming
+            if not jobs:
+                warming.start_probe()  # warming works only while no job needs the processor
+            # a probe's answer is taken (and its case run here) only while no job runs
+            probe = [warming.probe_fd] if warming.probe_fd is not None and not jobs else []
+            waiting_on = [connection, *probe]
+            ready = wait(waiting_on, timeout=None if warming.done else 0.2)
+            if warming.probe_fd in ready and connection not in ready:
+                warming.finish_probe()
+                continue
+            if connection not in ready:
                 continue
             try:
                 _, key, result_key, progress_key, args, context = connection.recv()

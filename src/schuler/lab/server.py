@@ -108,7 +108,7 @@ def host_allowed(header: str, bound: str, port: int | None) -> bool:
     bound : str
         The address the lab listens on.
     port : int or None
-        The TCP port served (None: any port, for an application not bound to one).
+        TCP port served, a plain number from 0 to 65535 (None: any, for an application not bound to one).
 
     Returns
     -------
@@ -207,7 +207,7 @@ def listening_text(host: str, port: int) -> str:
     host : str
         The address the socket is bound to.
     port : int
-        The TCP port it is bound to.
+        TCP port bound, a plain number from 0 to 65535.
 
     Returns
     -------
