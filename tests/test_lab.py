@@ -137,6 +137,23 @@ def test_the_server_prints_its_url_and_stops_cleanly_on_a_signal(signum, how):
     assert stderr == f"schuler lab: stopped ({how})\n"
 
 
+def test_the_job_server_ends_and_removes_the_job_cache_when_the_lab_is_killed():
+    import psutil
+
+    process, _ = start_server()
+    try:
+        [job_server] = psutil.Process(process.pid).children()
+        cache_dir = Path(job_server.cmdline()[-1])
+        assert cache_dir.is_dir()
+        process.kill()  # no cleanup runs: the job server sees its pipe close
+        process.wait(timeout=30)
+        assert gone_within(job_server.pid, 20)
+        assert not cache_dir.exists()
+    finally:
+        if process.poll() is None:
+            process.kill()
+
+
 def test_closing_the_lab_removes_its_job_cache():
     bench = create_app()
     assert bench.cache_dir.is_dir()

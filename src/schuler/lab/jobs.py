@@ -19,6 +19,7 @@ server dies, the job server reads the end of its pipe and ends its jobs.
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -358,6 +359,7 @@ def serve_jobs(connection, cache_dir: str) -> None:
                 os.waitpid(pid, 0)
             except (ProcessLookupError, ChildProcessError):
                 pass
+        shutil.rmtree(cache_dir, ignore_errors=True)  # also when the web server was killed and could not
 
 
 def _run_job(function, cache_dir: str, result_key: str, progress_key: str, args, context) -> None:
