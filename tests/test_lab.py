@@ -21,7 +21,7 @@ from dash import html, no_update
 
 import schuler.lab
 import test_study_fake_system as fake
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, SchulerError
 from schuler.lab import compare_page, controls, figures, system_page, tasks, views
 from schuler.lab.app import MAX_REQUEST_BYTES, create_app, systems_available
 from schuler.lab.server import check_host, check_port, host_allowed
@@ -135,6 +135,21 @@ def test_the_server_prints_its_url_and_stops_cleanly_on_a_signal(signum, how):
     stderr = process.stderr.read()
     assert code == 0
     assert stderr == f"schuler lab: stopped ({how})\n"
+
+
+def test_a_job_server_killed_from_outside_is_replaced_and_a_closed_lab_starts_no_job():
+    bench = create_app()
+    try:
+        first = bench.jobs.server_pid
+        os.kill(first, signal.SIGKILL)
+        assert gone_within(first, 5)
+        job = long_job(bench)
+        assert bench.jobs.server_pid != first and bench.jobs.job_running(job)
+        assert bench.cache_dir.is_dir()  # the new job server writes into the same job cache
+    finally:
+        bench.close()
+    with pytest.raises(SchulerError, match="the lab is stopping"):
+        long_job(bench)
 
 
 def test_the_job_server_ends_and_removes_the_job_cache_when_the_lab_is_killed():

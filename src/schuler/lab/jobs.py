@@ -31,6 +31,7 @@ from pathlib import Path
 from dash import DiskcacheManager
 
 import schuler
+from schuler.exceptions import SchulerError
 
 FIRST_WARMED = "align"
 """The system warmed first (the lab's most used page); the others follow in the registry's order."""
@@ -60,10 +61,13 @@ class JobServerManager(DiskcacheManager):
         self._lock = threading.Lock()  # one request at a time on the pipe (the web server has a thread per request)
         self._process: subprocess.Popen | None = None
         self._connection: Connection | None = None
+        self._closed = False
         super().__init__(diskcache.Cache(str(self.cache_dir)))
         self._start()
 
     def _start(self) -> None:
+        if self._connection is not None:
+            self._connection.close()
         ours, theirs = socket.socketpair()
         environment = {
             **os.environ,
@@ -113,17 +117,17 @@ class JobServerManager(DiskcacheManager):
         """
         request = ("start", job_fn, key, self._make_progress_key(key), args, dict(context))
         with self._lock:
-            for attempt in (1, 2):
-                if self._process is None or self._process.poll() is not None:
-                    self._start()  # ended by a signal from outside: a new one (it warms again)
-                try:
-                    self._connection.send(request)
-                    return self._connection.recv()
-                except (EOFError, OSError):
-                    if attempt == 2:
-                        raise
-                    self._process = None
-        raise AssertionError("unreachable")
+            if self._closed:
+                raise SchulerError("the lab is stopping: no new computation starts")
+            if self._process is None or self._process.poll() is not None:
+                self._start()  # ended from outside (a signal): a new one, which warms again
+            try:
+                self._connection.send(request)
+                return self._connection.recv()
+            except (EOFError, OSError):  # it ended just now
+                self._start()
+                self._connection.send(request)
+                return self._connection.recv()
 
     def _own_job(self, job) -> object | None:
         """The psutil process of job ``job`` when it is one of this lab's jobs still running, else None."""
@@ -185,6 +189,7 @@ class JobServerManager(DiskcacheManager):
         import psutil
 
         with self._lock:
+            self._closed = True
             process, self._process = self._process, None
             try:
                 tree = psutil.Process(process.pid).children(recursive=True) if process is not None else []
@@ -328,6 +333,7 @@ def serve_jobs(connection, cache_dir: str) -> None:
 
     signal.signal(signal.SIGCHLD, reap)  # an ended job disappears at once: the web server sees it is not running
     warming = Warming()
+    lab_gone = False
     try:
         while True:
             if not jobs:
@@ -344,7 +350,8 @@ def serve_jobs(connection, cache_dir: str) -> None:
             try:
                 _, key, result_key, progress_key, args, context = connection.recv()
             except (EOFError, OSError):
-                break  # the lab closed (or died)
+                lab_gone = True  # the lab closed (or died)
+                break
             pid = os.fork()
             if pid == 0:
                 _run_job(functions[key], cache_dir, result_key, progress_key, args, context)
@@ -359,7 +366,8 @@ def serve_jobs(connection, cache_dir: str) -> None:
                 os.waitpid(pid, 0)
             except (ProcessLookupError, ChildProcessError):
                 pass
-        shutil.rmtree(cache_dir, ignore_errors=True)  # also when the web server was killed and could not
+        if lab_gone:  # also when the web server was killed and could not remove it (a new job server keeps it)
+            shutil.rmtree(cache_dir, ignore_errors=True)
 
 
 def _run_job(function, cache_dir: str, result_key: str, progress_key: str, args, context) -> None:
