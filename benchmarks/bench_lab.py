@@ -1,7 +1,7 @@
 """Benchmark: how long the gyrocompassing page of ``schuler lab`` takes to follow a change.
 
 Starts ``schuler lab`` on a free port, opens ``/align`` in Debian's Chromium
-(Playwright) and types a new latitude CHANGES times; each latency is the time
+(Playwright), sets an east drift of 0.02 deg/h and types a new latitude CHANGES times; each latency is the time
 from Enter to the new azimuth-error number on the page (its figures are drawn
 in the same update). The baseline measured in the same run is the computation
 alone (``System.run`` of the same case plus building the figures, in process),
@@ -60,6 +60,11 @@ def main() -> int:
             number = page.locator("[data-result=azimuth_error_rad]")
             field = page.locator("[data-param=latitude] input")
             while number.inner_text().strip() == "-":
+                page.wait_for_timeout(25)
+            # a drift, so that the azimuth error depends on the latitude (without one it is 0 at every latitude)
+            page.locator("[data-param=drift_east] input").fill("0.02")
+            page.locator("[data-param=drift_east] input").press("Enter")
+            while number.inner_text().strip() == "0 arcmin":
                 page.wait_for_timeout(25)
             for change in range(CHANGES):
                 shown = number.inner_text()

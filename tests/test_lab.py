@@ -21,10 +21,10 @@ from dash import html, no_update
 
 import schuler.lab
 import test_study_fake_system as fake
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, SchulerError
 from schuler.lab import compare_page, controls, figures, system_page, tasks, views
 from schuler.lab.app import MAX_REQUEST_BYTES, create_app, systems_available
-from schuler.lab.server import check_host, check_port
+from schuler.lab.server import check_host, check_port, host_allowed
 from schuler.registry import get_system
 
 ALIGN = get_system("align")
@@ -137,6 +137,38 @@ def test_the_server_prints_its_url_and_stops_cleanly_on_a_signal(signum, how):
     assert stderr == f"schuler lab: stopped ({how})\n"
 
 
+def test_a_job_server_killed_from_outside_is_replaced_and_a_closed_lab_starts_no_job():
+    bench = create_app()
+    try:
+        first = bench.jobs.server_pid
+        os.kill(first, signal.SIGKILL)
+        assert gone_within(first, 5)
+        job = long_job(bench)
+        assert bench.jobs.server_pid != first and bench.jobs.job_running(job)
+        assert bench.cache_dir.is_dir()  # the new job server writes into the same job cache
+    finally:
+        bench.close()
+    with pytest.raises(SchulerError, match="the lab is stopping"):
+        long_job(bench)
+
+
+def test_the_job_server_ends_and_removes_the_job_cache_when_the_lab_is_killed():
+    import psutil
+
+    process, _ = start_server()
+    try:
+        [job_server] = psutil.Process(process.pid).children()
+        cache_dir = Path(job_server.cmdline()[-1])
+        assert cache_dir.is_dir()
+        process.kill()  # no cleanup runs: the job server sees its pipe close
+        process.wait(timeout=30)
+        assert gone_within(job_server.pid, 20)
+        assert not cache_dir.exists()
+    finally:
+        if process.poll() is None:
+            process.kill()
+
+
 def test_closing_the_lab_removes_its_job_cache():
     bench = create_app()
     assert bench.cache_dir.is_dir()
@@ -144,47 +176,52 @@ def test_closing_the_lab_removes_its_job_cache():
     assert not bench.cache_dir.exists()
 
 
-FORKED_JOB = """
-import multiprocessing, os, signal, socket, sys, threading, time
-from schuler.lab.server import LabServer, serve_until_signal
+def long_job(bench):
+    """A job of the align page's run: a Monte Carlo of 2,000,000 members (minutes), started as the page does."""
+    from dash.background_callback.managers import BaseBackgroundCallbackManager
 
-sock = socket.socket()
-sock.bind(("127.0.0.1", 0))
-sock.listen()
-server = LabServer(lambda environ, start: [], sock)
-
-def job_gets_sigterm():
-    time.sleep(0.3)
-    job = multiprocessing.get_context("fork").Process(target=time.sleep, args=(60,))  # as Dash starts a job
-    job.start()
-    time.sleep(0.3)
-    os.kill(job.pid, signal.SIGTERM)
-    job.join(10)
-    print("job", "ended" if job.exitcode is not None else "alive", job.exitcode, flush=True)
-    if job.exitcode is None:
-        job.kill()
-    os.kill(os.getpid(), signal.SIGTERM)
-
-threading.Thread(target=job_gets_sigterm).start()
-print("server", serve_until_signal(server), flush=True)
-"""
+    key = next(key for key, fn, _ in BaseBackgroundCallbackManager.functions
+               if fn.__module__ == system_page.__name__ and fn.__name__ == "run")
+    parameters = system_page.page_parameters(ALIGN)
+    ids = [{"type": controls.PARAM, "name": p.name} for p in parameters]
+    values = [("2000000" if p.name == "monte_carlo" else controls.initial_text(p)) for p in parameters]
+    return bench.jobs.call_job_fn("long-job", key, [values, 0, ids, "align", "session"], {})
 
 
-def test_a_job_forked_from_the_server_ends_on_sigterm():
-    # the server's SIGTERM handler is inherited by the jobs it forks: there it must end the job, not the server
-    out = subprocess.run([sys.executable, "-c", FORKED_JOB], capture_output=True, text=True, timeout=60)
-    assert out.stdout.split("\n")[:2] == [f"job ended {-signal.SIGTERM}", "server SIGTERM"], out.stderr
+def gone_within(pid: int, seconds: float) -> bool:
+    import psutil
+
+    try:
+        psutil.Process(pid).wait(seconds)
+    except psutil.NoSuchProcess:
+        pass
+    except psutil.TimeoutExpired:
+        return False
+    return True
 
 
-def test_closing_the_lab_ends_a_job_that_ignores_sigterm():
+def test_jobs_are_forked_by_a_job_server_without_threads_and_end_on_cancel_sigterm_and_close():
+    import psutil
+
     bench = create_app()
-    stubborn = subprocess.Popen([sys.executable, "-c", "import signal, time; "
-                                 "signal.signal(signal.SIGTERM, signal.SIG_IGN); print(1, flush=True); time.sleep(60)"],
-                                stdout=subprocess.PIPE, text=True)
-    stubborn.stdout.readline()  # its handler is in place
-    bench.close()
-    # gone well before its 60 s (close reaps it, so its exit status is not left for Popen to read)
-    stubborn.wait(timeout=5)
+    try:
+        server = psutil.Process(bench.jobs.server_pid)
+        cancelled = long_job(bench)
+        assert psutil.Process(cancelled).ppid() == server.pid != os.getpid()
+        assert server.num_threads() == 1 and bench.jobs.job_running(cancelled)
+        bench.jobs.terminate_job(cancelled)  # the page's Cancel
+        assert gone_within(cancelled, 5) and not bench.jobs.job_running(cancelled)
+        bench.jobs.terminate_job(cancelled)  # a job already gone: nothing to do, no error
+        bench.jobs.terminate_job(os.getpid())  # not a job of the lab: left alone
+        terminated = long_job(bench)
+        os.kill(terminated, signal.SIGTERM)
+        assert gone_within(terminated, 5)
+        left_running = long_job(bench)
+        assert server.num_threads() == 1
+    finally:
+        bench.close()
+    assert gone_within(left_running, 5) and gone_within(server.pid, 5)
+    assert not bench.cache_dir.exists()
 
 
 # --- requests: size limit, assets, headers ----------------------------------------------------------------------
@@ -193,6 +230,49 @@ def test_large_requests_are_refused_before_they_are_read(client):
     body = b"{" + b" " * (MAX_REQUEST_BYTES + 1) + b"}"
     response = client.post("/_dash-update-component", data=body, content_type="application/json")
     assert response.status_code == 413
+
+
+@pytest.mark.parametrize("host", ["evil.example", "evil.example:8050", "127.0.0.1.evil.example", "192.168.1.20:8050"])
+def test_a_foreign_host_header_is_refused(host):
+    bench = create_app("127.0.0.1", 8050)
+    try:
+        client = bench.server.test_client()
+        assert client.get("/", headers={"Host": host}).status_code == 400
+        assert client.post("/_dash-update-component", json={}, headers={"Host": host}).status_code == 400
+        for own in ("127.0.0.1:8050", "localhost:8050", "[::1]:8050"):
+            assert client.get("/", headers={"Host": own}).status_code == 200, own
+        assert client.get("/", headers={"Host": "127.0.0.1:9999"}).status_code == 400  # another port
+    finally:
+        bench.close()
+
+
+@pytest.mark.parametrize("header, bound, port, allowed", [
+    ("192.168.1.20:8050", "192.168.1.20", 8050, True), ("192.168.1.21:8050", "192.168.1.20", 8050, False),
+    ("10.0.0.5:8050", "0.0.0.0", 8050, True), ("lab.example:8050", "0.0.0.0", 8050, False),
+    ("[::1]:8050", "::", 8050, True), ("localhost", "127.0.0.1", 80, True), ("", "127.0.0.1", 8050, False),
+])
+def test_with_remote_access_only_the_bound_address_is_accepted(header, bound, port, allowed):
+    assert host_allowed(header, bound, port) is allowed
+
+
+def test_remote_access_says_where_the_lab_listens_and_that_it_has_no_login():
+    process = subprocess.Popen([sys.executable, "-m", "schuler", "lab", "--host", "0.0.0.0", "--allow-remote",
+                                "--port", "0", "--no-browser"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    try:
+        process.stdout.readline()
+        warning = process.stderr.readline()
+    finally:
+        process.terminate()
+        process.wait(timeout=30)
+    assert warning.startswith("schuler lab: warning: listening on every address of this machine (0.0.0.0), port ")
+    assert "the lab has no login" in warning
+
+
+@pytest.mark.parametrize("path", ["/_dash-component-suites/dash/../x.js", "/_dash-component-suites/nope/x.js",
+                                  "/_dash-component-suites/dash/../../etc/passwd", "/_dash-component-suites/..%2fx"])
+def test_an_asset_that_does_not_exist_is_404(client, path):
+    assert client.get(path).status_code == 404
 
 
 def test_every_asset_of_a_page_is_served_by_the_lab_itself(client):
@@ -275,6 +355,38 @@ def test_an_injection_sent_to_the_server_comes_back_as_a_message(client, tmp_pat
     assert not marker.exists()
 
 
+POWER_TOWER = """
+import time
+from schuler.lab import controls, system_page
+from schuler.registry import get_system
+parameters = system_page.page_parameters(get_system("align"))
+print("ready", flush=True)
+start = time.perf_counter()
+case, errors = controls.parse_typed(parameters, {"latitude": "10**10**10 deg"})
+print(f"{time.perf_counter() - start:.3f}", case is None, errors.get("latitude", ""), flush=True)
+"""
+
+
+# remove the mark once schuler.units parses a quantity as a number and a unit (until then the parse hangs)
+@pytest.mark.xfail(reason="schuler.units still evaluates power expressions", strict=False)
+def test_a_power_tower_typed_in_a_field_is_answered_promptly_with_a_message():
+    # a quantity is a number and a unit: 10**10**10 must not be evaluated (it kept a server busy for minutes)
+    process = subprocess.Popen([sys.executable, "-c", POWER_TOWER], stdout=subprocess.PIPE, text=True,
+                               env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    try:
+        assert process.stdout.readline().strip() == "ready"
+        out, _ = process.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        pytest.fail("no answer to '10**10**10 deg' within 10 s (it must come within 5 s)")
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    seconds, refused, message = out.strip().split(" ", 2)
+    assert float(seconds) < 5.0
+    assert refused == "True" and message.startswith("--latitude: ")
+
+
 def test_the_lab_has_no_eval_exec_or_compile():
     for path in Path(schuler.lab.__file__).parent.glob("*.py"):
         tree = ast.parse(path.read_text(encoding="utf-8"))
@@ -318,6 +430,24 @@ def test_headline_numbers_show_the_display_unit():
     spans = {attribute(c, "data-result"): c.children for c in walk(table) if attribute(c, "data-result")}
     # 0.01 deg/h at 50 deg: 3.5557 arcmin (the fake's closed form, test_study_fake_system)
     assert spans == {"azimuth_error_rad": "3.556 arcmin", "settling_time_s": "3600 s"}
+
+
+def test_rounding_noise_is_shown_as_zero_and_a_flag_as_yes_or_no():
+    result = system_page.run_typed(ALIGN, {})  # no drift: every angle error is the arithmetic's noise (1e-86 rad)
+    values = {o.name: getattr(result, o.name) for o in ALIGN.outputs}
+    assert 0 < abs(values["azimuth_error_rad"]) < 1e-80
+    shown = dict(zip([o.name for o in ALIGN.outputs], views.headline_texts(ALIGN, values)))
+    assert shown["azimuth_error_rad"] == "0 arcmin" and shown["level_error_beta_rad"] == "0 arcmin"
+    assert shown["azimuth_error_sigma_rad"] == "3.579 arcmin"  # a real number of the same case stays
+    assert shown["constraints_ok"] == "yes"
+    assert views.quantity_text(False, ALIGN.outputs[-2]) == "no"
+    north = get_system("north")
+    result = system_page.run_typed(north, {})
+    texts = views.headline_texts(north, {o.name: getattr(result, o.name) for o in north.outputs})
+    # a north error of 1e-18 rad beside a north of 0.02 rad is noise, a genuine small value is not
+    assert texts[0] == "-1.23 deg" and texts[1] == "0 arcsec"
+    assert views.quantity_text(1e-12, north.outputs[1], views.resolutions(north, {"north_error_rad": 1e-12})[
+        "north_error_rad"]) == "2.063e-07 arcsec"
 
 
 def test_only_values_changed_from_the_defaults_count_as_typed():

@@ -13,7 +13,15 @@ import webbrowser
 
 import click
 
-from schuler.lab.server import LabServer, check_host, check_port, listen, serve_until_signal
+from schuler.lab.server import (
+    LabServer,
+    check_host,
+    check_port,
+    is_loopback,
+    listen,
+    listening_text,
+    serve_until_signal,
+)
 
 
 @click.command("lab", context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
@@ -31,16 +39,20 @@ def lab(port: int, host: str, allow_remote: bool, no_browser: bool) -> None:
     pages. Everything runs on this machine: the pages need no internet.
     Stop with Ctrl-C.
     """
-    sock = listen(check_host(host, allow_remote), check_port(port))
+    address = check_host(host, allow_remote)
+    sock = listen(address, check_port(port))
     from schuler.lab.app import create_app
 
-    bench = create_app()
+    bench = create_app(address, sock.getsockname()[1])
     try:
         server = LabServer(bench.server, sock, on_stop=bench.close)
     except BaseException:
         bench.close()  # the job cache folder goes with it
         raise
     click.echo(f"schuler lab: serving on {server.url} (Ctrl-C to stop)")
+    if not is_loopback(server.host):
+        click.echo(f"schuler lab: warning: listening on {listening_text(server.host, server.port)}; the lab has no "
+                   "login: anyone who can reach this port can run computations on this machine", err=True)
     sys.stdout.flush()
     if not no_browser:
         threading.Timer(0.5, webbrowser.open, args=(server.url,)).start()

@@ -14,7 +14,8 @@ Framework: `Dash <https://dash.plotly.com>`_ (Plotly; Flask underneath). Why:
 * callbacks are functions of the values the browser sends, so no user state
   lives in the server and two sessions cannot disturb each other;
 * long computations run as *background callbacks* with progress and
-  cancellation built in (``DiskcacheManager``: a process per job);
+  cancellation built in (a process per job, forked by the single-threaded job
+  server of :mod:`~schuler.lab.jobs`, results through Dash's disk cache);
 * components accept ``data-*`` attributes, which give scripts and tests their
   stable hooks (``data-param``, ``data-result``).
 
@@ -22,7 +23,8 @@ Panel/Bokeh were the alternative; their templates and several extensions load
 resources from CDNs by default, which had to be undone piece by piece.
 
 Modules: :mod:`~schuler.lab.app` (the application, routing, limits),
-:mod:`~schuler.lab.server` (binding, serving, clean stop),
+:mod:`~schuler.lab.server` (binding, Host check, serving, clean stop),
+:mod:`~schuler.lab.jobs` (the job server), :mod:`~schuler.lab.pages` (callback registration),
 :mod:`~schuler.lab.controls` (controls from parameters, parsing as the CLI),
 :mod:`~schuler.lab.views` (headline numbers, tables),
 :mod:`~schuler.lab.figures` (plotly figures), :mod:`~schuler.lab.system_page`

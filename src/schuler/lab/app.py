@@ -11,8 +11,9 @@ Every asset (Dash's renderer, React, plotly.js, the lab's CSS and scripts) is
 served by the application itself from the installed packages; the page's
 Content-Security-Policy lets the browser load nothing from anywhere else.
 Requests larger than :data:`MAX_REQUEST_BYTES` are refused (HTTP 413).
-Computations run as background jobs (Dash's ``DiskcacheManager``: one process
-per job, results in a job cache in a temporary folder removed at shutdown).
+Computations run as background jobs (one process per job, forked by the job
+server of :mod:`schuler.lab.jobs`, never by the threaded web server; results in a
+job cache in a temporary folder removed at shutdown).
 """
 
 from __future__ import annotations
@@ -25,11 +26,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from dash import Dash, DiskcacheManager, Input, Output, dcc, html
+from dash import Dash, Input, Output, dcc, html
 
 from schuler import __version__
 from schuler.contract import System
 from schuler.lab import compare_page, manual, system_page
+from schuler.lab.jobs import JobServerManager
+from schuler.lab.pages import register_pages
 from schuler.registry import SYSTEM_MODULES, get_system
 
 MAX_REQUEST_BYTES = 256 * 1024
@@ -79,31 +82,19 @@ class Lab:
         The WSGI application to serve.
     cache_dir : Path
         Where background jobs leave their results (removed by :meth:`close`).
+    jobs : JobServerManager
+        The job manager (its job server forks the jobs).
     """
 
-    def __init__(self, app: Dash, cache_dir: Path, manager: DiskcacheManager):
+    def __init__(self, app: Dash, cache_dir: Path, manager: JobServerManager):
         self.app = app
         self.server = app.server
         self.cache_dir = cache_dir
-        self._manager = manager
+        self.jobs = manager
 
     def close(self) -> None:
-        """End running jobs (the processes this server started) and remove the job cache."""
-        import psutil
-
-        for child in psutil.Process().children(recursive=True):
-            try:
-                child.terminate()
-            except psutil.NoSuchProcess:
-                pass
-        _, alive = psutil.wait_procs(psutil.Process().children(recursive=True), timeout=3)
-        for child in alive:  # a job that ignores SIGTERM would keep the server from exiting (its exit joins jobs)
-            try:
-                child.kill()
-            except psutil.NoSuchProcess:
-                pass
-        psutil.wait_procs(alive, timeout=3)
-        self._manager.handle.close()
+        """End the job server and its running jobs, and remove the job cache."""
+        self.jobs.close()
         for _ in range(3):  # a job ending just now may still be closing its files in the folder
             shutil.rmtree(self.cache_dir, ignore_errors=True)
             if not self.cache_dir.exists():
@@ -111,16 +102,18 @@ class Lab:
             time.sleep(0.2)
 
 
-def create_app() -> Lab:
-    """Build the lab (pages for every registered system, the KPI tasks, limits and headers)."""
-    import diskcache
-    from numba.core.registry import cpu_target
+def create_app(host: str = "127.0.0.1", port: int | None = None) -> Lab:
+    """Build the lab (pages for every registered system, the KPI tasks, limits and headers).
 
-    # jobs are forks of this threaded server: numba's lazily imported registries are loaded here, once, so that a
-    # job never imports them itself (a fork can inherit an import lock and wait on it forever)
-    cpu_target.target_context.refresh()
+    Parameters
+    ----------
+    host : str
+        The address the lab listens on (requests whose ``Host`` names another are refused).
+    port : int, optional
+        TCP port served, a plain number from 0 to 65535 (requests for another are refused); None accepts any.
+    """
     cache_dir = Path(tempfile.mkdtemp(prefix="schuler-lab-jobs-"))
-    manager = DiskcacheManager(diskcache.Cache(str(cache_dir)))
+    manager = JobServerManager(cache_dir)  # spawned first: it imports and warms while the pages are built
     app = Dash(
         __name__,
         title="schuler lab",
@@ -134,10 +127,8 @@ def create_app() -> Lab:
     )
     available = systems_available()
     app.layout = lambda: _shell(available)
-    system_page.register(app)
-    compare_page.register(app)
-    _routing(app, {a.name: a for a in available}, _task_pages(app))
-    _limits(app)
+    _routing(app, {a.name: a for a in available}, register_pages(app))
+    _limits(app, host, port)
     return Lab(app, cache_dir, manager)
 
 
@@ -161,21 +152,6 @@ def _shell(available: list[Availability]) -> html.Div:
         html.Div(id="page"),
         html.Footer(f"schuler {__version__}: computations run on this machine; nothing leaves it."),
     ])
-
-
-def _task_pages(app: Dash):
-    """The KPI task pages' layout function, or None when they cannot be offered.
-
-    They are built on the gyrocompassing system; imported here, so that a
-    gyrocompassing module that fails to import makes them (and its own page)
-    "not available" instead of stopping the lab.
-    """
-    try:
-        from schuler.lab import tasks
-    except Exception:  # the align page says why
-        return None
-    tasks.register(app)
-    return tasks.layout
 
 
 def _routing(app: Dash, by_name: dict[str, Availability], task_layout) -> None:
@@ -228,18 +204,28 @@ def _not_found(pathname: str) -> html.Div:
                      dcc.Link("the list of pages", href="/")])
 
 
-def _limits(app: Dash) -> None:
-    """Refuse large requests before reading them; headers that keep the page to its own origin."""
+def _limits(app: Dash, host: str, port: int | None) -> None:
+    """Refuse foreign Host headers and large requests before reading them; an asset that does not exist is
+    404; headers that keep the page to its own origin."""
+    from dash.exceptions import DependencyException
     from flask import abort, request
+
+    from schuler.lab.server import host_allowed
 
     server = app.server
     server.config["MAX_CONTENT_LENGTH"] = MAX_REQUEST_BYTES
     policy = f"{CONTENT_SECURITY_POLICY}; script-src 'self' {' '.join(app.csp_hashes())}"
 
     @server.before_request
-    def refuse_large():
+    def refuse_foreign_or_large():
+        if not host_allowed(request.host, host, port):
+            abort(400)  # a page elsewhere reaching the lab under its own name (DNS rebinding)
         if request.content_length is not None and request.content_length > MAX_REQUEST_BYTES:
             abort(413)
+
+    @server.errorhandler(DependencyException)
+    def no_such_asset(error):
+        return "not found", 404
 
     @server.after_request
     def headers(response):

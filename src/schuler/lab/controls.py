@@ -17,6 +17,7 @@ from dash import dcc, html
 from schuler.exceptions import InvalidParameter, SchulerError
 from schuler.lab.views import data_attributes
 from schuler.params import Case, Parameter, ParameterSet
+from schuler.units import to_unit
 
 MAX_VALUE_CHARS = 200
 """Longest text a control accepts (the input refuses more; the server checks again)."""
@@ -47,10 +48,17 @@ def initial_text(parameter: Parameter) -> str:
     '50'
     >>> initial_text(Parameter("c_a", "1/s", None, "Gain."))
     ''
+    >>> initial_text(Parameter("alpha0", "deg", "0.5 rad", "Start angle."))
+    '28.6478897565'
     """
     default = parameter.default
     if default is None:
         return ""
+    if isinstance(default, str) and parameter.kind == "quantity":
+        try:  # a default written with its unit ("3.69*pi/540 rad"): the number in the display unit
+            return f"{float(to_unit(parameter.parse(default), parameter.unit)):.12g}"
+        except Exception:  # a text the parser does not take is shown as written (the run reports it)
+            return default
     if isinstance(default, bool):
         return "true" if default else "false"
     if isinstance(default, float):
@@ -71,7 +79,9 @@ def describe(parameter: Parameter) -> str:
     str
         ``default ...; range ...`` (or ``one of ...`` for a choice, ``true or false`` for a flag).
     """
-    parts = [f"default {parameter.default_text()}"]
+    shown = initial_text(parameter)
+    written_with_unit = isinstance(parameter.default, str) and parameter.kind == "quantity" and parameter.unit
+    parts = [f"default {shown} {parameter.unit}" if written_with_unit else f"default {parameter.default_text()}"]
     if parameter.kind == "choice":
         parts.append("one of " + ", ".join(parameter.choices or ()))
     elif parameter.kind == "flag":
@@ -97,8 +107,31 @@ def unit_label(parameter: Parameter) -> str:
     return parameter.unit if parameter.kind == "quantity" and parameter.unit else ""
 
 
+def human_label(name: str) -> str:
+    """A parameter's name as people read it: ``drift_east`` -> ``drift east`` (a symbol like ``c_a`` stays).
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name (snake_case, as in the Python API and the scenario files).
+
+    Returns
+    -------
+    str
+        The words of the name separated by blanks; names starting with a one-letter symbol unchanged.
+
+    Examples
+    --------
+    >>> human_label("drift_east"), human_label("initial_azimuth_error"), human_label("c_a"), human_label("hm")
+    ('drift east', 'initial azimuth error', 'c_a', 'hm')
+    """
+    words = name.split("_")
+    return name if len(words[0]) == 1 else " ".join(words)
+
+
 def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM) -> html.Div:
-    """One control: ``div[data-param=NAME]`` with label, ``<input>``, default and range, error line.
+    """One control: ``div[data-param=NAME]`` with label (``drift east``, unit), ``<input>``, option, default and
+    range, error line.
 
     Parameters
     ----------
@@ -134,9 +167,10 @@ def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM
         spellCheck=False,
         className="value",
     )
-    label = html.Label([html.Span(name, className="name"), html.Span(unit, className="unit") if unit else None],
-                       title=parameter.help)
-    children = [label, field, options, html.Div(describe(parameter), className="hint", title=parameter.help),
+    label = html.Label([html.Span(human_label(name), className="name"),
+                        html.Span(unit, className="unit") if unit else None], title=parameter.help)
+    hint = f"{parameter.option}; {describe(parameter)}"  # the option the command line takes for the same value
+    children = [label, field, options, html.Div(hint, className="hint", title=parameter.help),
                 html.Div(id={"type": ERROR if id_type == PARAM else f"{id_type}-error", "name": name},
                          className="error", role="alert")]
     return html.Div([c for c in children if c is not None], className="control", **data_attributes(param=name))

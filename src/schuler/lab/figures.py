@@ -24,7 +24,7 @@ from dash import dcc, html
 
 from schuler.contract import System
 from schuler.exceptions import InvalidParameter
-from schuler.lab.views import data_attributes
+from schuler.lab.views import data_attributes, number_text
 from schuler.units import to_unit
 
 MAX_POINTS = 400
@@ -141,6 +141,27 @@ def shown_window(run) -> np.ndarray:
     return run.time <= end
 
 
+def window_text(run, window: np.ndarray) -> str:
+    """What part of a run a history figure shows, for its time axis: empty when it shows the whole run.
+
+    Parameters
+    ----------
+    run : CaseRun
+        The run (``time`` in s).
+    window : numpy.ndarray of bool
+        The samples shown (:func:`shown_window`).
+
+    Returns
+    -------
+    str
+        ``" (the first 12.5 of 120 min simulated; the rest is steady)"`` or empty.
+    """
+    shown, simulated = run.time[window][-1] / 60.0, run.time[-1] / 60.0
+    if shown >= simulated:
+        return ""
+    return f" (the first {number_text(shown)} of {number_text(simulated)} min simulated; the rest is steady)"
+
+
 def time_history(runs: dict, title: str = "Azimuth and level errors (Fig. 1.4)") -> dict:
     """delta [arcmin] and beta [arcsec] against time [min] for runs (label -> CaseRun), delta_y dotted.
 
@@ -165,9 +186,11 @@ def time_history(runs: dict, title: str = "Azimuth and level errors (Fig. 1.4)")
         line = {"dash": DASHES[number % len(DASHES)]}
         traces += [_line(minutes, delta, f"delta, {label}", line=line),
                    _line(minutes, beta, f"beta, {label}", row=2, line=line)]
-    steady = float(to_unit(next(iter(runs.values())).analytic["azimuth_error_analytic_rad"], "arcmin"))
+    first = next(iter(runs.values()))
+    steady = float(to_unit(first.analytic["azimuth_error_analytic_rad"], "arcmin"))
     shape, note = _level(steady, 1, "delta_y (1.21)")
-    return _figure(traces, title, ["delta [arcmin]", "beta [arcsec]"], "time [min]", 520, [shape], [note])
+    return _figure(traces, title, ["delta [arcmin]", "beta [arcsec]"],
+                   "time [min]" + window_text(first, shown_window(first)), 520, [shape], [note])
 
 
 def phase_trajectory(runs: dict, title: str = "Phase trajectory in the (delta, beta) plane (task 5)") -> dict:
@@ -192,12 +215,14 @@ def phase_trajectory(runs: dict, title: str = "Phase trajectory in the (delta, b
         delta, beta = thin(to_unit(run.delta[window], "arcmin"), to_unit(run.beta[window], "arcsec"))
         traces += [_line(delta, beta, label, line={"dash": DASHES[number % len(DASHES)]}),
                    _line(delta[:1], beta[:1], f"start, {label}", mode="markers", marker={"size": 9})]
-    first = next(iter(runs.values())).analytic
+    first_run = next(iter(runs.values()))
+    first = first_run.analytic
     traces.append(_line([to_unit(first["azimuth_error_analytic_rad"], "arcmin")],
                         [to_unit(first["level_error_beta_analytic_rad"], "arcsec")],
                         "steady state (1.21), (1.25)", mode="markers",
                         marker={"size": 14, "symbol": "star", "color": "black"}))
-    return _figure(traces, title, ["level error beta [arcsec]"], "azimuth error delta [arcmin]", 480)
+    return _figure(traces, title + window_text(first_run, shown_window(first_run)), ["level error beta [arcsec]"],
+                   "azimuth error delta [arcmin]", 480)
 
 
 def level_angles(run, title: str = "Level errors in mu, nu and in beta, alpha (task 3)") -> dict:
@@ -225,7 +250,8 @@ def level_angles(run, title: str = "Level errors in mu, nu and in beta, alpha (t
             if values is not None:
                 x, y = thin(minutes, to_unit(values[window], "arcsec"))
                 traces.append(_line(x, y, name, row=row))
-    return _figure(traces, title, ["mu, nu [arcsec]", "beta, alpha [arcsec]"], "time [min]", 520)
+    return _figure(traces, title, ["mu, nu [arcsec]", "beta, alpha [arcsec]"],
+                   "time [min]" + window_text(run, window), 520)
 
 
 def sweep_curves(x, x_label: str, columns: dict, constraints, title: str = "Accuracy and time against a parameter"):

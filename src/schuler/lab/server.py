@@ -5,14 +5,13 @@ anything but a loopback address unless remote access is asked for explicitly
 (the lab has no authentication: anyone who can reach the port can run
 computations). :class:`LabServer` serves the WSGI application with Werkzeug's
 threaded server (one thread per request; computations run in background job
-processes, see :mod:`schuler.lab.app`) and stops cleanly on Ctrl-C or SIGTERM:
+processes, see :mod:`schuler.lab.jobs`) and stops cleanly on Ctrl-C or SIGTERM:
 the listening socket is closed, running jobs are ended, the job cache is removed.
 """
 
 from __future__ import annotations
 
 import ipaddress
-import os
 import signal
 import socket
 import threading
@@ -92,6 +91,60 @@ it listens only on this machine (127.0.0.1, ::1, localhost) unless --allow-remot
     return text
 
 
+def host_allowed(header: str, bound: str, port: int | None) -> bool:
+    """Whether a request's ``Host`` header names this lab (a guard against DNS rebinding).
+
+    A foreign page can make the browser send requests to the lab under a name
+    of its own that resolves to 127.0.0.1; such a request carries that name in
+    ``Host``. Accepted: the loopback names and addresses, and, when the lab was
+    bound to another address (``--allow-remote``), that address written as an
+    IP address (any IP address for a wildcard bind: a rebinding page can only
+    send a name), each with the port served.
+
+    Parameters
+    ----------
+    header : str
+        The ``Host`` header (``127.0.0.1:8050``, ``[::1]:8050``, ``localhost``).
+    bound : str
+        The address the lab listens on.
+    port : int or None
+        TCP port served, a plain number from 0 to 65535 (None: any, for an application not bound to one).
+
+    Returns
+    -------
+    bool
+        True when the header names the lab.
+
+    Examples
+    --------
+    >>> host_allowed("127.0.0.1:8050", "127.0.0.1", 8050), host_allowed("evil.example:8050", "127.0.0.1", 8050)
+    (True, False)
+    """
+    text = (header or "").strip().lower()
+    if text.startswith("["):
+        name, _, rest = text[1:].partition("]")
+        given = rest[1:] if rest.startswith(":") else (None if not rest else "bad")
+    elif text.count(":") == 1:
+        name, given = text.split(":")
+    else:
+        name, given = text, None
+    if port is not None and (given or "80") != str(port):
+        return False
+    if is_loopback(name):
+        return True
+    try:
+        address = ipaddress.ip_address(name)
+    except ValueError:
+        return False  # a name: never trusted beyond the local ones
+    bound_text = bound.strip("[]")
+    if bound_text in ("0.0.0.0", "::", ""):
+        return True
+    try:
+        return address == ipaddress.ip_address(bound_text)
+    except ValueError:  # bound by name: only the names of this machine's loopback are trusted
+        return False
+
+
 def check_port(port: int) -> int:
     """A TCP port number, 0 (any free port) to 65535.
 
@@ -144,6 +197,26 @@ def url_of(host: str, port: int) -> str:
     if ":" in shown:
         shown = f"[{shown}]"
     return f"http://{shown}:{port}/"
+
+
+def listening_text(host: str, port: int) -> str:
+    """Where the lab really listens, in words: ``192.168.1.20:8050`` or ``every address of this machine, port 8050``.
+
+    Parameters
+    ----------
+    host : str
+        The address the socket is bound to.
+    port : int
+        TCP port bound, a plain number from 0 to 65535.
+
+    Returns
+    -------
+    str
+        The address and port (a wildcard address said as every address).
+    """
+    if host in ("0.0.0.0", "::", ""):
+        return f"every address of this machine ({host or '0.0.0.0'}), port {port}"
+    return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
 
 
 def listen(host: str, port: int) -> socket.socket:
@@ -253,14 +326,8 @@ def serve_until_signal(server: LabServer) -> str:
         ``"Ctrl-C"`` or ``"SIGTERM"``; ``"shutdown"`` when the server stopped for another reason.
     """
     received: list[str] = []
-    serving_pid = os.getpid()
 
     def stop(signum, frame):
-        if os.getpid() != serving_pid:
-            # a background job forked from the server inherits this handler: there the signal must end the job
-            signal.signal(signum, signal.SIG_DFL)
-            os.kill(os.getpid(), signum)
-            return
         received.append("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
         server.stop()
 

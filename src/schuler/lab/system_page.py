@@ -32,8 +32,9 @@ from schuler.registry import get_system
 
 _LOG = logging.getLogger(__name__)
 
-POLL_MS = 50
-"""How often the browser asks whether a background job has finished, ms (it bounds the added latency)."""
+POLL_MS = 150
+"""How often the browser asks whether a background job has finished, ms (it bounds the added latency; at 50 ms
+four sessions' polls alone kept a loaded 2-core machine's web server busy and answers took 10-40 s)."""
 
 
 ACTION_PAGES = {"align": {"compare": "Every self-alignment method on the same data, compared"}}

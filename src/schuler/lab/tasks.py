@@ -98,8 +98,10 @@ def layout(system: System, page: str) -> html.Div:
     """
     number = PAGES[page]
     sweeps = number in (1, 2)
-    questions = [html.Li([html.Span(manual.QUESTIONS[q], className="question"),
-                          html.Span(manual.HINTS.get(q, ""), className="hint")], value=str(q))
+    # numbered in order on the page, each with its number in the manual's list of control questions
+    questions = [html.Li([html.Span(f"question {q} of the manual", className="manual-number"),
+                          html.Span(manual.QUESTIONS[q], className="question"),
+                          html.Span(manual.HINTS.get(q, ""), className="hint")])
                  for q in manual.TASK_QUESTIONS[number]]
     aside = [html.H2("Parameters"), *controls(system.parameters, id_type=TASK_PARAM, values=STARTING_CASE)]
     if sweeps:
@@ -108,7 +110,8 @@ def layout(system: System, page: str) -> html.Div:
         dcc.Store(id="task-page", data=page),
         html.Div([html.H1(f"Task {number}: {TASKS[number]}"),
                   html.Blockquote(manual.TASK_TEXT[number], className="manual"),
-                  html.H2("Control questions"), html.Ol(questions, className="questions")], className="page-head"),
+                  html.H2("Control questions (from the manual's list)"), html.Ol(questions, className="questions")],
+                 className="page-head"),
         html.Div([
             html.Aside(aside, className="controls"),
             html.Main([

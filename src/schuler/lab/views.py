@@ -11,6 +11,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
 from dash import html
 
 from schuler.contract import Output, System
@@ -57,36 +58,94 @@ def number_text(value: float) -> str:
     return f"{value:.4g}"
 
 
-def quantity_text(value_si, output: Output) -> str:
-    """An output's value in its display unit: ``3.556 arcmin``; ``-`` when not computed.
+RELATIVE_RESOLUTION = 1e-10
+"""A value below this fraction of the largest value of the same unit in the same result is rounding noise."""
+
+ABSOLUTE_RESOLUTION = 1e-9
+"""A value below this many display units is shown as 0 (the command line's tables print 0.0000 there)."""
+
+
+def quantity_text(value_si, output: Output, resolution_si: float = 0.0) -> str:
+    """An output's value in its display unit: ``3.556 arcmin``; ``yes``/``no`` for a flag; ``-`` when not computed.
 
     Parameters
     ----------
-    value_si : float or None
-        The output's value in its SI unit (``output.unit``: rad, s, ...); None or NaN: not computed.
+    value_si : float or bool or None
+        The output's value in its SI unit (``output.unit``: rad, s, ...); None or NaN: not computed; a bool is a
+        flag.
     output : Output
         The output declaration (its ``display`` unit is the one shown; empty: the SI unit).
+    resolution_si : float
+        Values smaller in magnitude are shown as 0 (rounding noise; see :func:`resolutions`), SI unit of the
+        output.
 
     Returns
     -------
     str
-        The number (see :func:`number_text`) and the shown unit, or ``-``.
+        The number (see :func:`number_text`) and the shown unit, ``yes``/``no``, or ``-``.
 
     Examples
     --------
     >>> quantity_text(1.0343e-3, Output("azimuth_error_rad", "rad", "arcmin"))
     '3.556 arcmin'
     >>> quantity_text(None, Output("settling_time_s", "s")), quantity_text(True, Output("constraints_ok", "1"))
-    ('-', '1')
+    ('-', 'yes')
+    >>> quantity_text(1.56e-86, Output("azimuth_error_rad", "rad", "arcmin"), resolution_si=3e-13)
+    '0 arcmin'
     """
     if value_si is None:
         return "-"
+    if isinstance(value_si, (bool, np.bool_)):
+        return "yes" if value_si else "no"
     value = float(value_si)
     if math.isnan(value):
         return "-"
+    if abs(value) < resolution_si:
+        value = 0.0
     unit = output.shown_unit
     shown = float(to_unit(value, output.display)) if output.display else value
     return f"{number_text(shown)} {unit}".strip()
+
+
+def resolutions(system: System, values: Mapping[str, object]) -> dict[str, float]:
+    """Below which magnitude each output of a result is rounding noise, SI unit of the output.
+
+    The larger of :data:`ABSOLUTE_RESOLUTION` display units and :data:`RELATIVE_RESOLUTION` times the largest
+    magnitude among the result's outputs of the same SI unit (the case's scale: an east error of 1e-12 arcsec
+    beside a heading of 1.2 deg is the arithmetic's noise, not a result).
+
+    Parameters
+    ----------
+    system : System
+        The system whose declared outputs are shown.
+    values : mapping of str to object
+        Output name -> value in SI (the output's ``unit``).
+
+    Returns
+    -------
+    dict of str to float
+        Output name -> resolution, SI unit of that output.
+    """
+    scale: dict[str, float] = {}
+    for output in system.outputs:
+        value = _magnitude(values.get(output.name))
+        scale[output.unit] = max(scale.get(output.unit, 0.0), value)
+    found = {}
+    for output in system.outputs:
+        display_unit_si = 1.0 / float(to_unit(1.0, output.display)) if output.display else 1.0
+        found[output.name] = max(ABSOLUTE_RESOLUTION * display_unit_si, RELATIVE_RESOLUTION * scale[output.unit])
+    return found
+
+
+def _magnitude(value) -> float:
+    """|value| for a finite number; 0 for flags, missing, NaN and infinite values (they set no scale)."""
+    if value is None or isinstance(value, (bool, np.bool_)):
+        return 0.0
+    try:
+        number = abs(float(value))  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        return 0.0
+    return number if math.isfinite(number) else 0.0
 
 
 def data_attributes(**values) -> dict[str, Any]:
@@ -128,12 +187,13 @@ def headline(system: System, values: Mapping[str, object], with_ids: bool = Fals
     dash.html.Table
         One row per output: description, number with its display unit, key.
     """
+    floors = resolutions(system, values)
     rows = []
     for output in system.outputs:
         ident: dict[str, Any] = {"id": {"type": RESULT, "key": output.name}} if with_ids else {}
         rows.append(html.Tr([
             html.Th(output.description or output.name, scope="row"),
-            html.Td(html.Span(quantity_text(values.get(output.name), output), **ident,
+            html.Td(html.Span(quantity_text(values.get(output.name), output, floors[output.name]), **ident,
                               **data_attributes(result=output.name)), className="number"),
             html.Td(output.name, className="key"),
         ]))
@@ -153,9 +213,11 @@ def headline_texts(system: System, values: Mapping[str, object]) -> list[str]:
     Returns
     -------
     list of str
-        Number and display unit per output (see :func:`quantity_text`).
+        Number and display unit per output (see :func:`quantity_text`; rounding noise shown as 0, see
+        :func:`resolutions`).
     """
-    return [quantity_text(values.get(output.name), output) for output in system.outputs]
+    floors = resolutions(system, values)
+    return [quantity_text(values.get(output.name), output, floors[output.name]) for output in system.outputs]
 
 
 def monte_carlo_table(system: System, statistics: Mapping[str, Mapping[str, float | None]], members: int) -> html.Div:
