@@ -668,7 +668,10 @@ def test_not_computed_numbers_render_as_a_dash():
     nan = float("nan")
     assert views.number_text(nan) == "-"
     assert views.number_text(float("-inf")) == "-inf"
-    statistics = {"azimuth_error_rad": {"mean": nan, "std": 1e-3, "p05": nan, "p95": 2e-3, "min": 0.0, "max": 1.0}}
+    from schuler.results import MonteCarloStatistics
+
+    statistics = {"azimuth_error_rad": MonteCarloStatistics(count=3, mean=nan, std=1e-3, min=0.0, max=1.0, rms=1.0,
+                                                            p05=nan, p50=0.5, p95=2e-3)}
     cells = [c.children for c in views.monte_carlo_table(ALIGN, statistics, 3).children[1].children[1].children[0]
              .children[1:]]
     assert cells[0] == "-" and cells[2] == "-" and cells[1] != "-"

@@ -16,7 +16,7 @@ from dash import html
 
 from schuler.contract import Output, System
 from schuler.reproduction import Reproduction
-from schuler.results import display_label
+from schuler.results import MonteCarloStatistics, display_label
 from schuler.units import to_unit
 
 
@@ -220,14 +220,14 @@ def headline_texts(system: System, values: Mapping[str, object]) -> list[str]:
     return [quantity_text(values.get(output.name), output, floors[output.name]) for output in system.outputs]
 
 
-def monte_carlo_table(system: System, statistics: Mapping[str, Mapping[str, float | None]], members: int) -> html.Div:
+def monte_carlo_table(system: System, statistics: Mapping[str, MonteCarloStatistics], members: int) -> html.Div:
     """Mean, standard deviation and 5 %/95 % points of every output over the members (display units).
 
     Parameters
     ----------
     system : System
         The system whose declared outputs are the rows.
-    statistics : mapping of str to mapping of str to float
+    statistics : mapping of str to MonteCarloStatistics
         Output name -> its statistics over the members in SI (the output's ``unit``): ``mean``, ``std``,
         ``p05``, ``p95``, ``min``, ``max`` (None where not computed). Outputs whose ``min`` equals their
         ``max`` (no spread) are left out.
@@ -243,11 +243,11 @@ def monte_carlo_table(system: System, statistics: Mapping[str, Mapping[str, floa
     rows = []
     for output in system.outputs:
         stats = statistics.get(output.name)
-        if not stats or stats.get("min") == stats.get("max"):
+        if stats is None or stats.min == stats.max:
             continue
         cells = []
         for key in ("mean", "std", "p05", "p95"):
-            value = stats.get(key)
+            value = getattr(stats, key)
             cells.append(html.Td("-" if value is None else number_text(
                 float(to_unit(value, output.display)) if output.display else float(value)), className="number"))
         rows.append(html.Tr([html.Th(display_label(output.name, output.shown_unit), scope="row"), *cells]))
