@@ -31,6 +31,10 @@ THETA_13 = 5.371920351148152
 """Largest 1-norm for which the [13/13] approximant is exact to double precision (Higham 2005, Table 2.3)."""
 
 
+BLOCK = 512
+"""Matrices per block: a block's temporaries (a few hundred kB each) stay in cache instead of being mapped afresh."""
+
+
 def expm_stack(matrices: np.ndarray) -> np.ndarray:
     """e^A of every matrix of a stack.
 
@@ -52,7 +56,15 @@ def expm_stack(matrices: np.ndarray) -> np.ndarray:
     """
     matrices = np.asarray(matrices, dtype=float)
     shape, n = matrices.shape, matrices.shape[-1]
-    A = matrices.reshape(-1, n, n)
+    flat = matrices.reshape(-1, n, n)
+    result = np.empty_like(flat)
+    for start in range(0, flat.shape[0], BLOCK):
+        result[start:start + BLOCK] = _expm_block(flat[start:start + BLOCK])
+    return result.reshape(shape)
+
+
+def _expm_block(A: np.ndarray) -> np.ndarray:
+    n = A.shape[-1]
     norm = np.abs(A).sum(axis=1).max(axis=1)
     squarings = np.zeros(norm.shape, dtype=np.int64)
     large = norm > THETA_13
@@ -72,7 +84,7 @@ def expm_stack(matrices: np.ndarray) -> np.ndarray:
             result = result @ result
         else:
             result[more] = result[more] @ result[more]
-    return result.reshape(shape)
+    return result
 
 
 __all__ = ["expm_stack"]
