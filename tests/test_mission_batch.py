@@ -44,7 +44,11 @@ def test_the_covariance_analysis_makes_no_scipy_exponential(monkeypatch):
     assert budget.sigma("horizontal_position")[-1] > 0
 
 
-def test_a_batch_of_budgets_is_each_budget_alone():
+@pytest.mark.parametrize("batch_steps", [20_000, 80])  # one batch; batches of two 40-step missions
+def test_a_batch_of_budgets_is_each_budget_alone(batch_steps, monkeypatch):
+    from schuler.mission import covariance
+
+    monkeypatch.setattr(covariance, "BATCH_STEPS", batch_steps)
     headings = np.radians([0.0, 75.0, 200.0])
     setups = [setup_of(grade="tactical", trajectory="flight", duration=2400.0, heading=h) for h in headings]
     setups.append(setup_of(grade="consumer", alignment="ground-gyrocompass", calibration="multi-position",

@@ -67,6 +67,9 @@ LINEAR_LIMIT = np.radians(5.0)
 MAX_STEPS = 200_000
 """Largest number of steps of one analysis (memory: steps x sources x states)."""
 
+BATCH_STEPS = 20_000
+"""Mission steps (missions x steps) analysed at once: about 200 MB of step matrices and their exponentials."""
+
 
 class LinearityWarning(UserWarning):
     """The alignment leaves errors too large for the linear (small-angle) model to be trusted."""
@@ -268,8 +271,17 @@ def covariance_budgets(setups, disabled: tuple[str, ...] = ()) -> list[Covarianc
                                               f"output steps of {first.output_step:g} s")
     if round(steps) > MAX_STEPS:
         raise InvalidParameter("output_step", f"{round(steps)} steps exceed {MAX_STEPS}: use a longer output step")
-    dt = first.output_step
-    vertical = first.vertical_channel == "free"
+    per_batch = max(1, BATCH_STEPS // round(steps))
+    budgets = []
+    for start in range(0, len(setups), per_batch):
+        budgets.extend(_batch(setups[start:start + per_batch], disabled))
+    return budgets
+
+
+def _batch(setups: list[MissionSetup], disabled: tuple[str, ...]) -> list[CovarianceBudget]:
+    """:func:`covariance_budgets` of missions validated to share their steps, all at once."""
+    dt = setups[0].output_step
+    vertical = setups[0].vertical_channel == "free"
     parts = [_MissionTerms.of(setup, disabled, vertical) for setup in setups]
     M, K, n = len(parts), parts[0].F.shape[0], parts[0].F.shape[-1]
     F = np.stack([part.F for part in parts])
