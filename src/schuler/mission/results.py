@@ -74,14 +74,20 @@ class MissionResult(RunResult):
         """
         if self.monte_carlo is None:
             return {}
-        rms = self.monte_carlo.statistics["member_position_error_m"]["rms"]
+        statistics = self.monte_carlo.statistics
+
+        def rms(name: str) -> float:  # None when no member has a finite value
+            value = statistics[name]["rms"]
+            return math.nan if value is None else float(value)
+
         kept = np.asarray(self.monte_carlo.samples.get("member_position_error_m", ()), dtype=float)
         kept = kept[np.isfinite(kept)]
         squares = kept**2
         standard_error = (float(np.std(squares, ddof=1) / (2.0 * math.sqrt(np.mean(squares)) * math.sqrt(kept.size)))
                           if kept.size > 1 and np.mean(squares) > 0 else math.nan)
-        return {"position_error_sigma_m": rms, "position_error_sigma_standard_error_m": standard_error,
-                "covariance_position_error_sigma_m": self.monte_carlo.statistics["position_error_sigma_m"]["rms"],
+        return {"position_error_sigma_m": rms("member_position_error_m"),
+                "position_error_sigma_standard_error_m": standard_error,
+                "covariance_position_error_sigma_m": rms("position_error_sigma_m"),
                 "nominal_covariance_position_error_sigma_m": self.position_error_sigma_m}
 
     def render(self):
