@@ -87,3 +87,33 @@ def test_the_nonlinear_members_run_on_a_dask_cluster_as_in_process(run_cli, tmp_
     alone = members("alone", "--chunk-size", "6")
     assert dask["member_position_error_m"].nunique() == 6
     pd.testing.assert_frame_equal(dask, alone, check_exact=False, rtol=1e-12)
+
+
+@pytest.mark.slow
+def test_the_covariance_over_the_members_agrees_with_their_monte_carlo(run_cli):
+    # the example's members draw their heading from [monte_carlo.uniform] (0-360 deg), so the covariance to
+    # compare with is over their headings, not at the file's 30 deg. Band: two sampling standard errors of the
+    # members' RMS, std(e^2) / (2 RMS sqrt(N)), about 3.5 % at 300 members
+    out = run_cli("mission", "run", EXAMPLES / "mission_tactical.toml", "--monte-carlo", "300", "--json")
+    assert out.code == 0, out.stderr
+    data = out.json()
+    compared = data["monte_carlo"]
+    band = 2.0 * compared["position_error_sigma_standard_error_m"]
+    assert 0.02 < band / compared["position_error_sigma_m"] < 0.15
+    assert abs(compared["covariance_position_error_sigma_m"] - compared["position_error_sigma_m"]) <= band
+    # the nominal heading's covariance (kept as the top-level key) is not the members' and lies outside the band
+    nominal = data["position_error_sigma_m"]
+    assert compared["nominal_covariance_position_error_sigma_m"] == pytest.approx(nominal, rel=1e-12)
+    assert abs(data["position_error_sigma_m"] - compared["position_error_sigma_m"]) > 2 * band
+    rms = compared["statistics"]["member_position_error_m"]["rms"]
+    assert compared["position_error_sigma_m"] == pytest.approx(rms, rel=1e-12)
+
+
+def test_the_table_labels_each_covariance_beside_the_monte_carlo(run_cli):
+    out = run_cli("mission", "run", "--grade", "navigation", "--trajectory", "stationary", "--duration", "600",
+                  "--monte-carlo", "4")
+    assert out.code == 0, out.stderr
+    for label in ("1-sigma (covariance at the nominal case)",
+                  "covariance over the Monte Carlo members' cases (RMS of their 1-sigma)",
+                  "Monte Carlo (4 members, nonlinear INS): RMS, its sampling 1-sigma"):
+        assert label in " ".join(out.stdout.split())

@@ -1,9 +1,14 @@
-"""Every example scenario runs, through ``schuler run`` and through a small sweep."""
+"""Every example scenario runs, through ``schuler run`` and through a small sweep, and every command its
+comments advertise runs as written within the time they state."""
 
 from __future__ import annotations
 
 import json
+import re
+import shlex
+import time
 import tomllib
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -15,6 +20,45 @@ from schuler.study.systems import load_system
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 FILES = sorted(EXAMPLES.glob("*.toml"))
+
+
+@dataclass(frozen=True)
+class CommentCommand:
+    """A command written in an example's header comment, with the time the comment promises."""
+
+    file: str
+    text: str
+    arguments: list[str]
+    seconds: float | None
+
+
+_STATED_TIME = re.compile(r"under (\d+(?:\.\d+)?) (s|min)\b")
+
+
+def comment_commands(files=FILES) -> list[CommentCommand]:
+    """Every ``schuler ...`` line of the examples' comments (continuations joined), its stated time in s."""
+    commands = []
+    for path in files:
+        lines = [line.removeprefix("#").strip() for line in path.read_text().splitlines() if line.startswith("#")]
+        joined: list[str] = []
+        for line in lines:
+            if joined and joined[-1].endswith("\\"):
+                joined[-1] = joined[-1][:-1].rstrip() + " " + line
+            else:
+                joined.append(line)
+        for line in joined:
+            if not line.startswith("schuler "):
+                continue
+            text, _, note = line.partition("  (")
+            stated = _STATED_TIME.search(note)
+            seconds = None if stated is None else float(stated[1]) * (60.0 if stated[2] == "min" else 1.0)
+            commands.append(CommentCommand(path.name, text.strip(), shlex.split(text)[1:], seconds))
+    return commands
+
+
+COMMANDS = comment_commands()
+FAST_COMMAND = 30.0
+"""Stated time (s) above which a comment's command runs with the slow tests."""
 
 
 def system_of(path: Path) -> str:
@@ -79,3 +123,27 @@ def test_an_unregistered_system_name_is_refused_with_the_registered_names():
         load_system("allign")
     with pytest.raises(InvalidParameter, match=r"'compass' is not a system; choose from errors, vertical"):
         load_system("compass")
+
+
+def test_every_comment_command_states_its_time():
+    assert len(COMMANDS) >= 2 * len(FILES)
+    assert [c.text for c in COMMANDS if c.seconds is None] == []
+
+
+@pytest.mark.parametrize("command", [
+    pytest.param(c, id=f"{c.file}:{' '.join(c.arguments[:3])}:{i}",
+                 marks=[pytest.mark.slow] if c.seconds is None or c.seconds > FAST_COMMAND else [])
+    for i, c in enumerate(COMMANDS)])
+def test_a_comment_command_runs_as_written_within_its_stated_time(command, run_cli, tmp_path, monkeypatch):
+    # as a user types it, from a folder holding the examples: relative paths resolve, --out folders land here
+    (tmp_path / "examples").symlink_to(EXAMPLES)
+    monkeypatch.chdir(tmp_path)
+    started = time.perf_counter()
+    out = run_cli(*command.arguments)
+    elapsed = time.perf_counter() - started
+    assert out.code == 0, out.stderr
+    assert command.seconds is not None and elapsed <= command.seconds, f"{elapsed:.1f} s"
+    if "--json" in command.arguments:
+        json.loads(out.stdout)
+    if "--out" in command.arguments:
+        assert any((tmp_path / command.arguments[command.arguments.index("--out") + 1]).iterdir())

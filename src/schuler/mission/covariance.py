@@ -48,12 +48,11 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import expm
 
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
-from schuler.core.lti import zoh_discretize
 from schuler.exceptions import InvalidParameter
 from schuler.mission.coefficients import StepCoefficients, step_coefficients
+from schuler.mission.exponential import expm_stack
 from schuler.mission.setup import CONSTANT_SOURCES, SOURCES, WHITE_SOURCES, MissionSetup
 from schuler.mission.stages import alignment_noise, initial_state_map, sensor_inputs
 from schuler.navigate.attitude import rotation_matrix
@@ -67,6 +66,9 @@ LINEAR_LIMIT = np.radians(5.0)
 
 MAX_STEPS = 200_000
 """Largest number of steps of one analysis (memory: steps x sources x states)."""
+
+BATCH_STEPS = 20_000
+"""Mission steps (missions x steps) analysed at once: about 200 MB of step matrices and their exponentials."""
 
 
 class LinearityWarning(UserWarning):
@@ -181,15 +183,15 @@ def _output_rows(coefficients: StepCoefficients, n: int) -> np.ndarray:
 
 
 def process_noise(F: np.ndarray, noise_input: np.ndarray, dt: float) -> np.ndarray:
-    """Van Loan's discrete process noise of each step: integral of e^(F s) Qc e^(F^T s) over dt, (K, n, n).
+    """Van Loan's discrete process noise of each step: integral of e^(F s) Qc e^(F^T s) over dt, (..., n, n).
 
     Parameters
     ----------
     F : ndarray
-        System matrix of each step, shape (K, n, n), SI (psi-angle model: each state's rate per unit of each
+        System matrix of each step, shape (..., n, n), SI (psi-angle model: each state's rate per unit of each
         state, states in m, m/s, rad).
     noise_input : ndarray
-        G Q_c G^T of each step, shape (K, n, n): the white input's PSD mapped onto the state derivatives,
+        G Q_c G^T of each step, shape (..., n, n): the white input's PSD mapped onto the state derivatives,
         (state unit)^2 / s (e.g. rad^2/s on psi from an angle random walk N^2).
     dt : float
         Step length, s.
@@ -197,7 +199,7 @@ def process_noise(F: np.ndarray, noise_input: np.ndarray, dt: float) -> np.ndarr
     Returns
     -------
     ndarray
-        Q_k, shape (K, n, n), (state unit)^2, symmetrised.
+        Q_k, shape (..., n, n), (state unit)^2, symmetrised.
 
     Examples
     --------
@@ -206,13 +208,13 @@ def process_noise(F: np.ndarray, noise_input: np.ndarray, dt: float) -> np.ndarr
     2.0
     """
     n = F.shape[-1]
-    M = np.zeros((F.shape[0], 2 * n, 2 * n))
-    M[:, :n, :n] = -F
-    M[:, :n, n:] = noise_input
-    M[:, n:, n:] = np.swapaxes(F, 1, 2)
-    E = expm(M * dt)
-    Q = np.swapaxes(E[:, n:, n:], 1, 2) @ E[:, :n, n:]
-    return 0.5 * (Q + np.swapaxes(Q, 1, 2))
+    M = np.zeros((*F.shape[:-2], 2 * n, 2 * n))
+    M[..., :n, :n] = -F
+    M[..., :n, n:] = noise_input
+    M[..., n:, n:] = np.swapaxes(F, -1, -2)
+    E = expm_stack(M * dt)
+    Q = np.swapaxes(E[..., n:, n:], -1, -2) @ E[..., :n, n:]
+    return 0.5 * (Q + np.swapaxes(Q, -1, -2))
 
 
 def covariance_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> CovarianceBudget:
@@ -221,6 +223,7 @@ def covariance_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> Co
     Parameters
     ----------
     setup : MissionSetup
+        The mission, SI.
     disabled : tuple of str
         Sources switched off (their sigma set to zero), e.g. to check that one
         source's share is exactly what it adds.
@@ -228,66 +231,136 @@ def covariance_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> Co
     Returns
     -------
     CovarianceBudget
+        Every source's variance contribution to every output channel at every step boundary, SI^2.
     """
+    return covariance_budgets([setup], disabled)[0]
+
+
+def covariance_budgets(setups, disabled: tuple[str, ...] = ()) -> list[CovarianceBudget]:
+    """The error budgets of several missions of the same duration, output step and vertical channel, batched.
+
+    The missions may differ in everything else (instrument, stages, start point, heading, trajectory): a
+    Monte Carlo whose members draw their cases gets every member's covariance in one pass over the steps,
+    each step's matrix exponentials of all members at once.
+
+    Parameters
+    ----------
+    setups : sequence of MissionSetup
+        The missions, SI; equal ``duration`` (s), ``output_step`` (s) and ``vertical_channel``.
+    disabled : tuple of str
+        Sources switched off in every mission (their sigma set to zero).
+
+    Returns
+    -------
+    list of CovarianceBudget
+        One per mission, in order, as :func:`covariance_budget` gives it.
+    """
+    setups = list(setups)
     unknown = set(disabled) - set(SOURCES)
     if unknown:
         raise InvalidParameter("disabled", f"unknown sources {sorted(unknown)}; choose from {', '.join(SOURCES)}")
-    steps = setup.duration / setup.output_step
+    if not setups:
+        return []
+    first = setups[0]
+    if any((s.duration, s.output_step, s.vertical_channel) != (first.duration, first.output_step,
+                                                               first.vertical_channel) for s in setups):
+        raise InvalidParameter("setups", "a batch of budgets needs one duration, output step and vertical channel")
+    steps = first.duration / first.output_step
     if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
-        raise InvalidParameter("output_step", f"the duration {setup.duration:g} s must be a whole number of "
-                                              f"output steps of {setup.output_step:g} s")
+        raise InvalidParameter("output_step", f"the duration {first.duration:g} s must be a whole number of "
+                                              f"output steps of {first.output_step:g} s")
     if round(steps) > MAX_STEPS:
         raise InvalidParameter("output_step", f"{round(steps)} steps exceed {MAX_STEPS}: use a longer output step")
-    trajectory = setup.trajectory()
-    coefficients = step_coefficients(trajectory, setup.latitude, setup.height, setup.duration, setup.output_step)
-    vertical = setup.vertical_channel == "free"
-    F, G = wgs84_error_matrices(coefficients.latitude, coefficients.height, coefficients.velocity_ned,
-                                coefficients.specific_force_ned, EARTH_RATE, vertical)
-    n = F.shape[-1]
-    dt = setup.output_step
-    Ad, Bd = zoh_discretize(F * dt, G * dt, 1.0)
-    sigma = setup.constant_sigmas * np.array([name not in disabled for name in CONSTANT_SOURCES])
-    start_rotation = rotation_matrix(trajectory.kinematics(np.array([0.0]))[1])[0]
-    x0 = initial_state_map(setup, start_rotation, n) * sigma[:, None]
-    inputs = sensor_inputs(coefficients.body_to_ned, coefficients.body_rate,
-                           coefficients.body_specific_force) * sigma[None, :, None]
-    rows = _output_rows(coefficients, n)
-    K = F.shape[0]
-    constant = np.empty((K + 1, len(CONSTANT_SOURCES), n))
-    constant[0] = x = x0
+    per_batch = max(1, BATCH_STEPS // round(steps))
+    budgets = []
+    for start in range(0, len(setups), per_batch):
+        budgets.extend(_batch(setups[start:start + per_batch], disabled))
+    return budgets
+
+
+def _batch(setups: list[MissionSetup], disabled: tuple[str, ...]) -> list[CovarianceBudget]:
+    """:func:`covariance_budgets` of missions validated to share their steps, all at once."""
+    dt = setups[0].output_step
+    vertical = setups[0].vertical_channel == "free"
+    parts = [_MissionTerms.of(setup, disabled, vertical) for setup in setups]
+    M, K, n = len(parts), parts[0].F.shape[0], parts[0].F.shape[-1]
+    F = np.stack([part.F for part in parts])
+    G = np.stack([part.G for part in parts])
+    augmented = np.zeros((M, K, n + 6, n + 6))
+    augmented[..., :n, :n] = F * dt
+    augmented[..., :n, n:] = G * dt
+    transition = expm_stack(augmented)
+    Ad, Bd = transition[..., :n, :n], transition[..., :n, n:]
+    Ad_T, Bd_T = np.swapaxes(Ad, -1, -2), np.swapaxes(Bd, -1, -2)
+    rows = np.stack([part.rows for part in parts])
+    inputs = np.stack([part.inputs for part in parts])
+    constant = np.empty((M, K + 1, len(CONSTANT_SOURCES), n))
+    constant[:, 0] = x = np.stack([part.x0 for part in parts])
     for k in range(K):
-        x = x @ Ad[k].T + inputs[k] @ Bd[k].T
-        constant[k + 1] = x
-    projected = np.einsum("kcn,ksn->kcs", rows, constant)
-    contributions = [projected**2]
-    initial = alignment_noise(setup, start_rotation, n)
-    densities = {"gyro_random_walk": (setup.gyro_random_walk, slice(3, 6)),
-                 "accel_random_walk": (setup.accel_random_walk, slice(0, 3))}
-    white = np.zeros((K + 1, len(OUTPUT_CHANNELS), len(WHITE_SOURCES)))
-    total_initial = np.einsum("si,sj->ij", x0, x0)
+        x = x @ Ad_T[:, k] + inputs[:, k] @ Bd_T[:, k]
+        constant[:, k + 1] = x
+    projected = np.einsum("mkcn,mksn->mkcs", rows, constant)
+    white = np.zeros((M, K + 1, len(OUTPUT_CHANNELS), len(WHITE_SOURCES)))
+    totals = np.einsum("msi,msj->mij", constant[:, 0], constant[:, 0])
     for w, name in enumerate(WHITE_SOURCES):
         if name in disabled:
             continue
-        density, columns = densities[name]
-        ned = coefficients.body_to_ned @ np.diag(density**2) @ np.swapaxes(coefficients.body_to_ned, 1, 2)
-        Gw = G[:, :, columns]
-        Q = process_noise(F, Gw @ ned @ np.swapaxes(Gw, 1, 2), dt)
-        P = initial[name]
-        total_initial = total_initial + P
-        white[0, :, w] = np.einsum("cn,nm,cm->c", rows[0], P, rows[0])
+        columns = slice(3, 6) if name == "gyro_random_walk" else slice(0, 3)
+        Gw = G[..., columns]
+        density = np.stack([part.ned_density[name] for part in parts])
+        Q = process_noise(F, Gw @ density @ np.swapaxes(Gw, -1, -2), dt)
+        P = np.stack([part.initial[name] for part in parts])
+        totals = totals + P
+        white[:, 0, :, w] = np.einsum("mcn,mnl,mcl->mc", rows[:, 0], P, rows[:, 0])
         for k in range(K):
-            P = Ad[k] @ P @ Ad[k].T + Q[k]
-            white[k + 1, :, w] = np.einsum("cn,nm,cm->c", rows[k + 1], P, rows[k + 1])
-    contributions.append(white)
-    heading = math.sqrt(float(np.einsum("n,nm,m->", rows[0, 4], total_initial, rows[0, 4])))
-    if heading > LINEAR_LIMIT:
-        warnings.warn(f"the {setup.alignment} alignment over {setup.alignment_duration:g} s leaves a 1-sigma heading "
-                      f"error of {math.degrees(heading):.1f} deg: the small-angle error model is past its validity "
-                      "(align longer, calibrate better, or take north from a ground gyrocompass)",
-                      LinearityWarning, stacklevel=2)
-    variance = np.concatenate(contributions, axis=2)
-    padded = np.zeros((len(SOURCES), n))
-    padded[:len(CONSTANT_SOURCES)] = x0
-    return CovarianceBudget(time=coefficients.time, sources=SOURCES,
-                            variance={name: variance[:, c, :] for c, name in enumerate(OUTPUT_CHANNELS)},
-                            initial_state=padded, initial_covariance=total_initial, states=n)
+            P = Ad[:, k] @ P @ Ad_T[:, k] + Q[:, k]
+            white[:, k + 1, :, w] = np.einsum("mcn,mnl,mcl->mc", rows[:, k + 1], P, rows[:, k + 1])
+    variance = np.concatenate([projected**2, white], axis=3)
+    budgets = []
+    for m, (setup, part) in enumerate(zip(setups, parts)):
+        heading = math.sqrt(float(np.einsum("n,nl,l->", rows[m, 0, 4], totals[m], rows[m, 0, 4])))
+        if heading > LINEAR_LIMIT:
+            warnings.warn(f"the {setup.alignment} alignment over {setup.alignment_duration:g} s leaves a 1-sigma "
+                          f"heading error of {math.degrees(heading):.1f} deg: the small-angle error model is past "
+                          "its validity (align longer, calibrate better, or take north from a ground gyrocompass)",
+                          LinearityWarning, stacklevel=3)
+        padded = np.zeros((len(SOURCES), n))
+        padded[:len(CONSTANT_SOURCES)] = part.x0
+        budgets.append(CovarianceBudget(time=part.time, sources=SOURCES,
+                                        variance={name: variance[m, :, c, :] for c, name in enumerate(OUTPUT_CHANNELS)},
+                                        initial_state=padded, initial_covariance=totals[m], states=n))
+    return budgets
+
+
+@dataclass(frozen=True)
+class _MissionTerms:
+    """One mission's step matrices, unit-source inputs, output rows and initial terms (SI)."""
+
+    time: np.ndarray
+    F: np.ndarray
+    G: np.ndarray
+    rows: np.ndarray
+    x0: np.ndarray
+    inputs: np.ndarray
+    initial: dict[str, np.ndarray]
+    ned_density: dict[str, np.ndarray]
+
+    @classmethod
+    def of(cls, setup: MissionSetup, disabled: tuple[str, ...], vertical: bool) -> _MissionTerms:
+        trajectory = setup.trajectory()
+        coefficients = step_coefficients(trajectory, setup.latitude, setup.height, setup.duration,
+                                         setup.output_step)
+        F, G = wgs84_error_matrices(coefficients.latitude, coefficients.height, coefficients.velocity_ned,
+                                    coefficients.specific_force_ned, EARTH_RATE, vertical)
+        n = F.shape[-1]
+        sigma = setup.constant_sigmas * np.array([name not in disabled for name in CONSTANT_SOURCES])
+        start_rotation = rotation_matrix(trajectory.kinematics(np.array([0.0]))[1])[0]
+        inputs = sensor_inputs(coefficients.body_to_ned, coefficients.body_rate,
+                               coefficients.body_specific_force) * sigma[None, :, None]
+        C = coefficients.body_to_ned
+        ned_density = {name: C @ np.diag(density**2) @ np.swapaxes(C, 1, 2)
+                       for name, density in (("gyro_random_walk", setup.gyro_random_walk),
+                                             ("accel_random_walk", setup.accel_random_walk))}
+        return cls(time=coefficients.time, F=F, G=G, rows=_output_rows(coefficients, n),
+                   x0=initial_state_map(setup, start_rotation, n) * sigma[:, None], inputs=inputs,
+                   initial=alignment_noise(setup, start_rotation, n), ned_density=ned_density)

@@ -2,7 +2,8 @@
 
 :func:`evaluate` runs the covariance analysis of each case
 (:mod:`schuler.mission.covariance`; cases sharing every parameter are computed
-once). With random streams (a Monte Carlo), each member also flies the
+once, the distinct cases of one duration, output step and vertical channel in
+one batch). With random streams (a Monte Carlo), each member also flies the
 nonlinear INS with its own draws (:mod:`schuler.mission.monte_carlo`) and
 reports its final horizontal position error; the nominal case (no random
 streams) draws nothing, so that error is 0.
@@ -15,11 +16,19 @@ import math
 import numpy as np
 
 from schuler.contract import Cases, Output
+from schuler.imu.error_model import ErrorModel
 from schuler.imu.spec import GRADES
-from schuler.mission.covariance import CovarianceBudget, covariance_budget
+from schuler.mission.covariance import CovarianceBudget, covariance_budget, covariance_budgets
 from schuler.mission.monte_carlo import final_horizontal_errors, run_members
 from schuler.mission.results import MissionResult
-from schuler.mission.setup import ALIGNMENTS, CALIBRATIONS, TRAJECTORIES, VERTICAL_CHANNELS, mission_setup
+from schuler.mission.setup import (
+    ALIGNMENTS,
+    CALIBRATIONS,
+    TRAJECTORIES,
+    VERTICAL_CHANNELS,
+    error_model,
+    mission_setup,
+)
 from schuler.navigate.mechanization import estimate_memory
 from schuler.params import Case, Parameter, ParameterSet
 
@@ -116,6 +125,10 @@ def budget_outputs(budget: CovarianceBudget) -> dict[str, float]:
     }
 
 
+_SHAPE_KEYS = ("duration", "output_step", "vertical_channel")
+"""The parameters that fix the covariance analysis's steps and states: cases sharing them are batched."""
+
+
 def _values(cases: Cases, i: int) -> dict:
     case = cases.case(i)
     return {name: case[name] for name in PARAMETERS.names}
@@ -123,6 +136,10 @@ def _values(cases: Cases, i: int) -> dict:
 
 def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
+
+    The covariance analysis runs once per distinct case, and the distinct cases of one duration, output step
+    and vertical channel in one batch (:func:`~schuler.mission.covariance.covariance_budgets`), so that a
+    Monte Carlo whose members draw their cases costs the same per member however many there are.
 
     Parameters
     ----------
@@ -139,14 +156,25 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     out["member_position_error_m"] = np.zeros(n)
-    for index, group in cases.groups(*_BUDGET_KEYS):
-        setup = mission_setup(_values(group, 0))
-        for name, value in budget_outputs(covariance_budget(setup)).items():
-            out[name][index] = value
-        if cases.random is not None:
-            rate = float(group.float("imu_rate")[0])
-            result = run_members(setup, group.members, cases.random, rate, output_step=setup.duration)
-            out["member_position_error_m"][index] = final_horizontal_errors(result)
+    models: dict[tuple, ErrorModel] = {}
+    for shape_index, shape_group in cases.groups(*_SHAPE_KEYS):
+        distinct = list(shape_group.groups(*_BUDGET_KEYS))
+        setups = []
+        for _, group in distinct:
+            values = _values(group, 0)
+            key = (values["grade"], values["imu_spec"], values["instrument"])
+            if key not in models:
+                models[key] = error_model(*key)
+            setups.append(mission_setup(values, model=models[key]))
+        for (index, group), setup, budget in zip(distinct, setups, covariance_budgets(setups)):
+            rows = shape_index[index]
+            for name, value in budget_outputs(budget).items():
+                out[name][rows] = value
+            if cases.random is not None:
+                for rate_index, members in group.groups("imu_rate"):
+                    rate = float(members.float("imu_rate")[0])
+                    result = run_members(setup, members.members, cases.random, rate, output_step=setup.duration)
+                    out["member_position_error_m"][rows[rate_index]] = final_horizontal_errors(result)
     return out
 
 

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
+
+import numpy as np
 
 from schuler.mission.covariance import CovarianceBudget
 from schuler.mission.setup import SOURCES
@@ -20,9 +23,20 @@ class MissionResult(RunResult):
     ``budget`` maps every source to its share of the final horizontal
     position-error variance (the shares sum to 1); ``history`` holds every
     source's contribution at every output step (not in ``to_dict``; written by
-    :func:`write_files`). With a Monte Carlo, ``to_dict()["monte_carlo"]`` also
-    holds ``position_error_sigma_m``: the root mean square of the members' final
-    horizontal position errors (nonlinear INS).
+    :func:`write_files`). The top-level 1-sigma values are the covariance at the
+    nominal case. With a Monte Carlo, ``to_dict()["monte_carlo"]`` also holds the
+    comparison of like with like, in m:
+
+    * ``position_error_sigma_m``: the root mean square of the members' final
+      horizontal position errors (nonlinear INS);
+    * ``position_error_sigma_standard_error_m``: its sampling standard error,
+      std(e^2) / (2 RMS sqrt(N)) over the members kept (the delta method);
+    * ``covariance_position_error_sigma_m``: the covariance over the members'
+      own cases, sqrt(mean of their 1-sigma^2), what the RMS estimates when the
+      members draw scenario values (a ``[monte_carlo]`` table); without draws it
+      is the nominal one;
+    * ``nominal_covariance_position_error_sigma_m``: the covariance at the
+      nominal case (the top-level ``position_error_sigma_m``).
     """
 
     position_error_sigma_m: float
@@ -45,9 +59,36 @@ class MissionResult(RunResult):
     def to_dict(self) -> dict[str, Any]:
         data = super().to_dict()
         if self.monte_carlo is not None and isinstance(data.get("monte_carlo"), dict):
-            rms = self.monte_carlo.statistics["member_position_error_m"]["rms"]
-            data["monte_carlo"]["position_error_sigma_m"] = rms
+            data["monte_carlo"].update(self.comparison())
         return data
+
+    def comparison(self) -> dict[str, float]:
+        """The covariance beside the Monte Carlo over the same members, m (empty without a Monte Carlo).
+
+        Returns
+        -------
+        dict of str to float
+            ``position_error_sigma_m`` (the members' RMS, nonlinear INS), its sampling
+            ``position_error_sigma_standard_error_m``, ``covariance_position_error_sigma_m`` (over the members'
+            cases) and ``nominal_covariance_position_error_sigma_m`` (at the nominal case), m.
+        """
+        if self.monte_carlo is None:
+            return {}
+        statistics = self.monte_carlo.statistics
+
+        def rms(name: str) -> float:  # None when no member has a finite value
+            value = statistics[name]["rms"]
+            return math.nan if value is None else float(value)
+
+        kept = np.asarray(self.monte_carlo.samples.get("member_position_error_m", ()), dtype=float)
+        kept = kept[np.isfinite(kept)]
+        squares = kept**2
+        standard_error = (float(np.std(squares, ddof=1) / (2.0 * math.sqrt(np.mean(squares)) * math.sqrt(kept.size)))
+                          if kept.size > 1 and np.mean(squares) > 0 else math.nan)
+        return {"position_error_sigma_m": rms("member_position_error_m"),
+                "position_error_sigma_standard_error_m": standard_error,
+                "covariance_position_error_sigma_m": rms("position_error_sigma_m"),
+                "nominal_covariance_position_error_sigma_m": self.position_error_sigma_m}
 
     def render(self):
         from rich.console import Group
@@ -57,7 +98,8 @@ class MissionResult(RunResult):
         table.add_column("quantity")
         table.add_column("value", justify="right")
         rows = [
-            ("horizontal position error, 1-sigma (covariance)", f"{self.position_error_sigma_m:,.4g} m"),
+            ("horizontal position error, 1-sigma (covariance at the nominal case)",
+             f"{self.position_error_sigma_m:,.4g} m"),
             ("  north, east", f"{self.position_error_north_sigma_m:,.4g} m, {self.position_error_east_sigma_m:,.4g} m"),
             ("horizontal velocity error, 1-sigma", f"{self.velocity_error_sigma_m_s:.4g} m/s"),
             ("heading error, 1-sigma: after alignment, at the end",
@@ -67,9 +109,14 @@ class MissionResult(RunResult):
             ("dominant source", f"{self.dominant_source} ({100 * self.dominant_share:.1f} %)"),
         ]
         if self.monte_carlo is not None:
-            stats = self.monte_carlo.statistics["member_position_error_m"]
-            rows.append((f"Monte Carlo ({self.monte_carlo.members} members, nonlinear INS): RMS",
-                         f"{stats['rms']:,.4g} m"))
+            # like with like, below the nominal case: the covariance over the members' own cases beside their RMS
+            compared = self.comparison()
+            rows[2:2] = [("  covariance over the Monte Carlo members' cases (RMS of their 1-sigma)",
+                          f"{compared['covariance_position_error_sigma_m']:,.4g} m"),
+                         (f"  Monte Carlo ({self.monte_carlo.members} members, nonlinear INS): RMS, "
+                          "its sampling 1-sigma",
+                          f"{compared['position_error_sigma_m']:,.4g} m, "
+                          f"{compared['position_error_sigma_standard_error_m']:,.2g} m")]
         for name, value in rows:
             table.add_row(name, value)
         shares = Table(title="Share of the final horizontal position-error variance", show_header=True)

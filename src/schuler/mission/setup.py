@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -181,9 +181,10 @@ class MissionSetup:
             return accel.random_walk / (self.gravity * math.sqrt(self.calibration_duration))
         return accel.scale_factor.copy()
 
-    @property
+    @cached_property
     def constant_sigmas(self) -> np.ndarray:
-        """1-sigma of each of :data:`CONSTANT_SOURCES`, SI."""
+        """1-sigma of each of :data:`CONSTANT_SOURCES`, SI (computed once: the covariance and the Monte Carlo
+        both read it, and the slow terms' Allan variances are its cost)."""
         north = self.north_reference_error if self.alignment == "ground-gyrocompass" else 0.0
         return np.concatenate([self.gyro_bias_sigma(), self.accel_bias_sigma(), self.error_model.gyro.scale_factor,
                                self.accel_scale_factor_sigma(),
@@ -244,7 +245,7 @@ def _resolved(instrument: str, stamp: tuple[int, int] | None) -> ErrorModel:
         raise InvalidParameter("instrument", error.reason) from None
 
 
-def mission_setup(values) -> MissionSetup:
+def mission_setup(values, model: ErrorModel | None = None) -> MissionSetup:
     """A :class:`MissionSetup` from a case's SI values (a mapping with every parameter of the system).
 
     With a ``profile`` file, its ``[start]`` table and first waypoint's heading
@@ -256,6 +257,9 @@ def mission_setup(values) -> MissionSetup:
         Every parameter of :data:`~schuler.mission.evaluation.PARAMETERS` by name, SI (latitude, longitude,
         heading in rad; height in m; durations and steps in s; speed in m/s; ``pulse_relative_error`` a plain
         ratio; ``north_reference_error`` in rad; ``initial_position_error`` in m), choices and paths as text.
+    model : ErrorModel, optional
+        The instrument's error model when the caller has resolved it already (a batch of cases of one
+        instrument); not given: resolved from ``grade``, ``imu_spec`` and ``instrument``.
 
     Returns
     -------
@@ -272,7 +276,8 @@ def mission_setup(values) -> MissionSetup:
         start = {name: float(values[name]) for name in ("latitude", "longitude", "height", "heading")}
         kind = str(values["trajectory"])
     return MissionSetup(
-        error_model=error_model(values["grade"], values["imu_spec"], values["instrument"]),
+        error_model=model if model is not None else error_model(values["grade"], values["imu_spec"],
+                                                                values["instrument"]),
         calibration=str(values["calibration"]), calibration_duration=float(values["calibration_duration"]),
         pulse_relative_error=float(values["pulse_relative_error"]),
         alignment=str(values["alignment"]), alignment_duration=float(values["alignment_duration"]),
