@@ -255,3 +255,17 @@ def test_long_scenario_values_and_keys_are_quoted_short():
         with pytest.raises(ScenarioError) as error:
             parse_scenario(text, source="s.toml")
         assert len(str(error.value).split("; allowed:")[0]) < 300
+
+
+def test_the_lab_answers_a_power_expression_at_once():
+    from schuler.lab.controls import parse_typed
+    from schuler.study.systems import load_system
+
+    parameters = load_system("align").parameters
+    start = time.perf_counter()
+    values, errors = parse_typed(parameters, {"latitude": "10**10**10 deg", "azimuth": "1e400 deg"})
+    assert time.perf_counter() - start < 0.5  # the lab server stays free (it was busy for minutes)
+    assert values is None
+    assert errors == {"latitude": "--latitude: cannot read '10**10**10 deg' as a quantity in deg: a number and a "
+                                  "unit, not an expression",
+                      "azimuth": "--azimuth: '1e400 deg': the number is too large (floats end near 1.8e308)"}
