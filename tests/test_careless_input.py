@@ -269,3 +269,9 @@ def test_the_lab_answers_a_power_expression_at_once():
     assert errors == {"latitude": "--latitude: cannot read '10**10**10 deg' as a quantity in deg: a number and a "
                                   "unit, not an expression",
                       "azimuth": "--azimuth: '1e400 deg': the number is too large (floats end near 1.8e308)"}
+
+
+def test_align_compare_refuses_a_huge_initial_window(run_cli):
+    line = one_line_error(run_cli("align", "compare", "--imu", "tactical", "--duration", "60",
+                                  "--initial-window", "1e308"))
+    assert line == "schuler: error: --initial-window: '1e308' is outside (0, 86400] s"
