@@ -77,7 +77,9 @@ _ANGLE_UNITS = frozenset(
 _ANGLE_RATE_UNITS = frozenset({"revolutions_per_minute", "revolutions_per_second", "degree_per_second"})
 
 # the number in front of a unit: decimal, scientific notation, or inf/nan (refused later as not finite)
-_NUMBER = re.compile(r"[+-]?(?:(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.IGNORECASE)
+_DIGITS = r"\d(?:_?\d)*"  # 10_000 as Python writes it
+_NUMBER = re.compile(rf"[+-]?(?:(?:{_DIGITS}(?:\.(?:{_DIGITS})?)?|\.{_DIGITS})(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)",
+                     re.IGNORECASE)
 _NUMBER_WORD = re.compile(r"[+-]?(?:inf(?:inity)?|nan)", re.IGNORECASE)
 
 # the tokens of a unit; a name may hold digits after its first letter (g0), never an operator
