@@ -48,7 +48,8 @@ QUICK_ACTIONS = {
 CARELESS = st.one_of(
     st.sampled_from(["nan", "NaN", "inf", "-inf", "-1", "0", "1e308", "-1e308", "1e9", "1e-300", "", " ",
                      "abc", "1,5", "12 parsecs", "5 kg", "0.01 Hz", "95 percent", "1e4 g", "-0", "0x10",
-                     "1e9 s", "1e-9 s", "3 deg/h", "[1, 2]", "None", "true", "()", "f()"]),
+                     "1e9 s", "1e-9 s", "3 deg/h", "[1, 2]", "None", "true", "()", "f()", "10**10**10",
+                     "10**400 deg", "1e400", "9" * 500]),
     st.floats(allow_nan=True, allow_infinity=True).map(repr),
     st.integers(min_value=-10**12, max_value=10**12).map(str),
 )

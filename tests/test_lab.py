@@ -349,8 +349,9 @@ def test_an_injection_sent_to_the_server_comes_back_as_a_message(client, tmp_pat
     response = client.post("/_dash-update-component", json=body)
     assert response.status_code == 200
     messages = {key: value["children"] for key, value in response.get_json()["response"].items()}
-    assert messages['{"name":"latitude","type":"param-error"}'] == \
-        f"--latitude: cannot read {typed!r} as a quantity in deg"
+    latitude = messages['{"name":"latitude","type":"param-error"}']
+    assert latitude.startswith(f"--latitude: {typed[:40]!r}"[:-1]) and "too long for a quantity" in latitude
+    assert not marker.exists()
     assert all(text == "" for key, text in messages.items() if '"latitude"' not in key)
     assert not marker.exists()
 

@@ -102,7 +102,8 @@ def test_run_prints_what_the_api_returns(tmp_path, run_cli):
          "[parameters] method: 'guess' is not one of closed, table"),
         ('system = "fake"\n[parameters]\nmembers = 0\n', "[parameters] members: 0 is outside [1, inf)"),
         # wrong types
-        ('system = "fake"\n[parameters]\nlatitude = [1, 2]\n', "[parameters] latitude: [1, 2] is not a single number"),
+        ('system = "fake"\n[parameters]\nlatitude = [1, 2]\n',
+         "[parameters] latitude: expected a number or a string with a unit; got an array [1, 2]"),
         ('system = "fake"\nparameters = 3\n', "parameters: 3 must be a table"),
         # system
         ('[parameters]\nlatitude = 1\n', "system: missing"),

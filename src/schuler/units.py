@@ -5,14 +5,24 @@ The package works in SI inside (rad, rad/s, m, m/s, m/s^2, s). Users write
 such a string, or a bare number in the option's display unit, into an SI float,
 with a clear :class:`~schuler.exceptions.InvalidParameter` when it cannot.
 
-Two traps of the units library are closed here:
+**Unit text is data, not arithmetic.** A quantity is one number (scientific
+notation kept: ``1e-4``, ``1.5e+3``) followed by a unit, at most
+:data:`MAX_TEXT_LENGTH` characters. The unit is read here by a small grammar:
+unit names joined by ``*``, ``/``, ``·`` or a space, parentheses, ``sqrt(...)``
+and ``√``, and powers (``^`` or ``**``) that are small literal numbers
+(``m/s^2``, ``Hz^0.5``, ``h^(-1/2)``; at most :data:`MAX_EXPONENT` in size).
+Each name is looked up in the units library; nothing the user typed is ever
+evaluated as an expression, so ``10**10**10 deg`` is refused at once instead of
+computed for hours.
+
+Three traps of the units library are closed here:
 
 * **"g" is gram in pint.** Where an acceleration is expected, a bare ``g`` (and
   ``mg``, ``ug``/``µg``) means standard gravity g0 = 9.80665 m/s^2, as the field
   writes it ("1e-4 g"). The explicit spellings ``g0`` and ``gee`` mean standard
   gravity everywhere.
-* **Spec sheets write square roots**: "deg/sqrt(h)", "ug/√Hz". pint knows
-  neither spelling (it silently drops "√"), so both become ``**0.5`` first.
+* **Spec sheets write square roots**: "deg/sqrt(h)", "ug/√Hz"; both are read as
+  a power of 1/2.
 * **Radians are dimensionless in pint**, so "0.01 Hz" would pass as an angular
   rate and "95 percent" as an angle. Every option whose display unit carries an
   angle (deg, deg/h, arcmin ...) requires the value to carry an angle unit too,
@@ -30,6 +40,11 @@ Examples
 Traceback (most recent call last):
 ...
 schuler.exceptions.InvalidParameter: drift: '0.01 Hz' is not an angular rate (expected a unit like deg/h)
+>>> parse_quantity("10**10**10 deg", "deg", name="latitude")
+Traceback (most recent call last):
+...
+schuler.exceptions.InvalidParameter: latitude: cannot read '10**10**10 deg' as a quantity in deg: a number and a \
+unit, not an expression
 """
 
 from __future__ import annotations
@@ -47,19 +62,45 @@ ureg: pint.UnitRegistry = pint.UnitRegistry()
 ureg.define("standard_gravity_unit = 9.80665 meter / second ** 2 = g0 = gee")
 ureg.define("statute_mile = 1609.344 meter = smi")
 
+MAX_TEXT_LENGTH = 100
+"""Longest quantity text read, characters ("1.5e-3 deg/sqrt(h)" has 18)."""
+
+MAX_EXPONENT = 4
+"""Largest power written in a unit, in size (m/s^2, kg*m^2, Hz^0.5)."""
+
+EXCERPT_LENGTH = 80
+"""Characters of a user's text that a message quotes (longer text is cut, with "...")."""
+
 _ANGLE_UNITS = frozenset(
     {"radian", "degree", "arcminute", "arcsecond", "revolution", "turn", "gradian", "milliarcsecond"}
 )
 _ANGLE_RATE_UNITS = frozenset({"revolutions_per_minute", "revolutions_per_second", "degree_per_second"})
 
-# A bare g (optionally milli or micro) as a whole token: standard gravity where an
-# acceleration is expected.
-_G_TOKEN = re.compile(r"(?<![A-Za-z_])(m|u|µ|micro|milli)?g(?![A-Za-z_0-9])")
-_G_PREFIX = {None: "", "m": "milli", "milli": "milli", "u": "micro", "µ": "micro", "micro": "micro"}
+# the number in front of a unit: decimal, scientific notation, or inf/nan (refused later as not finite)
+_DIGITS = r"\d(?:_?\d)*"  # 10_000 as Python writes it
+_NUMBER = re.compile(rf"[+-]?(?:(?:{_DIGITS}(?:\.(?:{_DIGITS})?)?|\.{_DIGITS})(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)",
+                     re.IGNORECASE)
+_NUMBER_WORD = re.compile(r"[+-]?(?:inf(?:inity)?|nan)", re.IGNORECASE)
 
-# sqrt(X) and √X / √(X) as spec sheets write them
-_SQRT_CALL = re.compile(r"(?:sqrt|√)\s*\(([^()]*)\)")
-_SQRT_SIGN = re.compile(r"√\s*([A-Za-zµ_][A-Za-z0-9µ_]*)")
+# the tokens of a unit; a name may hold digits after its first letter (g0), never an operator
+_UNIT_TOKEN = re.compile(r"""
+    (?P<space>\s+)
+  | (?P<name>[A-Za-z_µμ°%‰][A-Za-z0-9_µμ]*)
+  | (?P<power>\*\*|\^)
+  | (?P<operator>[*/·×])
+  | (?P<number>[+-]?\d+(?:\.\d+)?)
+  | (?P<open>\()
+  | (?P<close>\))
+  | (?P<root>√)
+""", re.VERBOSE)
+
+_UNIT_NAME = re.compile(r"[A-Za-z_µμ][A-Za-z0-9_µμ]*")
+_POWER_LITERAL = re.compile(r"(?:\*\*|\^)\s*(?:\([^()]*\)|[+-]?\d+(?:\.\d+)?)")
+
+# a bare g (optionally milli or micro): standard gravity where an acceleration is expected
+_G_NAME = re.compile(r"(m|u|µ|μ|micro|milli)?g")
+_G_PREFIX = {None: "", "m": "milli", "milli": "milli", "u": "micro", "µ": "micro", "μ": "micro", "micro": "micro"}
+_SYMBOLS = {"°": "degree", "%": "percent", "‰": "permille"}
 
 _KIND_NAMES = {
     "[length]": "a length",
@@ -73,9 +114,151 @@ _KIND_NAMES = {
 }
 
 
+def quoted(value, limit: int = EXCERPT_LENGTH) -> str:
+    """A value as an error message quotes it: its repr, cut to about ``limit`` characters with "...".
+
+    Parameters
+    ----------
+    value : object
+        What the user gave (text, a number, a list ...).
+    limit : int
+        Longest excerpt of the text quoted, a count of characters.
+
+    Examples
+    --------
+    >>> quoted("0.01 deg/h")
+    "'0.01 deg/h'"
+    >>> quoted("x" * 1000, limit=5)
+    "'xxxxx...' (1,000 characters)"
+    """
+    if isinstance(value, str) and len(value) > limit:
+        return f"{value[:limit]!r}"[:-1] + f"...' ({len(value):,} characters)"
+    shown = repr(value)
+    return shown if len(shown) <= limit + 2 else shown[:limit] + "..."
+
+
+class _UnitSyntaxError(ValueError):
+    """The text is not a unit of the grammar; the message says what was found."""
+
+
+class _UnitReader:
+    """Recursive descent over the tokens of a unit (see the module notes for the grammar)."""
+
+    def __init__(self, text: str, gravity: bool):
+        self.tokens = _tokens(text)
+        self.position = 0
+        self.gravity = gravity
+
+    def read(self) -> PlainUnit:
+        if not self.tokens:
+            return ureg.Unit("")
+        if self.tokens[0] == ("operator", "/"):  # "2/s": the number is the numerator
+            self.tokens.insert(0, ("number", "1"))
+        unit = self.product()
+        if self.position != len(self.tokens):
+            raise _UnitSyntaxError(f"unexpected {self.tokens[self.position][1]!r}")
+        return unit
+
+    def peek(self) -> tuple[str, str]:
+        return self.tokens[self.position] if self.position < len(self.tokens) else ("end", "")
+
+    def take(self) -> tuple[str, str]:
+        token = self.peek()
+        self.position += 1
+        return token
+
+    def product(self) -> PlainUnit:
+        unit = self.factor()
+        while True:
+            kind, text = self.peek()
+            if kind == "operator":
+                self.take()
+                right = self.factor()
+                unit = unit / right if text == "/" else unit * right
+            elif kind in ("name", "open", "root"):  # a space between names multiplies
+                unit = unit * self.factor()
+            else:
+                return unit
+
+    def factor(self) -> PlainUnit:
+        unit = self.primary()
+        if self.peek()[0] == "power":
+            self.take()
+            unit = unit ** self.exponent()
+        return unit
+
+    def primary(self) -> PlainUnit:
+        kind, text = self.take()
+        if kind == "root":
+            return self.primary() ** 0.5
+        if kind == "open":
+            unit = self.product()
+            if self.take()[0] != "close":
+                raise _UnitSyntaxError("a parenthesis is not closed")
+            return unit
+        if kind == "number" and text == "1":  # "1/s"
+            return ureg.Unit("")
+        if kind == "name" and text == "sqrt" and self.peek()[0] == "open":
+            return self.primary() ** 0.5
+        if kind == "name":
+            return ureg.Unit(self.lookup(text))
+        if kind == "end":
+            raise _UnitSyntaxError("the unit ends early")
+        raise _UnitSyntaxError(f"unexpected {text!r}")
+
+    def exponent(self) -> int | float:
+        kind, text = self.take()
+        if kind == "open":
+            numerator = self.literal()
+            denominator = 1.0
+            if self.peek() == ("operator", "/"):
+                self.take()
+                denominator = self.literal()
+            if self.take()[0] != "close" or denominator == 0:
+                raise _UnitSyntaxError("a power in parentheses is a fraction like (1/2)")
+            value = numerator / denominator
+        elif kind == "number":
+            value = float(text)
+        else:
+            raise _UnitSyntaxError("a power must be a number")
+        if abs(value) > MAX_EXPONENT:
+            raise _UnitSyntaxError(f"a power of {value:g} (at most {MAX_EXPONENT} in size)")
+        return int(value) if value.is_integer() else value
+
+    def literal(self) -> float:
+        kind, text = self.take()
+        if kind != "number":
+            raise _UnitSyntaxError("a power must be a number")
+        return float(text)
+
+    def lookup(self, name: str) -> str:
+        name = _SYMBOLS.get(name, name)
+        match = _G_NAME.fullmatch(name)
+        if self.gravity and match:
+            name = f"{_G_PREFIX[match.group(1)]}g0"
+        try:
+            return ureg.get_name(name)
+        except pint.errors.UndefinedUnitError:
+            raise _UnitSyntaxError(f"unknown unit {name!r}") from None
+
+
+def _tokens(text: str) -> list[tuple[str, str]]:
+    tokens = []
+    position = 0
+    while position < len(text):
+        match = _UNIT_TOKEN.match(text, position)
+        if match is None:
+            raise _UnitSyntaxError(f"unexpected {text[position]!r}")
+        position = match.end()
+        kind = match.lastgroup or ""
+        if kind != "space":
+            tokens.append((kind, match.group()))
+    return tokens
+
+
 def _exponents(unit: PlainUnit) -> dict[str, float]:
     """Each unit name in ``unit`` with its exponent (deg/h -> {"degree": 1.0, "hour": -1.0})."""
-    # pint types an exponent as any scalar, complex included; the units it builds have real ones
+    # pint types an exponent as any scalar, complex included; the units built here have real ones
     return {name: float(exponent) for name, exponent in unit._units.items()}  # type: ignore[arg-type]
 
 
@@ -90,20 +273,11 @@ def _angle_power(unit: PlainUnit) -> int:
 
 
 @lru_cache(maxsize=256)
-def _display_unit(unit: str) -> pint.Unit:
-    return ureg.Unit(_standard_gravity_spelling(unit))
+def _display_unit(unit: str) -> PlainUnit:
+    return _UnitReader(unit, gravity=True).read()
 
 
-def _standard_gravity_spelling(text: str) -> str:
-    return _G_TOKEN.sub(lambda m: f"{_G_PREFIX[m.group(1)]}g0", _square_roots(text))
-
-
-def _square_roots(text: str) -> str:
-    """"deg/sqrt(h)", "ug/√Hz" -> "deg/(h)**0.5", "ug/Hz**0.5"."""
-    return _SQRT_SIGN.sub(r"\1**0.5", _SQRT_CALL.sub(r"(\1)**0.5", text))
-
-
-def _describe(unit: pint.Unit) -> str:
+def _describe(unit: PlainUnit) -> str:
     angle = _angle_power(unit)
     dims = str(unit.dimensionality)
     if angle == 1 and dims == "1 / [time]":
@@ -115,11 +289,27 @@ def _describe(unit: pint.Unit) -> str:
     return _KIND_NAMES.get(dims, f"a quantity in {unit:~P}")
 
 
-def _gravity_units_expected(unit: pint.Unit) -> bool:
+def _gravity_units_expected(unit: PlainUnit) -> bool:
     """A bare g means standard gravity where the unit involves length and time but no mass
     (an acceleration, a noise density in ug/sqrt(Hz), a g-sensitivity in deg/h/g)."""
     dims = unit.dimensionality
     return dims.get("[mass]", 0) == 0 and dims.get("[length]", 0) != 0 and dims.get("[time]", 0) != 0
+
+
+def _looks_like_expression(rest: str) -> bool:
+    """Arithmetic after the number ("**10**10", "*3", "/2 deg", "+1") rather than a unit with a mistake."""
+    if rest.lstrip().startswith(("*", "^", "+", "-")) or "+" in rest:
+        return True
+    # what is left of the unit without its names, its power literals and a leading "1" of "1/s"
+    left = _POWER_LITERAL.sub(" ", _UNIT_NAME.sub(" ", rest))
+    return re.search(r"\d", re.sub(r"(?<![\d.])1\s*/", "/", left)) is not None
+
+
+def _number(text: str, shown: str, name: str) -> float:
+    number = float(text)
+    if math.isinf(number) and not _NUMBER_WORD.fullmatch(text):
+        raise InvalidParameter(name, f"{shown}: the number is too large (floats end near 1.8e308)")
+    return number
 
 
 def parse_quantity(value, unit: str, *, name: str) -> float:
@@ -128,8 +318,9 @@ def parse_quantity(value, unit: str, *, name: str) -> float:
     Parameters
     ----------
     value : str, int or float
-        A number (taken in ``unit``) or a string with a unit ("0.01 deg/h").
-        A string holding only a number is also taken in ``unit``.
+        A number (taken in ``unit``) or a string with a unit ("0.01 deg/h"): one
+        number, then a unit (see the module notes), at most :data:`MAX_TEXT_LENGTH`
+        characters. A string holding only a number is also taken in ``unit``.
     unit : str
         The display unit of the option, e.g. ``"deg"``, ``"deg/h"``, ``"s"``,
         ``"ft"``, ``"g"`` (standard gravity), ``""`` for a plain number.
@@ -144,45 +335,50 @@ def parse_quantity(value, unit: str, *, name: str) -> float:
     Raises
     ------
     InvalidParameter
-        Unparseable text, an unknown unit, a unit of the wrong dimension or
-        without the angle the option needs, or a value that is not finite.
+        Over-long or unreadable text, an expression, an unknown unit, a unit of the
+        wrong dimension or without the angle the option needs, or a value that is
+        not finite (too large for a float included).
     """
     target = _display_unit(unit)
     if isinstance(value, bool):
         raise InvalidParameter(name, f"{value!r} is not a number")
     if isinstance(value, (int, float)):
-        quantity = ureg.Quantity(float(value), target)
-        shown = repr(value)
+        shown = quoted(value)
+        try:
+            number = float(value)
+        except OverflowError:
+            raise InvalidParameter(name, f"{shown}: the number is too large (floats end near 1.8e308)") from None
+        written = target
     else:
         text = str(value).strip()
-        shown = repr(text)
+        shown = quoted(text)
         if not text:
             raise InvalidParameter(name, "empty value")
+        if len(text) > MAX_TEXT_LENGTH:
+            raise InvalidParameter(name, f"{shown} is too long for a quantity (at most {MAX_TEXT_LENGTH} "
+                                   "characters: a number and a unit)")
+        match = _NUMBER.match(text)
+        if match is None:
+            raise InvalidParameter(name, f"cannot read {shown} as a quantity in {unit or 'plain numbers'}: it does "
+                                   "not start with a number")
+        number = _number(match.group(), shown, name)
+        rest = text[match.end():]
         try:
-            quantity = ureg.Quantity(float(text), target)
-        except ValueError:
-            spelled = _standard_gravity_spelling(text) if _gravity_units_expected(target) else _square_roots(text)
-            try:
-                quantity = ureg.Quantity(spelled)
-            except Exception:  # pint raises many kinds on malformed text: "()" asserts, "deg (" fails to tokenize
-                raise InvalidParameter(
-                    name, f"cannot read {shown} as a quantity in {unit or 'plain numbers'}"
-                ) from None
-            if not isinstance(quantity, ureg.Quantity):
-                quantity = ureg.Quantity(float(quantity), "")
-            if not str(quantity.units) and str(target):
-                # "50" with spaces or an expression: a bare number in the display unit
-                quantity = ureg.Quantity(float(quantity.magnitude), target)
-    if not quantity.is_compatible_with(target) or _angle_power(quantity.units) != _angle_power(target):
-        raise InvalidParameter(
-            name, f"{shown} is not {_describe(target)} (expected a unit like {unit or 'a plain number'})"
-        )
-    si = quantity.to_base_units()
+            written = _UnitReader(rest, gravity=_gravity_units_expected(target)).read() if rest.strip() else target
+        except _UnitSyntaxError as error:
+            reason = "a number and a unit, not an expression" if _looks_like_expression(rest) else str(error)
+            raise InvalidParameter(name, f"cannot read {shown} as a quantity in {unit or 'plain numbers'}: "
+                                   f"{reason}") from None
+    if not written.is_compatible_with(target) or _angle_power(written) != _angle_power(target):
+        expected = f"expected a unit like {unit}" if unit else "expected a plain number, without a unit"
+        raise InvalidParameter(name, f"{shown} is not {_describe(target)} ({expected})")
     try:
-        magnitude = float(si.magnitude)
-    except TypeError:
-        raise InvalidParameter(name, f"{shown} is not a single number") from None
+        magnitude = float(ureg.Quantity(number, written).to_base_units().magnitude)
+    except (pint.errors.PintError, ArithmeticError):  # offset units (degC) in a product
+        raise InvalidParameter(name, f"cannot convert {shown} to SI") from None
     if not math.isfinite(magnitude):
+        if math.isfinite(number):
+            raise InvalidParameter(name, f"{shown} is too large once in SI ({si_unit(unit)})")
         raise InvalidParameter(name, f"{shown} is not a finite number")
     return magnitude
 

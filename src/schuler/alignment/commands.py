@@ -77,7 +77,8 @@ ALIGN_COMPARE_PARAMETERS = ParameterSet((
     Parameter("update_interval", "s", 1.0, "Time between Kalman updates.", minimum=0, exclusive_minimum=True,
               maximum=60),
     Parameter("initial_window", "s", 30.0, "Coarse alignment over the first seconds starts the Kalman filter and the "
-              "gyrocompass.", minimum=0, exclusive_minimum=True),
+              "gyrocompass (at most a day; a window longer than the record takes all of it).", minimum=0,
+              exclusive_minimum=True, maximum=86400),
 ), owner="align compare")
 """Options of ``schuler align compare``."""
 

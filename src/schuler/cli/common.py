@@ -82,6 +82,25 @@ def options_named(parameters):
         raise type(error)(f"{options[name]}: {rest}") from None
 
 
+class FolderPath(click.Path):
+    """A folder option's value (a :class:`~pathlib.Path`); an empty name is refused, not read as ".".
+
+    click turns ``--out ""`` into the current folder, where the files of a run would then land unasked.
+    """
+
+    def __init__(self):
+        super().__init__(file_okay=False, path_type=Path)
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, str) and not value.strip():
+            self.fail("an empty folder name; give a folder (write . for the current one)", param, ctx)
+        return super().convert(value, param, ctx)
+
+
+FOLDER = FolderPath()
+"""The type of every ``--out`` folder option."""
+
+
 def folder_not_option(ctx, param, value: Path | None) -> Path | None:
     """Refuse a folder named like an option (``--out --help`` would create a folder "--help")."""
     if value is not None and str(value).startswith("-"):
@@ -93,7 +112,7 @@ json_option = click.option("--json", "as_json", is_flag=True, help="Print a mach
 out_option = click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=FOLDER,
     default=None,
     callback=folder_not_option,
     help="Folder for figures and data files (created if missing).",
@@ -159,5 +178,5 @@ def warn(message: str) -> None:
     print(f"schuler: warning: {message}", file=sys.stderr)
 
 
-__all__ = ["emit", "json_document", "json_option", "options_named", "out_option", "parameter_options",
-           "progress_reporter", "warn"]
+__all__ = ["FOLDER", "FolderPath", "emit", "json_document", "json_option", "options_named", "out_option",
+           "parameter_options", "progress_reporter", "warn"]

@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from schuler import __version__
-from schuler.cli.common import folder_not_option, json_option
+from schuler.cli.common import FOLDER, folder_not_option, json_option
 from schuler.cli.sweep import SCENARIO_ARGUMENT
 from schuler.registry import SYSTEM_MODULES
 
@@ -18,7 +18,7 @@ from schuler.registry import SYSTEM_MODULES
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=FOLDER,
     callback=folder_not_option,
     default=None,
     help="Folder for figures and data files (default: the scenario's [outputs] directory, if any).",
@@ -50,7 +50,7 @@ def run_scenario(scenario: Path, out_dir: Path | None, no_time_limit: bool, as_j
 @click.option(
     "--out",
     "out_dir",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=FOLDER,
     callback=folder_not_option,
     default=Path("results"),
     show_default=True,

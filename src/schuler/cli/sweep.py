@@ -11,7 +11,7 @@ from pathlib import Path
 
 import click
 
-from schuler.cli.common import emit, folder_not_option, json_option
+from schuler.cli.common import FOLDER, emit, folder_not_option, json_option
 from schuler.exceptions import ScenarioError
 
 SCENARIO_ARGUMENT = click.argument("scenario", metavar="SCENARIO.toml",
@@ -61,7 +61,7 @@ def sweep_command(system: str | None = None) -> click.Command:
     @click.option(
         "--out",
         "out_dir",
-        type=click.Path(file_okay=False, path_type=Path),
+        type=FOLDER,
         callback=folder_not_option,
         required=True,
         help="Folder for results.csv, results.parquet, summary.json, plots and the chunk files. "

@@ -53,8 +53,8 @@ from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
 
 MOTION_PARAMETERS = (
-    # the source's value as it prints it: 3.69 pi/540 rad (= motion.SOURCE_ALPHA0)
-    Parameter("alpha0", "rad", "3.69*pi/540 rad",
+    # the source's 3.69 pi/540 rad, as a number: quantity text is a number and a unit, not an expression
+    Parameter("alpha0", "rad", motion.SOURCE_ALPHA0,
               "True initial angle alpha0 of the rotor axis from north (small angles).", minimum=-0.5, maximum=0.5),
     Parameter("alpha0_dot", "rad/s", motion.SOURCE_ALPHA0_DOT, "True initial azimuth rate.",
               minimum=-0.01, maximum=0.01),

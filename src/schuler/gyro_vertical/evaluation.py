@@ -119,8 +119,9 @@ PARAMETERS = ParameterSet((
     Parameter("compensation", "", "none", "Subtract the transport and Coriolis accelerations W* (21) computed "
               "from the known trajectory.", choices=("none", "trajectory"), kind="choice"),
     Parameter("earth_rate_compensation", "", True, "Apply the Earth-rate torques (8).", kind="flag"),
-    Parameter("schuler_tuning", "", 1.0, "kappa = k R / H (1: the Schuler condition (11)).", minimum=0,
-              maximum=100, exclusive_minimum=True),
+    Parameter("schuler_tuning", "", 1.0, "kappa = k R / H (1: the Schuler condition (11)); the correction's "
+              "period is 84.4 min / sqrt(kappa), from 14 h to 8.4 min over the range: a gyro vertical mistuned "
+              "beyond that is not one.", minimum=0.01, maximum=100),
     Parameter("trajectory", "", "great-circle", "Move along the great circle, or freeze latitude and azimuth "
               "(the source's slowly-varying assumption; exact matrix-exponential solution).",
               choices=("great-circle", "frozen"), kind="choice"),

@@ -44,15 +44,26 @@ from schuler.params import Case, Parameter, ParameterSet
 _ERROR_LIMIT = 600.0
 """Largest latitude error and initial level error accepted, arcmin (either sign)."""
 
+_DRIFT_LIMIT = 15.0
+"""Largest residual drift accepted, deg/h (either sign): about the Earth's rate, 15.04 deg/h, which the loop
+compares it with; an east drift that large leaves no north to find (the azimuth error is 90 deg or more)."""
+
+_DRIFT_RANGE = f" Within about the Earth's rate ({_DRIFT_LIMIT:g} deg/h): a larger drift leaves no north to find."
+
 PARAMETERS = ParameterSet((
     Parameter("latitude", "deg", 50.0, "Latitude of the site.", minimum=-90, maximum=90,
               exclusive_minimum=True, exclusive_maximum=True),
     Parameter("azimuth", "deg", 0.0, "Azimuth A of the platform's x_g axis.", minimum=-360, maximum=360),
-    Parameter("drift_east", "deg/h", 0.0, "Residual drift about east, Delta omega_dxi (estimate - true)."),
-    Parameter("drift_north", "deg/h", 0.0, "Residual drift about north, Delta omega_deta."),
-    Parameter("drift_x", "deg/h", 0.0, "Residual drift about the platform x axis (adds to east/north)."),
-    Parameter("drift_y", "deg/h", 0.0, "Residual drift about the platform y axis (adds to east/north)."),
-    Parameter("drift_z", "deg/h", 0.0, "Residual drift about the platform z axis (up)."),
+    Parameter("drift_east", "deg/h", 0.0, "Residual drift about east, Delta omega_dxi (estimate - true)."
+              + _DRIFT_RANGE, minimum=-_DRIFT_LIMIT, maximum=_DRIFT_LIMIT),
+    Parameter("drift_north", "deg/h", 0.0, "Residual drift about north, Delta omega_deta." + _DRIFT_RANGE,
+              minimum=-_DRIFT_LIMIT, maximum=_DRIFT_LIMIT),
+    Parameter("drift_x", "deg/h", 0.0, "Residual drift about the platform x axis (adds to east/north)."
+              + _DRIFT_RANGE, minimum=-_DRIFT_LIMIT, maximum=_DRIFT_LIMIT),
+    Parameter("drift_y", "deg/h", 0.0, "Residual drift about the platform y axis (adds to east/north)."
+              + _DRIFT_RANGE, minimum=-_DRIFT_LIMIT, maximum=_DRIFT_LIMIT),
+    Parameter("drift_z", "deg/h", 0.0, "Residual drift about the platform z axis (up)." + _DRIFT_RANGE,
+              minimum=-_DRIFT_LIMIT, maximum=_DRIFT_LIMIT),
     Parameter("latitude_error", "arcmin", 0.0, "Error Delta phi of the latitude entered.",
               minimum=-_ERROR_LIMIT, maximum=_ERROR_LIMIT),
     Parameter("accel_bias_x", "g", 0.0, "Bias Delta a_x of the x accelerometer (measured - true).",

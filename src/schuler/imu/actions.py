@@ -37,6 +37,7 @@ from schuler.imu.run_results import SimulationResult
 from schuler.imu.simulate import simulate_record, write_simulation
 from schuler.memory import require
 from schuler.params import Parameter, ParameterSet
+from schuler.units import quoted
 
 ALLAN_BYTES_PER_SAMPLE = 32
 """Memory an Allan analysis holds per sample of the file: six channels' angles over twice the longest lag
@@ -78,12 +79,16 @@ SIMULATE_PARAMETERS = PARAMETERS + ParameterSet((Parameter(
     "seed", "", 0, "Seed of the record's random numbers.", minimum=0, kind="integer"),))
 
 
+_PAIR_EXAMPLES = {"columns": "time=t,gyro_x=wx,accel_x=ax", "units": "gyro=deg/s,accel=g"}
+"""What each channel=value option's message suggests."""
+
+
 def _pairs(text: str, name: str) -> dict[str, str]:
     pairs = {}
     for part in (p.strip() for p in text.split(",")):
         key, equals, value = part.partition("=")
         if not equals or not key.strip() or not value.strip():
-            raise InvalidParameter(name, f"{part!r} is not channel=value; write e.g. 'gyro=deg/s,accel=g'")
+            raise InvalidParameter(name, f"{quoted(part)} is not channel=value; write e.g. '{_PAIR_EXAMPLES[name]}'")
         pairs[key.strip()] = value.strip()
     return pairs
 

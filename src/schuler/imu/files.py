@@ -42,8 +42,12 @@ def open_record(path, **options) -> RecordSource:
         The opened file: metadata and an iterator over its chunks, nothing read yet beyond the header.
     """
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise ImuFileError(path, "no such file")
+    if path.is_dir():
+        raise ImuFileError(path, "is a folder, not an IMU file")
+    if not path.is_file():
+        raise ImuFileError(path, "not a regular file (a device, pipe or socket); give an IMU file")
     suffix = path.suffix.lower()
     if suffix in (".imu", ".parquet") and options:
         raise InvalidParameter(sorted(options)[0], f"applies to CSV files only, not {suffix}")

@@ -50,6 +50,7 @@ import numpy as np
 
 from schuler.exceptions import InvalidParameter, SchulerError
 from schuler.imu.record import KINDS, ImuRecord, axes_matrix
+from schuler.units import quoted
 
 CHANNELS = ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
 """The six sensor channels, body frame."""
@@ -62,6 +63,9 @@ DEFAULT_MAX_MEMORY_BYTES = 2 * 1024**3
 
 CHUNK_ROWS = 1 << 20
 """Rows per chunk when streaming a file."""
+
+MAX_LINE_CHARACTERS = 1 << 16
+"""Longest header or sample line read while opening a file; a longer one is refused, not loaded into memory."""
 
 _BYTES_PER_SAMPLE = 7 * 8 * 3  # time + 6 channels as float64, with room for one copy while converting
 _ARCSEC = math.pi / 180.0 / 3600.0
@@ -77,7 +81,8 @@ class ImuFileError(SchulerError):
         if line is not None:
             where += f", line {line}"
         if column is not None:
-            where += f", column {column}" + (f" ({column_name})" if column_name else "")
+            shown = column_name if not column_name or len(column_name) <= 40 else column_name[:40] + "..."
+            where += f", column {column}" + (f" ({shown})" if shown else "")
         super().__init__(f"{where}: {message}")
 
 
@@ -262,6 +267,15 @@ def _decode_guard(path, iterator):
                            f"{error.start} of a read block); convert the file to UTF-8") from None
 
 
+def _bounded_lines(path: Path, handle) -> Iterator[str]:
+    """The lines of an open text file, each read with a bound; a line over :data:`MAX_LINE_CHARACTERS` is refused."""
+    for number, line in enumerate(iter(lambda: handle.readline(MAX_LINE_CHARACTERS + 1), ""), start=1):
+        if len(line) > MAX_LINE_CHARACTERS and line[-1] not in "\r\n":
+            raise ImuFileError(path, f"a line longer than {MAX_LINE_CHARACTERS:,} characters ({line[:40]!r}...); "
+                               "an IMU file's header and sample lines are short", line=number)
+        yield line
+
+
 def _estimate_rows(path: Path, header_bytes: int, sample_lines: list[str]) -> int:
     size = os.path.getsize(path)
     if not sample_lines:
@@ -307,7 +321,7 @@ def _locate_text(path, frame, first_line: int) -> np.ndarray:
         text = frame[column].notna() & converted.isna()
         if text.any():
             row = int(np.flatnonzero(text.to_numpy())[0])
-            raise ImuFileError(path, f"not a number: {frame[column].iloc[row]!r}", line=first_line + row,
+            raise ImuFileError(path, f"not a number: {quoted(frame[column].iloc[row])}", line=first_line + row,
                                column=column_index + 1, column_name=str(column))
     return frame.apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
 
@@ -383,14 +397,15 @@ def _csv_header(path: Path, encoding: str):
     with _open_text(path, encoding) as handle:
         try:
             comments, header_bytes, header = 0, 0, None
-            for line in handle:
+            lines = _bounded_lines(path, handle)
+            for line in lines:
                 header_bytes += len(line.encode("utf-8"))
                 if line.lstrip().startswith("#"):
                     comments += 1
                     continue
                 header = line.strip()
                 break
-            sample = [line.rstrip("\r\n") for _, line in zip(range(1000), handle)]
+            sample = [line.rstrip("\r\n") for _, line in zip(range(1000), lines)]
         except UnicodeDecodeError as error:
             raise ImuFileError(
                 path, f"not valid text in {encoding} ({error.reason}); convert the file to UTF-8") from None
@@ -416,12 +431,12 @@ def _csv_mapping(path: Path, names: list[str], columns: dict | None, header_line
         same_channel = [(i, n) for i, n in enumerate(names) if n.startswith(prefix)]
         if same_channel and columns is None:
             index, found = same_channel[0]
-            raise ImuFileError(path, f"wrong units: column {found!r} where {name!r} is expected (the project's CSV "
-                               "holds SI rates); give a column/unit mapping for other units",
+            raise ImuFileError(path, f"wrong units: column {quoted(found)} where {quoted(name)} is expected (the "
+                               "project's CSV holds SI rates); give a column/unit mapping for other units",
                                line=header_line, column=index + 1, column_name=found)
         close = difflib.get_close_matches(name, names, n=1)
-        hint = f"; did you mean {close[0]!r}?" if close else f"; the header has {', '.join(names)}"
-        raise ImuFileError(path, f"no column {name!r} for {channel}{hint}", line=header_line)
+        hint = f"; did you mean {quoted(close[0])}?" if close else f"; the header has {quoted(', '.join(names))}"
+        raise ImuFileError(path, f"no column {quoted(name)} for {channel}{hint}", line=header_line)
     return mapping
 
 
@@ -501,7 +516,8 @@ def _psins_header(path: Path, encoding: str):
     line_number, header_bytes = 0, 0
     with _open_text(path, encoding) as handle:
         try:
-            for line in handle:
+            lines = _bounded_lines(path, handle)
+            for line in lines:
                 line_number += 1
                 header_bytes += len(line.encode("utf-8"))
                 text = line.strip()
@@ -510,7 +526,7 @@ def _psins_header(path: Path, encoding: str):
                 try:
                     numbers = [float(v) for v in text.split()]
                 except ValueError:
-                    raise ImuFileError(path, f"header line {len(headers) + 1} is not numeric: {text[:60]!r}",
+                    raise ImuFileError(path, f"header line {len(headers) + 1} is not numeric: {quoted(text)}",
                                        line=line_number) from None
                 if len(numbers) != 6 or not all(math.isfinite(v) for v in numbers):
                     raise ImuFileError(path, f"header line {len(headers) + 1} must hold 6 finite numbers, "
@@ -518,7 +534,7 @@ def _psins_header(path: Path, encoding: str):
                 headers.append(numbers)
                 if len(headers) == 3:
                     break
-            sample = [line.rstrip("\r\n") for _, line in zip(range(1000), handle)]
+            sample = [line.rstrip("\r\n") for _, line in zip(range(1000), lines)]
         except UnicodeDecodeError as error:
             raise ImuFileError(
                 path, f"not valid text in {encoding} ({error.reason}); convert the file to UTF-8") from None

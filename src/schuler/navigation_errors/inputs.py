@@ -38,7 +38,7 @@ from schuler.core.earth import PRESETS
 from schuler.exceptions import InvalidParameter
 from schuler.navigation_errors.single_channel import SOURCES, check_source
 from schuler.params import Case, Parameter, ParameterSet
-from schuler.units import parse_quantity, si_unit
+from schuler.units import parse_quantity, quoted, si_unit
 
 SOURCE_UNITS: dict[str, str] = {
     "tilt": "deg",
@@ -136,16 +136,21 @@ class MagnitudeParameter(Parameter):
     def parse(self, value, label: str | None = None):
         label = label or self.name
         text = str(value).strip()
-        problems = []
+        problems = {}
         for source in SOURCES:
             try:
                 magnitude_si(source, text, label)
                 return text
             except InvalidParameter as error:
-                problems.append(error.reason)
-        if any("must be finite and >= 0" in reason for reason in problems):
-            raise InvalidParameter(label, f"{text!r} must be finite and >= 0 (the source's direction sets the sign)")
-        raise InvalidParameter(label, f"cannot read {text!r} as a magnitude: a number in the source's unit "
+                problems[source] = error.reason
+        if any("must be finite and >= 0" in reason for reason in problems.values()):
+            raise InvalidParameter(label, f"{quoted(text)} must be finite and >= 0 (the source's direction sets "
+                                   "the sign)")
+        too_large = [source for source, reason in problems.items() if " is more than " in reason]
+        if too_large:
+            largest = ", ".join(f"{SOURCE_MAXIMA[source]:g} {SOURCE_UNITS[source]} ({source})" for source in too_large)
+            raise InvalidParameter(label, f"{quoted(text)} is out of range: a magnitude is at most {largest}")
+        raise InvalidParameter(label, f"cannot read {quoted(text)} as a magnitude: a number in the source's unit "
                                       "or a value with an angle, speed, acceleration or angular-rate unit")
 
     def help_text(self) -> str:

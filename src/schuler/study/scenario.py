@@ -49,7 +49,6 @@ imu, navigate, mission
 
 from __future__ import annotations
 
-import difflib
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -75,6 +74,7 @@ from schuler.exceptions import InvalidParameter, ScenarioError
 from schuler.imu.instrument import apply_instrument, instrument_options
 from schuler.params import Case, Parameter
 from schuler.registry import SYSTEM_MODULES, get_system
+from schuler.study.scenario_problems import first_problem, names, shown
 from schuler.study.systems import load_system
 from schuler.units import to_unit
 
@@ -337,11 +337,13 @@ def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise ScenarioError(f"{source}: not valid TOML: {error}") from None
+    except RecursionError:  # the parser recurses into nested arrays and inline tables
+        raise ScenarioError(f"{source}: not valid TOML: arrays or tables nested too deeply") from None
     if "system" not in data:
-        raise ScenarioError(f"{source}: system: missing; set system = one of {_names(SYSTEM_MODULES)}")
+        raise ScenarioError(f"{source}: system: missing; set system = one of {names(SYSTEM_MODULES)}")
     name = data["system"]
-    if name not in SYSTEM_MODULES:
-        raise ScenarioError(f"{source}: system: {name!r} is not one of {_names(SYSTEM_MODULES)}")
+    if not isinstance(name, str) or name not in SYSTEM_MODULES:
+        raise ScenarioError(f"{source}: system: {shown(name)} is not one of {names(SYSTEM_MODULES)}")
     system = load_system(name)
     if system is None:
         raise ScenarioError(f"{source}: system: {name!r} is not available in this installation")
@@ -349,7 +351,9 @@ def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
     try:
         parsed = model.model_validate(data)
     except ValidationError as error:
-        raise ScenarioError(f"{source}: {_first_problem(error, model)}") from None
+        raise ScenarioError(f"{source}: {first_problem(error, model, system)}") from None
+    except RecursionError:
+        raise ScenarioError(f"{source}: arrays or tables nested too deeply for a scenario") from None
     return _build(parsed, system, source)
 
 
@@ -426,59 +430,6 @@ def _validators(parameters: dict[str, Parameter], fields: dict) -> dict:
     if not fields:
         return {}
     return {"check_parameters": field_validator(*fields)(check)}
-
-
-_TABLE_TITLES = {
-    "parameters": "[parameters]",
-    "simulation": "[simulation]",
-    "outputs": "[outputs]",
-    "monte_carlo": "[monte_carlo]",
-    "instrument": "[instrument]",
-}
-
-
-def _first_problem(error: ValidationError, model: type[BaseModel]) -> str:
-    """One line for the first validation problem: table, key, value, what is allowed."""
-    problem = error.errors(include_url=False)[0]
-    location = [str(part) for part in problem["loc"]]
-    if location[:2] == ["monte_carlo", "normal"] or location[:2] == ["monte_carlo", "uniform"]:
-        table, keys = f"[monte_carlo.{location[1]}]", location[2:]
-    elif location and location[0] in _TABLE_TITLES and len(location) > 1:
-        table, keys = _TABLE_TITLES[location[0]], location[1:]
-    else:
-        table, keys = "", location
-    key = keys[0] if keys else ""
-    where = " ".join(part for part in (table, key) if part)
-    kind = problem["type"]
-    if kind == "extra_forbidden":
-        allowed = _allowed_keys(model, location[:-1])
-        hint = difflib.get_close_matches(key, allowed, n=1)
-        suggestion = f"did you mean {hint[0]!r}? " if hint else ""
-        return f"{where}: unknown key; {suggestion}allowed: {_names(allowed)}"
-    cause = problem.get("ctx", {}).get("error")
-    if isinstance(cause, InvalidParameter):
-        return f"{where}: {cause.reason}"
-    value = problem.get("input")
-    if kind in ("model_type", "model_attributes_type", "dict_type"):
-        return f"{where}: {value!r} must be a table"
-    if kind == "literal_error":
-        return f"{where}: {value!r} is not allowed; expected {problem['ctx']['expected']}"
-    if kind.startswith(("bool", "string", "int", "float", "tuple")) or kind.endswith("_type"):
-        return f"{where}: {value!r} is not a single number or string with a unit ({problem['msg'].lower()})"
-    return f"{where}: {value!r}: {problem['msg']}"
-
-
-def _allowed_keys(model: type[BaseModel], location: list[str]) -> list[str]:
-    """Keys allowed in the table at ``location`` of the scenario model."""
-    for part in location:
-        annotation = model.model_fields[part].annotation
-        candidates = [a for a in getattr(annotation, "__args__", (annotation,)) if isinstance(a, type)]
-        model = next(a for a in candidates if issubclass(a, BaseModel))
-    return [info.alias or name for name, info in model.model_fields.items()]
-
-
-def _names(items) -> str:
-    return ", ".join(items) if items else "(none)"
 
 
 def _build(parsed: ScenarioTables, system: System, source: str) -> Scenario:
