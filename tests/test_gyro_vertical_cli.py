@@ -79,6 +79,7 @@ def test_bad_input_is_one_line_exit_2(run_cli, args, options):
 
 def test_memory_refusals_name_the_options(run_cli, monkeypatch):
     monkeypatch.setenv("SCHULER_MEMORY_BUDGET", "1 GiB")
+    monkeypatch.setenv("SCHULER_TIME_BUDGET", "none")  # the time estimate would refuse these first
     one_line_error(run_cli("vertical", "run", "--output-step", "1e-3 s"), "--duration or --output-step",
                    "memory budget")
     # formerly a bare 720 meant hours here, and this grew to 24 GB until the kernel killed it
