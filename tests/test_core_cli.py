@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -83,3 +84,14 @@ def test_unwritable_output_folder_is_one_line(run_cli, tmp_path):
     out = run_cli("errors", "run", "--out", blocker / "figures")
     assert out.code == 2
     assert out.stderr.startswith("schuler: error: ") and out.stderr.count("\n") == 1
+
+
+def test_the_command_runs_blas_on_one_thread_unless_told_otherwise():
+    import subprocess
+    import sys
+
+    code = "import os, schuler.cli, numpy; print(os.environ['OPENBLAS_NUM_THREADS'])"
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
+    assert subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True).stdout.strip() == "1"
+    env["OPENBLAS_NUM_THREADS"] = "2"
+    assert subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True).stdout.strip() == "2"

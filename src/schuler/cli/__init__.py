@@ -14,6 +14,7 @@ line on stderr and exit with code 2.
 from __future__ import annotations
 
 import importlib
+import os
 import signal
 import sys
 import threading
@@ -23,6 +24,13 @@ import click
 
 from schuler import __version__
 from schuler.exceptions import SchulerError
+
+# The models' matrices are small: BLAS threads cost more than they give on them, and the cores are shared with
+# numba's parallel loops and the sweep's workers (mission's covariance analysis: 12 s of CPU with OpenBLAS's
+# default threads on a busy 2-core machine, 0.34 s with one). Set before numpy is first imported (click and the
+# package's top level do not import it); a value the user set is kept.
+for _variable in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_variable, "1")
 
 COMMANDS: dict[str, tuple[str, str]] = {
     "errors": ("system", "Schuler-tuned INS error propagation (Bollay)."),
