@@ -368,8 +368,6 @@ print(f"{time.perf_counter() - start:.3f}", case is None, errors.get("latitude",
 """
 
 
-# remove the mark once schuler.units parses a quantity as a number and a unit (until then the parse hangs)
-@pytest.mark.xfail(reason="schuler.units still evaluates power expressions", strict=False)
 def test_a_power_tower_typed_in_a_field_is_answered_promptly_with_a_message():
     # a quantity is a number and a unit: 10**10**10 must not be evaluated (it kept a server busy for minutes)
     process = subprocess.Popen([sys.executable, "-c", POWER_TOWER], stdout=subprocess.PIPE, text=True,
