@@ -121,4 +121,8 @@ def test_four_sessions_for_minutes_every_change_answered_memory_bounded(server, 
     assert peak < MEMORY_BOUND_BYTES
     assert max(r for r, _ in last) < 1.5 * max(r for r, _ in first)  # no growth from jobs left behind
     assert processes_after == 2  # the web server and the job server: every job ended
+    # a session leaving a page while that page's figures job is still polled aborts the poll in the browser
+    # (net::ERR_ABORTED): the page's own doing, not an unanswered request; any other failure counts
+    for found in problems:
+        found["failed"] = [failure for failure in found["failed"] if not failure.endswith("net::ERR_ABORTED")]
     assert problems == [{"console": [], "page": [], "failed": [], "outside": []}] * 4

@@ -29,7 +29,10 @@ from typing import Any, Literal
 import numpy as np
 
 from schuler.exceptions import InvalidParameter
-from schuler.units import from_unit, parse_quantity, si_unit, to_unit
+from schuler.units import from_unit, parse_quantity, quoted, si_unit, to_unit
+
+_LARGEST_INTEGER = 2**63 - 1
+"""The largest whole-number parameter (a count or a seed): numpy's int64."""
 
 Kind = Literal["quantity", "choice", "integer", "flag", "text"]
 
@@ -191,7 +194,9 @@ class Parameter:
             try:
                 number = int(str(value).strip()) if not isinstance(value, int) or isinstance(value, bool) else value
             except ValueError:
-                raise InvalidParameter(label, f"{value!r} is not a whole number") from None
+                raise InvalidParameter(label, f"{quoted(str(value))} is not a whole number") from None
+            if abs(number) > _LARGEST_INTEGER:  # counts and seeds are 64-bit integers everywhere below
+                raise InvalidParameter(label, f"{quoted(str(value))} is too large: at most {_LARGEST_INTEGER:,}")
             self._check_range(number, number, value, label)
             return number
         si = parse_quantity(value, self.unit, name=label)
