@@ -258,7 +258,7 @@ def test_with_remote_access_only_the_bound_address_is_accepted(header, bound, po
 def test_remote_access_says_where_the_lab_listens_and_that_it_has_no_login():
     process = subprocess.Popen([sys.executable, "-m", "schuler", "lab", "--host", "0.0.0.0", "--allow-remote",
                                 "--port", "0", "--no-browser"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+                               stdin=subprocess.DEVNULL, text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
     try:
         process.stdout.readline()
         warning = process.stderr.readline()
@@ -370,17 +370,19 @@ print(f"{time.perf_counter() - start:.3f}", case is None, errors.get("latitude",
 
 def test_a_power_tower_typed_in_a_field_is_answered_promptly_with_a_message():
     # a quantity is a number and a unit: 10**10**10 must not be evaluated (it kept a server busy for minutes)
-    process = subprocess.Popen([sys.executable, "-c", POWER_TOWER], stdout=subprocess.PIPE, text=True,
-                               env={**os.environ, "PYTHONUNBUFFERED": "1"})
+    # no stream of a test worker is shared: under pytest-xdist its standard streams are its channel to the controller
+    process = subprocess.Popen([sys.executable, "-c", POWER_TOWER], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               stdin=subprocess.DEVNULL, text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"})
     try:
         assert process.stdout.readline().strip() == "ready"
-        out, _ = process.communicate(timeout=10)
+        out, err = process.communicate(timeout=10)
     except subprocess.TimeoutExpired:
         pytest.fail("no answer to '10**10**10 deg' within 10 s (it must come within 5 s)")
     finally:
         if process.poll() is None:
             process.kill()
             process.wait()
+    assert out.count(" ") >= 2, (out, err[-2000:], process.returncode)
     seconds, refused, message = out.strip().split(" ", 2)
     assert float(seconds) < 5.0
     assert refused == "True" and message.startswith("--latitude: ")
