@@ -416,3 +416,14 @@ def test_the_default_drive_with_ideal_sensors_and_exact_gnss_returns_the_truth(a
     assert np.abs(position).max() < 1e-3 and np.abs(velocity).max() < 1e-3
     assert np.degrees(np.abs(attitude).max()) < attitude_bound_deg
     assert run.rejected[0] == 0 and run.epoch_t_s.size == fixes.epochs
+
+
+def test_a_member_leaving_the_equations_domain_is_refused_in_one_line(short_drive):
+    """A start 4,000 km below the surface: the strapdown kernel stops the member and the filter says why."""
+    from schuler.exceptions import SimulationError
+
+    path, imu = short_drive
+    start = start_of(path)
+    deep = dataclasses.replace(start, height=np.array([-4.0e6]))
+    with pytest.raises(SimulationError, match="fell below -3,189 km"):
+        run_filter(increments_of(imu)[:400], 1.0 / RATE, deep, tactical_model(), gnss_from(imu, np.array([1.0])))

@@ -57,11 +57,12 @@ from schuler.aided.error_state import (
 )
 from schuler.aided.gnss import GnssRecord
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, SimulationError
 from schuler.memory import require
 from schuler.navigate import _kernels
 from schuler.navigate._loops import strapdown_chunk
 from schuler.navigate.attitude import quaternion_from_rotation_vector, quaternion_multiply, rotation_matrix
+from schuler.navigate.validity import domain_message
 
 _NEVER = 2**62  # an output interval that never comes: the kernel stores nothing
 _PARALLEL_STEPS = 200_000  # member-samples of a segment above which the mechanization runs on every core
@@ -249,14 +250,18 @@ class _Navigator:
         k = stop - first
         zeros = np.zeros((k, 6))
         vertical = np.zeros((k, 2))
-        out, every, first_sample = (self.out, self.output_every, first) if store else (self._dummy_out, _NEVER, 0)
+        out, every = (self.out, self.output_every) if store else (self._dummy_out, _NEVER)
         threads = numba.get_num_threads()
         # a short segment is over before the worker threads have started: run it on this one
         numba.set_num_threads(threads if k * self.state.shape[0] >= _PARALLEL_STEPS else 1)
         try:
-            self._mechanize(first_sample, zeros, vertical, compensated, out, every, fraction)
+            self._mechanize(first, zeros, vertical, compensated, out, every, fraction)
         finally:
             numba.set_num_threads(threads)
+        if self.state[:, _kernels.LEFT_AT].any():  # the kernel stopped a member outside the equations' domain
+            members = self.state.shape[0]
+            raise SimulationError(domain_message(self.state, np.arange(members), members if members > 1 else None,
+                                                 self.dt, "free"))
         accumulator.angle += compensated[..., :3].sum(axis=1)
         accumulator.velocity += compensated[..., 3:].sum(axis=1)
         accumulator.elapsed += k * self.dt * fraction
