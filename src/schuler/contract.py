@@ -36,7 +36,7 @@ import difflib
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
-from functools import partial
+from functools import partial, wraps
 from pathlib import Path
 from typing import Any
 
@@ -48,7 +48,7 @@ from schuler.core.stats import StreamingStatistics
 from schuler.exceptions import InvalidParameter
 from schuler.memory import require_time
 from schuler.params import Case, Parameter, ParameterSet
-from schuler.results import MonteCarloSummary, Result, RunResult
+from schuler.results import MonteCarloSummary, Result, RunResult, SystemResult
 
 MONTE_CARLO_CHUNK = 2_000
 """Members evaluated at once in :meth:`System.run` Monte Carlo (unless the system says otherwise)."""
@@ -89,6 +89,42 @@ class Output:
         return self.display or ("" if self.unit == "1" else self.unit)
 
 
+class Evaluation(Mapping[str, np.ndarray]):
+    """What a system's ``evaluate(cases, histories=False)`` returns: its outputs and, when asked, histories.
+
+    It reads as the mapping of outputs (``evaluation["azimuth_error_rad"]``, an
+    array of length ``len(cases)``, SI), so sweeps and Monte Carlo use it as
+    the dict of outputs; ``histories`` holds named
+    :class:`~schuler.core.response.Histories` (keyed by file stem) and
+    ``extras`` structured results (tables, lists) of a batch's first case,
+    present only when ``evaluate`` was asked for histories.
+
+    Parameters
+    ----------
+    outputs : mapping of str to array_like
+        Every declared output, one value per case (SI).
+    histories : mapping of str to Histories, optional
+        Time histories by file stem (``align_time_history``).
+    extras : mapping of str to object, optional
+        JSON-safe structured results beside the outputs.
+    """
+
+    def __init__(self, outputs: Mapping[str, Any], histories: Mapping[str, Any] | None = None,
+                 extras: Mapping[str, Any] | None = None):
+        self.outputs = dict(outputs)
+        self.histories = dict(histories or {})
+        self.extras = dict(extras or {})
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.outputs[name]
+
+    def __iter__(self):
+        return iter(self.outputs)
+
+    def __len__(self) -> int:
+        return len(self.outputs)
+
+
 @dataclass(frozen=True)
 class Argument:
     """A positional argument of an action: a file it reads (``north identify RECORD``)."""
@@ -121,6 +157,9 @@ class Action:
         ``write_files(result, out_dir) -> [paths]`` for an action whose results are
         not the system's own types (a comparison built by another package); None:
         the system's ``write_files``.
+    figures : callable, optional
+        ``figures(result) -> {stem: Figure}`` for an action whose results the
+        system's ``figures`` does not draw; None: the system's.
     """
 
     name: str
@@ -130,6 +169,7 @@ class Action:
     arguments: tuple[Argument, ...] = ()
     output_file: str = ""
     write_files: Callable[[Result, Path], list[Path]] | None = None
+    figures: Callable[[Result], dict[str, Any]] | None = None
 
 
 @dataclass(frozen=True)
@@ -180,6 +220,26 @@ class System:
         Monte Carlo's rate is measured on its first chunks instead.
     guide : str
         Name of the system's page in the user guide.
+    figures : callable or None
+        ``figures(result) -> {stem: Figure}``: the figures of any result of the
+        system (run, reproduction, actions), drawn on demand (``result.plot()``)
+        and written by :meth:`write`.
+    data_files : callable or None
+        ``data_files(result, out_dir) -> [paths]``: files in a field's own
+        formats beside the generic CSV and figures.
+    result_type : type
+        The :class:`~schuler.results.SystemResult` subclass ``run`` returns (it
+        changes only how a result renders).
+    realisation : bool
+        A run without Monte Carlo is member 0 of ``seed`` (every random term
+        drawn), not the nominal case.
+    instrument : callable or None
+        ``instrument(parameters, case, options) -> case``: the case with the
+        values an IMU gives (``imu=`` a grade, a spec file, a recording), for
+        the parameters not given explicitly.
+    instrument_parameters : ParameterSet
+        The options of ``instrument`` (``imu``, ``imu_window`` ...), accepted by
+        :meth:`case` and :meth:`run` beside the system's parameters.
     """
 
     name: str
@@ -187,11 +247,17 @@ class System:
     reference: str
     parameters: ParameterSet
     outputs: tuple[Output, ...]
-    evaluate: Callable[[Cases], dict[str, np.ndarray]]
-    run_case: Callable[[Case, str | None], Result]
+    evaluate: Callable[..., Mapping[str, np.ndarray]]
     reproduce: Callable[..., Result]
-    write_files: Callable[[Result, Path], list[Path]]
     report: Callable[[Path], Any]
+    figures: Callable[[Result], dict[str, Any]] | None = None
+    data_files: Callable[[Result, Path], list[Path]] | None = None
+    result_type: type[SystemResult] = SystemResult
+    realisation: bool = False
+    instrument: Callable[[ParameterSet, Case, Case], Case] | None = None
+    instrument_parameters: ParameterSet = field(default_factory=lambda: ParameterSet(()))
+    run_case: Callable[[Case, str | None], Result] | None = None
+    write_files: Callable[[Result, Path], list[Path]] | None = None
     reproduce_parameters: ParameterSet = field(default_factory=lambda: ParameterSet(()))
     fidelities: tuple[str, ...] = ()
     actions: tuple[Action, ...] = ()
@@ -200,15 +266,59 @@ class System:
     member_seconds: Callable[[Case], float] | None = None
     guide: str = ""
 
+    def __post_init__(self) -> None:
+        if self.figures is None:
+            return
+        # what reproduce and the actions return can plot itself, as run's result does
+        object.__setattr__(self, "reproduce", _attaching(self.reproduce, self.figures))
+        object.__setattr__(self, "actions", tuple(
+            replace(action, function=_attaching(action.function, action.figures or self.figures))
+            for action in self.actions))
+
+    @property
+    def evaluates_histories(self) -> bool:
+        """Whether ``evaluate`` gives the run in full (``histories=True``): the contract every system moves to."""
+        return self.run_case is None
+
+    def write(self, result: Result, out_dir: Path, action: str | None = None) -> list[Path]:
+        """Write a result's files into ``out_dir``: its histories as CSV, its figures, the system's data files.
+
+        Parameters
+        ----------
+        result : Result
+            What :meth:`run`, ``reproduce`` or an action returned.
+        out_dir : Path
+            Folder to write into (created if missing).
+        action : str, optional
+            The action that made ``result`` (its own writer, where it has one).
+        """
+        if not self.evaluates_histories:
+            chosen = None if action is None else self.actions[[a.name for a in self.actions].index(action)]
+            writer = (chosen.write_files if chosen is not None else None) or self.write_files
+            assert writer is not None, f"{self.name} declares neither figures nor write_files"
+            return writer(result, Path(out_dir))
+        return write_result(result, Path(out_dir), self.data_files)
+
     def case(self, **si_values) -> Case:
         """A validated case from SI values; unknown names raise :class:`InvalidParameter` with a suggestion.
 
         Parameters
         ----------
         **si_values
-            Parameters by name, in SI (each parameter's SI unit: rad, rad/s, m, s ...).
+            Parameters by name, in SI (each parameter's SI unit: rad, rad/s, m, s ...), or as text or pint
+            quantities in any unit of the parameter's dimension (``latitude="50 deg"``); ``imu=`` and its
+            options where the system takes its sensor errors from an IMU (:attr:`instrument_parameters`).
         """
-        return self.parameters.case(si_values)
+        options = {name: si_values.pop(name) for name in list(si_values) if name in self.instrument_parameters}
+        case = self.parameters.case(si_values)
+        given = {name: value for name, value in options.items() if value is not None}
+        if not given:
+            return case
+        chosen = self.instrument_parameters.case(given)
+        if chosen["imu"] is None:
+            raise InvalidParameter(sorted(given)[0], "applies with imu only")
+        assert self.instrument is not None
+        return self.instrument(self.parameters, case, chosen)
 
     def action(self, name: str) -> Callable[..., Result]:
         """The function of the system's action ``name`` (``north.action("identify")``), to call from Python.
@@ -287,10 +397,40 @@ class System:
         if estimate is not None:
             what = f"this {self.name} run" + (f" with {members} Monte Carlo members" if members else "")
             require_time(estimate, what, ("--monte-carlo, " if members else "") + self._work_options())
-        result = self.run_case(case, fidelity)
+        summary = None
         if members:
             summary = self.monte_carlo(case, members, streams, fidelity, draw=draw, progress=progress)
-            result = _with_monte_carlo(result, summary)
+        if not self.evaluates_histories:
+            assert self.run_case is not None
+            result = self.run_case(case, fidelity)
+            return result if summary is None else _with_monte_carlo(result, summary)
+        return self.result(case, fidelity, streams if self.realisation else None, summary)
+
+    def result(self, case: Case, fidelity: str | None = None, random: RandomStreams | None = None,
+               monte_carlo: MonteCarloSummary | None = None) -> SystemResult:
+        """One case in full: ``evaluate`` with histories, as the system's result type (what :meth:`run` returns).
+
+        Parameters
+        ----------
+        case : Case
+            A validated case (SI values).
+        fidelity : str, optional
+            One of :attr:`fidelities` (default: the first).
+        random : RandomStreams, optional
+            Where the case's random terms come from (member 0); None: the nominal case.
+        monte_carlo : MonteCarloSummary, optional
+            Statistics of a Monte Carlo around the case, attached to the result.
+        """
+        fidelity = self.check_fidelity(fidelity)
+        cases = Cases.from_case(case, 1, members=np.zeros(1, dtype=np.int64), random=random, fidelity=fidelity)
+        evaluation = self.evaluate(cases, histories=True)
+        outputs = {output.name: _scalar(evaluation[output.name]) for output in self.outputs}
+        result = self.result_type(
+            system=self.name, outputs=outputs, fidelity=fidelity, extras=dict(getattr(evaluation, "extras", {})),
+            parameters=dict(case), histories=dict(getattr(evaluation, "histories", {})), monte_carlo=monte_carlo,
+            output_units={output.name: output.unit for output in self.outputs},
+            display_units={output.name: output.display for output in self.outputs if output.display})
+        result.attach_figures(self.figures)
         return result
 
     def work_seconds(self, case: Case, members: int = 0) -> float | None:
@@ -494,6 +634,57 @@ class _MeasuredPace:
                          "--monte-carlo")
         if self.progress is not None:
             self.progress(done, total)
+
+
+def write_result(result: Result, out_dir: Path, data_files: Callable[[Result, Path], list[Path]] | None = None
+                 ) -> list[Path]:
+    """The one writer of every system: histories as CSV (``STEM.csv``), figures (``STEM.png``, ``.svg``), data files.
+
+    Each CSV has the time column ``t_s`` first and one column per channel, the
+    SI unit in the column's name; ``data_files(result, out_dir)`` adds files in
+    a field's own formats (a KF-GINS navigation file).
+
+    Parameters
+    ----------
+    result : Result
+        What a system returned (its figures from :meth:`Result.figures`).
+    out_dir : Path
+        Folder to write into (created if missing).
+    data_files : callable, optional
+        ``data_files(result, out_dir) -> [paths]``: the system's own data files.
+    """
+    from schuler.io import save_figure_formats, write_dataframe_csv
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    for stem, histories in getattr(result, "histories", {}).items():
+        paths.append(write_dataframe_csv(histories.to_dataframe().reset_index(), out_dir / f"{stem}.csv"))
+    for stem, figure in result.figures().items():
+        paths += save_figure_formats(figure, out_dir / stem)
+    if data_files is not None:
+        paths += data_files(result, out_dir)
+    return paths
+
+
+def _attaching(function: Callable[..., Result], figures: Callable[[Result], dict[str, Any]] | None
+               ) -> Callable[..., Result]:
+    """``function`` whose result draws its figures with ``figures`` (:meth:`Result.attach_figures`)."""
+    if getattr(function, "attached_figures", None) is figures:
+        return function
+
+    @wraps(function)
+    def attached(*args, **kwargs):
+        return function(*args, **kwargs).attach_figures(figures)
+
+    attached.attached_figures = figures  # type: ignore[attr-defined]
+    return attached
+
+
+def _scalar(values) -> Any:
+    """The first case's value of an output array, as a Python number (or the object it holds)."""
+    value = np.asarray(values).reshape(-1)[0]
+    return value.item() if isinstance(value, np.generic) else value
 
 
 def _count(value, name: str) -> int:

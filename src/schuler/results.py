@@ -103,6 +103,56 @@ class Result:
         console.print(self.render())
         return console.export_html(inline_styles=True, code_format="<pre style=\"font-family:monospace\">{code}</pre>")
 
+    def figures(self) -> dict[str, Any]:
+        """The result's figures, file stem -> matplotlib Figure, drawn by the system that made it ({}: none).
+
+        The system attaches its ``figures(result)`` hook when it returns the result
+        (:meth:`attach_figures`); the files ``--out`` writes are these figures.
+        """
+        draw = self.__dict__.get("_draw_figures")
+        return dict(draw(self)) if draw is not None else {}
+
+    def attach_figures(self, draw) -> Result:
+        """Let :meth:`figures` and :meth:`plot` draw with ``draw(result) -> {stem: Figure}``; returns the result.
+
+        Parameters
+        ----------
+        draw : callable or None
+            A system's ``figures`` hook (None: the result has no figures).
+        """
+        self.__dict__["_draw_figures"] = draw
+        return self
+
+    def plot(self, name: str | None = None):
+        """One of the result's figures (the first by default) as a matplotlib Figure; no backend is switched.
+
+        Parameters
+        ----------
+        name : str, optional
+            The figure's stem, as in the ``--out`` files (``align_time_history``); default: the first.
+
+        Raises
+        ------
+        ValueError
+            The result has no figures.
+        KeyError
+            No figure called ``name`` (the figures there are named).
+        """
+        import matplotlib.pyplot as plt
+
+        figures = self.figures()
+        if not figures:
+            raise ValueError(f"{type(self).__name__} has no figures")
+        chosen = next(iter(figures)) if name is None else name
+        if chosen not in figures:
+            for figure in figures.values():
+                plt.close(figure)
+            raise KeyError(f"no figure {name!r}; figures: {', '.join(figures)}")
+        for stem, figure in figures.items():
+            if stem != chosen:
+                plt.close(figure)
+        return figures[chosen]
+
     def to_dataframe(self):
         """The result as a pandas DataFrame: here one row of its scalar fields, units in the column names.
 
@@ -159,6 +209,85 @@ class RunResult(Result):
     """
 
     monte_carlo: MonteCarloSummary | None = None
+
+
+@dataclasses.dataclass(kw_only=True)
+class SystemResult(RunResult):
+    """What :meth:`System.run <schuler.contract.System.run>` returns for every system: one case in full.
+
+    ``outputs`` holds every declared output of the system's ``evaluate`` for the
+    case (SI; the same values ``evaluate`` gives, by construction), readable as
+    attributes (``result.azimuth_error_rad``); ``histories`` the named time
+    histories (:class:`~schuler.core.response.Histories`, keyed by the stem of
+    the CSV file ``--out`` writes); ``extras`` structured results beside the
+    outputs (lists, tables: an aided run's outages), also readable as attributes.
+    A system subclasses it only to change how it renders.
+    """
+
+    system: str
+    outputs: dict[str, Any]
+    fidelity: str | None = None
+    extras: dict[str, Any] = dataclasses.field(default_factory=dict)
+    parameters: dict[str, Any] = dataclasses.field(default_factory=dict, repr=False)
+    histories: dict[str, Any] = dataclasses.field(default_factory=dict, repr=False)
+    output_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
+    display_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
+
+    def __getattr__(self, name: str) -> Any:
+        # only reached when normal lookup fails: outputs and extras read as attributes
+        if not name.startswith("_"):
+            for holder in ("outputs", "extras"):
+                values = self.__dict__.get(holder, {})
+                if name in values:
+                    return values[name]
+        raise AttributeError(f"{type(self).__name__} has no attribute {name!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe: every output and extra at the top level, ``units`` of the outputs, ``monte_carlo``."""
+        data = {name: json_safe(value) for name, value in self.outputs.items()}
+        data.update({name: json_safe(value) for name, value in self.extras.items()})
+        if self.fidelity is not None:
+            data["fidelity"] = self.fidelity
+        data["monte_carlo"] = None if self.monte_carlo is None else self.monte_carlo.to_dict()
+        data["units"] = {**self.output_units, **type(self).units}
+        return data
+
+    def to_dataframe(self):
+        """The first histories indexed by time (``t_s``), or one row of the outputs where there are none.
+
+        Units are in the column names (``azimuth_error_rad``, ``c_gamma [1/s]``) and in ``attrs["units"]``;
+        every set of histories is ``result.histories[stem].to_dataframe()``.
+        """
+        import pandas as pd
+
+        if self.histories:
+            return next(iter(self.histories.values())).to_dataframe()
+        row = {}
+        for name, value in self.outputs.items():
+            unit = self.output_units.get(name, "")
+            row[name if not unit or unit == "1" or name.endswith(_suffix_of(unit)) else f"{name} [{unit}]"] = value
+        frame = pd.DataFrame([row])
+        frame.attrs["units"] = dict(self.output_units)
+        return frame
+
+    def render(self):
+        """The outputs in their display units, then the Monte Carlo's statistics."""
+        from rich.console import Group
+        from rich.table import Table
+
+        from schuler.units import to_unit
+
+        table = Table(title=f"{self.system}" + (f" ({self.fidelity})" if self.fidelity else ""), show_header=False)
+        table.add_column("output")
+        table.add_column("value", justify="right")
+        for name, value in self.outputs.items():
+            unit = self.display_units.get(name, "")
+            if isinstance(value, (float, int, np.floating, np.integer)) and not isinstance(value, bool):
+                shown = float(to_unit(value, unit)) if unit else float(value)
+                table.add_row(display_label(name, unit), f"{shown:.6g}")
+            else:
+                table.add_row(name, str(value))
+        return table if self.monte_carlo is None else Group(table, self.monte_carlo.render())
 
 
 @dataclasses.dataclass

@@ -12,6 +12,7 @@ hands the result to :func:`~schuler.cli.common.emit`. No numerics here.
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 
 import click
@@ -75,7 +76,7 @@ def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fide
         with progress_reporter(label, enabled=not as_json) as progress:
             result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
                                 **_given(case))
-    files = _write_files(system.write_files, result, out_dir, f"{system.name} run")
+    files = _write_files(system.write, result, out_dir, f"{system.name} run")
     inputs = dict(case)
     parameters = system.parameters
     if instrument is not None:
@@ -176,7 +177,7 @@ def _reproduce_command(system: System) -> click.Command:
         case = system.reproduce_parameters.parse(raw, labels="option")
         with options_named(system.reproduce_parameters):
             result = system.reproduce(**case)
-        files = _write_files(system.write_files, result, out_dir, f"{system.name} reproduce")
+        files = _write_files(system.write, result, out_dir, f"{system.name} reproduce")
         emit(result, as_json, inputs=dict(case), parameters=system.reproduce_parameters, files=files)
 
     return _command("reproduce", reproduce, system.reproduce_parameters,
@@ -191,8 +192,8 @@ def _action_command(system: System, action: Action) -> click.Command:
         case = action.parameters.parse(raw, labels="option")
         with options_named(action.parameters):
             result = action.function(**files_in, **case)
-        writer = action.write_files or system.write_files
-        files = _write_files(writer, result, out_dir, f"{system.name} {action.name}")
+        files = _write_files(partial(system.write, action=action.name), result, out_dir,
+                             f"{system.name} {action.name}")
         written = getattr(result, "files", None) or []
         emit(result, as_json, inputs={**{k: str(v) for k, v in files_in.items()}, **case},
              parameters=action.parameters, files=[*written, *files])

@@ -16,6 +16,8 @@ Examples
 
 from __future__ import annotations
 
+from functools import partial
+
 from schuler.alignment.commands import calibrate_compare_action
 from schuler.contract import System
 from schuler.drift_calibration.evaluation import (
@@ -31,6 +33,7 @@ from schuler.drift_calibration.reproduction import (
     reproduce,
 )
 from schuler.drift_calibration.results import write_files
+from schuler.imu.instrument import apply_options, instrument_options
 from schuler.params import Case
 from schuler.references import PULSE_CALIBRATION
 
@@ -68,6 +71,8 @@ SYSTEM = System(
     member_bytes=member_bytes,
     member_seconds=member_seconds,
     guide="calibrate",
+    instrument=partial(apply_options, "calibrate"),
+    instrument_parameters=instrument_options("calibrate"),
 )
 
 __all__ = ["SYSTEM"]

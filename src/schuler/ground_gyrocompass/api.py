@@ -18,6 +18,8 @@ Examples
 
 from __future__ import annotations
 
+from functools import partial
+
 from schuler.alignment.commands import north_compare_action
 from schuler.contract import System
 from schuler.ground_gyrocompass.actions import ACTIONS
@@ -33,6 +35,7 @@ from schuler.ground_gyrocompass.evaluation import (
 from schuler.ground_gyrocompass.report import report
 from schuler.ground_gyrocompass.reproduction import REPRODUCE_PARAMETERS, reproduce
 from schuler.ground_gyrocompass.results import write_files
+from schuler.imu.instrument import apply_options, instrument_options
 from schuler.params import Case
 from schuler.references import FEDOROV_2020
 
@@ -71,6 +74,8 @@ SYSTEM = System(
     member_bytes=member_bytes,
     member_seconds=member_seconds,
     guide="north",
+    instrument=partial(apply_options, "north"),
+    instrument_parameters=instrument_options("north"),
 )
 
 __all__ = ["SYSTEM"]

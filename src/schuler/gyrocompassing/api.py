@@ -16,12 +16,15 @@ Examples
 
 from __future__ import annotations
 
+from functools import partial
+
 from schuler.alignment.commands import ALIGN_COMPARE
 from schuler.contract import System
 from schuler.gyrocompassing.case import DEFAULT_DURATION
 from schuler.gyrocompassing.evaluation import FIDELITIES, OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case
 from schuler.gyrocompassing.reproduction import report, reproduce
 from schuler.gyrocompassing.results import write_files
+from schuler.imu.instrument import apply_options, instrument_options
 from schuler.params import Case
 from schuler.references import KPI_LAB_MANUAL
 
@@ -60,6 +63,8 @@ SYSTEM = System(
     member_bytes=member_bytes,
     member_seconds=member_seconds,
     guide="align",
+    instrument=partial(apply_options, "align"),
+    instrument_parameters=instrument_options("align"),
 )
 
 __all__ = ["SYSTEM"]

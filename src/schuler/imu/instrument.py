@@ -196,3 +196,26 @@ def apply_instrument(system: str, parameters: ParameterSet, case: Case, imu: str
             raise
         raise InvalidParameter("imu", f"{imu}: {error.name} from the IMU ({error.reason}); give --"
                                f"{error.name.replace('_', '-')} explicitly or choose another IMU") from None
+
+
+def apply_options(system: str, parameters: ParameterSet, case: Case, options: Case) -> Case:
+    """:func:`apply_instrument` with the options of :func:`instrument_options` as one case: a system's hook.
+
+    ``System(instrument=partial(apply_options, "align"), ...)`` lets
+    ``run(imu="tactical")`` set the case exactly as ``--imu tactical`` does.
+
+    Parameters
+    ----------
+    system : {"align", "calibrate", "north", "errors"}
+        The system being run.
+    parameters : ParameterSet
+        The system's parameters.
+    case : Case
+        The case as the user gave it, SI.
+    options : Case
+        ``imu`` (a grade, spec file or recording) and, where the system has them, ``imu_window`` (s) and
+        ``imu_latitude`` (rad).
+    """
+    merged, _ = apply_instrument(system, parameters, case, options["imu"], window_s=options.get("imu_window"),
+                                 latitude_rad=options.get("imu_latitude"))
+    return merged

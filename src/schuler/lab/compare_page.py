@@ -12,6 +12,7 @@ version of).
 from __future__ import annotations
 
 import warnings
+from functools import partial
 
 from dash import ALL, Dash, Input, Output, State, dcc, html, no_update
 from dash.exceptions import PreventUpdate
@@ -102,7 +103,7 @@ def figure_elements(result) -> list:
     result : AlignmentComparison
         What the comparison returned (any result its figure writer accepts).
     """
-    images = png_figures(compare_action().write_files or get_system(SYSTEM).write_files, result)
+    images = png_figures(partial(get_system(SYSTEM).write, action=compare_action().name), result)
     return [html.Figure([html.Img(src=uri, alt=stem), html.Figcaption(stem)], **views.data_attributes(figure=stem))
             for stem, uri in images] or [html.P("this comparison has no figures")]
 

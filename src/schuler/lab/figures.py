@@ -425,7 +425,7 @@ def file_figures(system: System, result) -> list[tuple[str, str]]:
     Parameters
     ----------
     system : System
-        The system that computed ``result`` (its ``write_files`` draws the figures).
+        The system that computed ``result`` (its ``write`` draws the figures).
     result : object
         What the system's ``run`` returned.
 
@@ -434,7 +434,7 @@ def file_figures(system: System, result) -> list[tuple[str, str]]:
     list of (str, str)
         File name and ``data:image/png;base64`` URI of each PNG.
     """
-    return png_figures(system.write_files, result)
+    return png_figures(system.write, result)
 
 
 def png_figures(write_files: Callable[[Any, Path], list[Path]], result) -> list[tuple[str, str]]:

@@ -354,7 +354,7 @@ def files_archive(system: System, result) -> bytes:
     Parameters
     ----------
     system : System
-        The system that computed ``result`` (its ``write_files`` writes the files).
+        The system that computed ``result`` (its ``write`` writes the files).
     result : object
         What the system's ``run`` returned.
 
@@ -365,7 +365,7 @@ def files_archive(system: System, result) -> bytes:
     """
     buffer = io.BytesIO()
     with tempfile.TemporaryDirectory(prefix="schuler-lab-") as folder:
-        paths = system.write_files(result, Path(folder))
+        paths = system.write(result, Path(folder))
         with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
             for path in paths:
                 archive.write(path, path.name)

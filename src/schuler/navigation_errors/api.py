@@ -16,7 +16,10 @@ Examples
 
 from __future__ import annotations
 
+from functools import partial
+
 from schuler.contract import Action, System
+from schuler.imu.instrument import apply_options, instrument_options
 from schuler.navigation_errors.actions import (
     PERIOD_PARAMETERS,
     VERTICAL_PARAMETERS,
@@ -94,6 +97,8 @@ SYSTEM = System(
     member_bytes=member_bytes,
     member_seconds=member_seconds,
     guide="errors",
+    instrument=partial(apply_options, "errors"),
+    instrument_parameters=instrument_options("errors"),
 )
 
 __all__ = ["ACTIONS", "SYSTEM"]
