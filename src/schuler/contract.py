@@ -518,7 +518,8 @@ class System:
         n = lengths.pop() if lengths else 1
         arrays = default_arrays(self.parameters, n)
         arrays.update({name: np.broadcast_to(array, (n,)) for name, array in given.items()})
-        return self.evaluate(Cases(arrays, members=members, random=random, fidelity=self.check_fidelity(fidelity)))
+        cases = Cases(arrays, members=members, random=random, fidelity=self.check_fidelity(fidelity))
+        return dict(self.evaluate(cases))
 
     def checked_arrays(self, values: Mapping[str, Any]) -> dict[str, np.ndarray]:
         """The given parameter arrays validated as :meth:`run` validates one case (ranges on whole arrays).
@@ -557,7 +558,7 @@ class System:
         raise KeyError(name)
 
 
-def monte_carlo(evaluate: Callable[[Cases], dict[str, np.ndarray]], outputs: tuple[Output, ...], case: Case,
+def monte_carlo(evaluate: Callable[..., Mapping[str, np.ndarray]], outputs: tuple[Output, ...], case: Case,
                 members: int, streams: RandomStreams, fidelity: str | None = None, *, chunk: int = MONTE_CARLO_CHUNK,
                 draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None,
                 progress: Callable[[int, int], None] | None = None) -> MonteCarloSummary:

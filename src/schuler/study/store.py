@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import json
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from schuler import __version__
-from schuler.contract import Cases
 from schuler.exceptions import ScenarioError, SchulerError
 from schuler.io import atomic_path, write_json
 from schuler.params import Parameter
@@ -55,7 +54,7 @@ class ChunkTask:
 
     plan: SweepPlan
     index: int
-    evaluate: Callable[[Cases], dict[str, np.ndarray]]
+    evaluate: Callable[..., Mapping[str, np.ndarray]]
 
 
 @dataclass(frozen=True)
