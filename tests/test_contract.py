@@ -86,10 +86,15 @@ def test_get_system_is_top_level_and_suggests():
         schuler.get_system("allign")
 
 
-def test_the_command_table_lists_every_system():
-    from schuler.cli import COMMANDS
+def test_the_command_line_lists_every_system_from_the_registry():
+    from click.testing import CliRunner
 
-    assert [name for name, (origin, _) in COMMANDS.items() if origin == "system"] == NAMES
+    from schuler.cli import cli
+    from schuler.registry import SUMMARIES
+
+    assert cli.list_commands(None)[:len(NAMES)] == NAMES
+    shown = CliRunner().invoke(cli, ["--help"]).output
+    assert all(f"{name}" in shown and SUMMARIES[name] in shown for name in NAMES)
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -8,18 +8,16 @@ Registered as system "fake" by the ``fake_system`` fixture of the study tests.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar
 
 import numpy as np
 import pytest
 
-from schuler.contract import Cases, FigureRef, Output, ReportSection, System
+from schuler.contract import Cases, Evaluation, FigureRef, Output, ReportSection, System
+from schuler.core.response import Histories
 from schuler.params import Parameter, ParameterSet
 from schuler.registry import SYSTEM_MODULES
 from schuler.reproduction import Reproduction, compare
-from schuler.results import RunResult
 
 EARTH_RATE = 7.292115e-5
 
@@ -48,16 +46,7 @@ KILL_MARKER = "SCHULER_FAKE_KILL_MARKER"
 """Environment: file created by the worker that killed itself (so it happens once)."""
 
 
-@dataclass
-class FakeResult(RunResult):
-    azimuth_error_rad: float
-    settling_time_s: float
-    method: str
-
-    units: ClassVar[dict[str, str]] = {}
-
-
-def fake_evaluate(cases: Cases) -> dict[str, np.ndarray]:
+def fake_evaluate(cases: Cases, histories: bool = False) -> Evaluation:
     CALLS["sweep"] += 1
     latitude = cases.float("latitude")
     threshold = os.environ.get(KILL_ABOVE)
@@ -70,17 +59,25 @@ def fake_evaluate(cases: Cases) -> dict[str, np.ndarray]:
         drift = drift + cases.float("sigma_drift") * cases.random.normal("drift_east", cases.members)
     azimuth = drift / (EARTH_RATE * np.cos(latitude))
     settling = cases.float("duration") / cases.float("gain")
-    return {"azimuth_error_rad": azimuth, "settling_time_s": settling * cases["members"]}
+    outputs = {"azimuth_error_rad": azimuth, "settling_time_s": settling * cases["members"]}
+    if not histories:
+        return Evaluation(outputs)
+    # the first case's settling towards its steady state, e^(-t / tau) with tau = settling / 4.6 (1 % band)
+    time = np.arange(0.0, cases.float("duration")[0] + cases.float("output_step")[0] / 2, cases.float("output_step")[0])
+    tau = settling[0] / 4.6
+    settle = Histories(time, {"azimuth_error_rad": azimuth[0] * (1 - np.exp(-time / tau))},
+                       {"azimuth_error_rad": "rad"})
+    return Evaluation(outputs, histories={"fake_time_history": settle}, extras={"method": str(cases["method"][0])})
 
 
-def fake_run_case(case, fidelity=None) -> FakeResult:
-    out = fake_evaluate(Cases.from_case(case))
-    return FakeResult(azimuth_error_rad=float(out["azimuth_error_rad"][0]),
-                      settling_time_s=float(out["settling_time_s"][0]), method=case["method"])
+def fake_figures(result) -> dict:
+    if isinstance(result, Reproduction):
+        return {}
+    return {"fake_time_history": result.histories["fake_time_history"].plot()}
 
 
 def fake_reproduce() -> Reproduction:
-    result = fake_run_case(PARAMETERS.case(latitude=np.radians(50.0), drift_east=np.radians(0.01) / 3600))
+    result = FAKE.run(latitude=np.radians(50.0), drift_east=np.radians(0.01) / 3600)
     computed = float(np.degrees(result.azimuth_error_rad) * 60)
     return Reproduction(
         system="fake", source="Test fixture <not a real source> & co", constants="Omega = 7.292115e-5 rad/s",
@@ -88,10 +85,6 @@ def fake_reproduce() -> Reproduction:
               compare("printed typo", computed, "arcmin", printed="4.0", where="p. 2",
                       erratum="the source drops a factor")],
         notes=["An erratum, explained."], data=result)
-
-
-def fake_write_files(result, out_dir) -> list:
-    return []
 
 
 def fake_report(outdir: Path) -> ReportSection:
@@ -128,9 +121,8 @@ FAKE = System(
     parameters=PARAMETERS,
     outputs=OUTPUTS,
     evaluate=fake_evaluate,
-    run_case=fake_run_case,
     reproduce=fake_reproduce,
-    write_files=fake_write_files,
+    figures=fake_figures,
     report=fake_report,
     random_terms=True,
 )

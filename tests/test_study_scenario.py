@@ -74,7 +74,7 @@ def test_run_prints_what_the_api_returns(tmp_path, run_cli):
     assert data["settling_time_s"] == 2 * 7200.0
     assert data["inputs"]["latitude"] == pytest.approx(math.radians(45))
     text = run_cli("run", path)
-    assert text.code == 0 and "azimuth_error_rad" in text.stdout
+    assert text.code == 0 and "azimuth_error (arcmin)" in text.stdout
 
 
 @pytest.mark.parametrize(

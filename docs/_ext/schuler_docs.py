@@ -196,9 +196,12 @@ class Help(Directive):
 
     def run(self) -> list[nodes.Node]:
         from schuler.cli import COMMANDS
+        from schuler.registry import SYSTEM_MODULES
 
         sections = []
-        for name, (origin, _) in [("", ("", "")), *COMMANDS.items()]:
+        commands = [*((name, "system") for name in SYSTEM_MODULES), *((name, origin) for name, (origin, _) in
+                                                                       COMMANDS.items())]
+        for name, origin in [("", ""), *commands]:
             paths = [name] if origin != "system" else [name, *_subcommands(name)]
             for path in paths:
                 line = f"schuler {path} --help".replace("  ", " ")

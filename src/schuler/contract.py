@@ -8,18 +8,20 @@ which is generated from it — goes through the same few entries:
 1. **Parameters** (:class:`~schuler.params.ParameterSet`) declared once: names,
    display units, defaults, ranges, help. Every entry point builds a validated
    :class:`~schuler.params.Case` from them; nothing else fills defaults.
-2. ``evaluate(cases) -> {output: array}``: the vectorised evaluation of a batch
-   of cases (:class:`Cases`), each output an array of length ``len(cases)`` in
-   SI, declared in ``outputs`` (:class:`Output`). Sweeps and Monte Carlo call
-   only this.
-3. ``run_case(case, fidelity) -> Result``: one case in full (time histories for
-   figures and files). Its result's ``to_dict()`` holds every output of
-   ``evaluate`` with the same value (the contract tests check it to 1e-9).
+2. ``evaluate(cases, histories=False) -> Evaluation``: the vectorised evaluation
+   of a batch of cases (:class:`Cases`), each output an array of length
+   ``len(cases)`` in SI, declared in ``outputs`` (:class:`Output`); with
+   ``histories=True`` also the first case's named time histories
+   (:class:`~schuler.core.response.Histories`) and structured extras. Sweeps
+   and Monte Carlo use the outputs; :meth:`System.run` evaluates the one case
+   with histories into one :class:`~schuler.results.SystemResult`, so a run
+   equals ``evaluate`` by construction.
+3. ``figures(result) -> {stem: Figure}``: the figures of any result of the
+   system, drawn on demand (``result.plot()``) and written by the one writer,
+   :func:`write_result` (histories as CSV, figures, the system's ``data_files``).
 4. ``reproduce(**options) -> Reproduction``: the source's published case, rows
    of printed and computed values with verdicts from stated tolerances.
-5. ``write_files(result, out_dir) -> [paths]``: the one entry that writes a
-   result's figures and data files.
-6. ``actions``: the system's own commands beyond ``run`` and ``reproduce``
+5. ``actions``: the system's own commands beyond ``run`` and ``reproduce``
    (``north identify``), each a function of validated parameters returning a Result.
 
 Randomness belongs to the driver: a case's random terms (sensor noise,

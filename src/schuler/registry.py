@@ -26,7 +26,20 @@ SYSTEM_MODULES: dict[str, str] = {
     "navigate": "schuler.navigate.api",
     "mission": "schuler.mission.api",
 }
-"""Command name of each system -> module holding its ``SYSTEM``."""
+"""Command name of each system -> module holding its ``SYSTEM``: the one line that registers a system."""
+
+SUMMARIES: dict[str, str] = {
+    "errors": "Schuler-tuned INS error propagation (Bollay).",
+    "vertical": "Gyro vertical with integral correction (Drozdovich).",
+    "calibrate": "Gyro drift calibration by alternating torque pulses.",
+    "align": "Physical gyrocompassing of a platform INS.",
+    "north": "Ground gyrocompass during rotor run-down.",
+    "imu": "IMU recordings, spec-sheet error models and Allan variance.",
+    "navigate": "Nonlinear strapdown or platform INS on WGS-84.",
+    "mission": "Calibrate, align, navigate: a mission's error budget.",
+}
+"""Short help of each system for ``schuler --help`` (so the help imports no system); a system without one shows
+its ``title``."""
 
 
 def list_systems() -> list[str]:

@@ -24,6 +24,7 @@ import click
 
 from schuler import __version__
 from schuler.exceptions import SchulerError
+from schuler.registry import SUMMARIES, SYSTEM_MODULES, get_system
 
 # The models' matrices are small: BLAS threads cost more than they give on them, and the cores are shared with
 # numba's parallel loops and the sweep's workers (mission's covariance analysis: 12 s of CPU with OpenBLAS's
@@ -33,42 +34,34 @@ for _variable in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
 COMMANDS: dict[str, tuple[str, str]] = {
-    "errors": ("system", "Schuler-tuned INS error propagation (Bollay)."),
-    "vertical": ("system", "Gyro vertical with integral correction (Drozdovich)."),
-    "calibrate": ("system", "Gyro drift calibration by alternating torque pulses."),
-    "align": ("system", "Physical gyrocompassing of a platform INS."),
-    "north": ("system", "Ground gyrocompass during rotor run-down."),
-    "imu": ("system", "IMU recordings, spec-sheet error models and Allan variance."),
-    "navigate": ("system", "Nonlinear strapdown or platform INS on WGS-84."),
-    "mission": ("system", "Calibrate, align, navigate: a mission's error budget."),
     "run": ("schuler.cli.study:run_scenario", "Run a scenario file (TOML)."),
     "sweep": ("schuler.cli.sweep:sweep", "Sweep parameters or Monte Carlo over a scenario."),
     "report": ("schuler.cli.study:report", "Build the HTML report of all systems."),
     "lab": ("schuler.cli.lab:lab", "Open the interactive lab bench in the browser."),
 }
-"""Each command: where it comes from (``"system"``: generated from the registry's System) and its short help."""
+"""The commands beside the systems': where each comes from and its short help (a system's command is generated
+from the registry, :data:`schuler.registry.SYSTEM_MODULES`, its help from :data:`schuler.registry.SUMMARIES`)."""
 
 
 class LazyGroup(click.Group):
     """A group whose subcommands are imported only when used."""
 
     def list_commands(self, ctx):
-        return list(COMMANDS)
+        return [*SYSTEM_MODULES, *COMMANDS]
 
     def get_command(self, ctx, name):
-        if name not in COMMANDS:
-            return None
-        origin = COMMANDS[name][0]
-        if origin == "system":
+        if name in SYSTEM_MODULES:
             from schuler.cli.systems import system_group
-            from schuler.registry import get_system
 
             return system_group(get_system(name))
-        module_name, attribute = origin.split(":")
+        if name not in COMMANDS:
+            return None
+        module_name, attribute = COMMANDS[name][0].split(":")
         return getattr(importlib.import_module(module_name), attribute)
 
     def format_commands(self, ctx, formatter):
-        rows = [(name, help_text) for name, (_, help_text) in COMMANDS.items()]
+        rows = [(name, SUMMARIES.get(name) or get_system(name).title) for name in SYSTEM_MODULES]
+        rows += [(name, help_text) for name, (_, help_text) in COMMANDS.items()]
         with formatter.section("Commands"):
             formatter.write_dl(rows)
 
