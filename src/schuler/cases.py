@@ -8,14 +8,24 @@ address the random draws, the random streams and the fidelity);
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
+import time
+from collections.abc import Callable, Iterator, Mapping
 from typing import Any
 
 import numpy as np
 
 from schuler.core.random import RandomStreams
+from schuler.core.stats import StreamingStatistics
 from schuler.exceptions import InvalidParameter
+from schuler.memory import require_time
 from schuler.params import Case, ParameterSet
+from schuler.results import MonteCarloSummary, Output
+
+MONTE_CARLO_CHUNK = 2_000
+"""Members evaluated at once in a Monte Carlo (unless the system sizes its chunks from its memory per member)."""
+
+MONTE_CARLO_SAMPLES = 100_000
+"""Members whose outputs a Monte Carlo summary keeps for histograms."""
 
 
 class Cases:
@@ -206,3 +216,82 @@ def default_arrays(parameters: ParameterSet, n: int) -> dict[str, np.ndarray]:
             one = np.array([value], dtype=object if isinstance(value, str) else None)
         arrays[name] = np.broadcast_to(one, (n,))
     return arrays
+
+
+def monte_carlo(evaluate: Callable[..., Mapping[str, np.ndarray]], outputs: tuple[Output, ...], case: Case,
+                members: int, streams: RandomStreams, fidelity: str | None = None, *, chunk: int = MONTE_CARLO_CHUNK,
+                draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None,
+                progress: Callable[[int, int], None] | None = None) -> MonteCarloSummary:
+    """Statistics of every output over ``members`` random members of ``case``, streamed in chunks.
+
+    Member ``i`` draws its random terms from ``streams`` at address ``i``, so the
+    statistics do not depend on ``chunk``. ``draw(member_numbers) -> {parameter:
+    values}`` optionally replaces parameters per member (a scenario's distributions).
+
+    Parameters
+    ----------
+    evaluate : callable
+        A system's ``evaluate(cases) -> {output: array}`` (SI).
+    outputs : tuple of Output
+        The outputs to summarise.
+    case : Case
+        The nominal case (SI values).
+    members : int
+        Number of random members.
+    streams : RandomStreams
+        Where the members' random terms come from.
+    fidelity : str, optional
+        Passed to ``evaluate`` through :attr:`Cases.fidelity`.
+    chunk : int
+        Members evaluated at once (a count; it does not change the result).
+    draw : callable, optional
+        ``draw(member_numbers) -> {parameter: values}``, SI values per member.
+    progress : callable, optional
+        ``progress(done, total)`` after each chunk, in members.
+
+    """
+    statistics = {output.name: StreamingStatistics((1,), reservoir_size=MONTE_CARLO_SAMPLES) for output in outputs}
+    samples: dict[str, list[np.ndarray]] = {output.name: [] for output in outputs}
+    kept = 0
+    for start in range(0, members, chunk):
+        numbers = np.arange(start, min(start + chunk, members), dtype=np.int64)
+        batch = Cases.from_case(case, numbers.size, members=numbers, random=streams, fidelity=fidelity)
+        if draw is not None:
+            drawn = {name: batch[name] for name in batch.names}
+            drawn.update(draw(numbers))
+            batch = Cases(drawn, members=numbers, random=streams, fidelity=fidelity)
+        results = evaluate(batch)
+        for name, stats in statistics.items():
+            values = np.asarray(results[name], dtype=float)
+            stats.update(values[np.isfinite(values)][:, None])
+            if kept < MONTE_CARLO_SAMPLES:
+                samples[name].append(values[:MONTE_CARLO_SAMPLES - kept])
+        kept = min(MONTE_CARLO_SAMPLES, kept + numbers.size)
+        if progress is not None:
+            progress(int(numbers[-1]) + 1, members)
+    return MonteCarloSummary.from_statistics(members, streams.seed, outputs, statistics,
+                                             {k: np.concatenate(v) if v else np.empty(0) for k, v in samples.items()})
+
+
+class MeasuredPace:
+    """The time estimate of a system that declares none: the pace of a Monte Carlo's chunks after the first.
+
+    The first chunk is left out (it pays one-off compilation); from the second
+    on, what remains is extrapolated at the pace measured so far, and refused
+    past the time budget — so at most two chunks' time is spent on work refused.
+    """
+
+    def __init__(self, members: int, what: str, progress: Callable[[int, int], None] | None):
+        self.members, self.what, self.progress = members, what, progress
+        self.first: tuple[int, float] | None = None
+
+    def __call__(self, done: int, total: int) -> None:
+        now = time.perf_counter()
+        if self.first is None:
+            self.first = (done, now)
+        elif done > self.first[0] and done < self.members:
+            pace = (now - self.first[1]) / (done - self.first[0])
+            require_time(pace * (self.members - done), f"{self.what} ({self.members} members; pace measured)",
+                         "--monte-carlo")
+        if self.progress is not None:
+            self.progress(done, total)

@@ -35,7 +35,6 @@ random term zero.
 from __future__ import annotations
 
 import difflib
-import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from functools import partial, wraps
@@ -44,88 +43,17 @@ from typing import Any
 
 import numpy as np
 
-from schuler.cases import Cases, default_arrays
+from schuler.cases import MONTE_CARLO_CHUNK, MONTE_CARLO_SAMPLES, Cases, MeasuredPace, default_arrays, monte_carlo
 from schuler.core.random import RandomStreams
-from schuler.core.stats import StreamingStatistics
 from schuler.exceptions import InvalidParameter
 from schuler.memory import require_time
 from schuler.params import Case, Parameter, ParameterSet
-from schuler.results import MonteCarloSummary, Result, RunResult, SystemResult
-
-MONTE_CARLO_CHUNK = 2_000
-"""Members evaluated at once in :meth:`System.run` Monte Carlo (unless the system says otherwise)."""
+from schuler.results import Evaluation, MonteCarloSummary, Output, Result, RunResult, SystemResult, write_result
 
 RUN_CASE_MEMBERS = 4
 """Members a run in full counts as in a time estimate: its histories cost a few members where the work is large
 (measured: north 1.1-3.2, mission 4.1, navigate 1.2 with IMU noise and 7 without); where members cost well under a
 millisecond (align, calibrate, errors) the run in full is tens of members, still milliseconds."""
-
-MONTE_CARLO_SAMPLES = 100_000
-"""Members whose outputs a Monte Carlo summary keeps for histograms."""
-
-
-@dataclass(frozen=True)
-class Output:
-    """One output of a system's ``evaluate``: its key, SI unit, display unit and meaning.
-
-    Parameters
-    ----------
-    name : str
-        Key in ``evaluate``'s dict and in the result's ``to_dict()`` (unit in
-        the name where it is not obvious: ``azimuth_error_rad``).
-    unit : str
-        SI unit of the values (``"rad"``, ``"s"``, ``"1"``).
-    display : str
-        Unit shown to people (``"arcmin"``); empty: the SI unit.
-    description : str
-        One line for tables, plots and documentation.
-    """
-
-    name: str
-    unit: str
-    display: str = ""
-    description: str = ""
-
-    @property
-    def shown_unit(self) -> str:
-        return self.display or ("" if self.unit == "1" else self.unit)
-
-
-class Evaluation(Mapping[str, np.ndarray]):
-    """What a system's ``evaluate(cases, histories=False)`` returns: its outputs and, when asked, histories.
-
-    It reads as the mapping of outputs (``evaluation["azimuth_error_rad"]``, an
-    array of length ``len(cases)``, SI), so sweeps and Monte Carlo use it as
-    the dict of outputs; ``histories`` holds named
-    :class:`~schuler.core.response.Histories` (keyed by file stem) and
-    ``extras`` structured results (tables, lists) of a batch's first case,
-    present only when ``evaluate`` was asked for histories.
-
-    Parameters
-    ----------
-    outputs : mapping of str to array_like
-        Every declared output, one value per case (SI).
-    histories : mapping of str to Histories, optional
-        Time histories by file stem (``align_time_history``).
-    extras : mapping of str to object, optional
-        JSON-safe structured results beside the outputs.
-    """
-
-    def __init__(self, outputs: Mapping[str, Any], histories: Mapping[str, Any] | None = None,
-                 extras: Mapping[str, Any] | None = None):
-        self.outputs = dict(outputs)
-        self.histories = dict(histories or {})
-        self.extras = dict(extras or {})
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        return self.outputs[name]
-
-    def __iter__(self):
-        return iter(self.outputs)
-
-    def __len__(self) -> int:
-        return len(self.outputs)
-
 
 @dataclass(frozen=True)
 class Argument:
@@ -478,7 +406,7 @@ class System:
         """
         checked = None if draw is None else partial(self._checked_draw, draw)
         if self.member_seconds is None:
-            progress = _MeasuredPace(members, f"this {self.name} Monte Carlo", progress)
+            progress = MeasuredPace(members, f"this {self.name} Monte Carlo", progress)
         return monte_carlo(self.evaluate, self.outputs, case, members, streams, fidelity,
                            chunk=self._chunk_size(case), draw=checked, progress=progress)
 
@@ -560,116 +488,6 @@ class System:
         raise KeyError(name)
 
 
-def monte_carlo(evaluate: Callable[..., Mapping[str, np.ndarray]], outputs: tuple[Output, ...], case: Case,
-                members: int, streams: RandomStreams, fidelity: str | None = None, *, chunk: int = MONTE_CARLO_CHUNK,
-                draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None,
-                progress: Callable[[int, int], None] | None = None) -> MonteCarloSummary:
-    """Statistics of every output over ``members`` random members of ``case``, streamed in chunks.
-
-    Member ``i`` draws its random terms from ``streams`` at address ``i``, so the
-    statistics do not depend on ``chunk``. ``draw(member_numbers) -> {parameter:
-    values}`` optionally replaces parameters per member (a scenario's distributions).
-
-    Parameters
-    ----------
-    evaluate : callable
-        A system's ``evaluate(cases) -> {output: array}`` (SI).
-    outputs : tuple of Output
-        The outputs to summarise.
-    case : Case
-        The nominal case (SI values).
-    members : int
-        Number of random members.
-    streams : RandomStreams
-        Where the members' random terms come from.
-    fidelity : str, optional
-        Passed to ``evaluate`` through :attr:`Cases.fidelity`.
-    chunk : int
-        Members evaluated at once (a count; it does not change the result).
-    draw : callable, optional
-        ``draw(member_numbers) -> {parameter: values}``, SI values per member.
-    progress : callable, optional
-        ``progress(done, total)`` after each chunk, in members.
-
-    """
-    statistics = {output.name: StreamingStatistics((1,), reservoir_size=MONTE_CARLO_SAMPLES) for output in outputs}
-    samples: dict[str, list[np.ndarray]] = {output.name: [] for output in outputs}
-    kept = 0
-    for start in range(0, members, chunk):
-        numbers = np.arange(start, min(start + chunk, members), dtype=np.int64)
-        batch = Cases.from_case(case, numbers.size, members=numbers, random=streams, fidelity=fidelity)
-        if draw is not None:
-            drawn = {name: batch[name] for name in batch.names}
-            drawn.update(draw(numbers))
-            batch = Cases(drawn, members=numbers, random=streams, fidelity=fidelity)
-        results = evaluate(batch)
-        for name, stats in statistics.items():
-            values = np.asarray(results[name], dtype=float)
-            stats.update(values[np.isfinite(values)][:, None])
-            if kept < MONTE_CARLO_SAMPLES:
-                samples[name].append(values[:MONTE_CARLO_SAMPLES - kept])
-        kept = min(MONTE_CARLO_SAMPLES, kept + numbers.size)
-        if progress is not None:
-            progress(int(numbers[-1]) + 1, members)
-    return MonteCarloSummary.from_statistics(members, streams.seed, outputs, statistics,
-                                             {k: np.concatenate(v) if v else np.empty(0) for k, v in samples.items()})
-
-
-class _MeasuredPace:
-    """The time estimate of a system that declares none: the pace of a Monte Carlo's chunks after the first.
-
-    The first chunk is left out (it pays one-off compilation); from the second
-    on, what remains is extrapolated at the pace measured so far, and refused
-    past the time budget — so at most two chunks' time is spent on work refused.
-    """
-
-    def __init__(self, members: int, what: str, progress: Callable[[int, int], None] | None):
-        self.members, self.what, self.progress = members, what, progress
-        self.first: tuple[int, float] | None = None
-
-    def __call__(self, done: int, total: int) -> None:
-        now = time.perf_counter()
-        if self.first is None:
-            self.first = (done, now)
-        elif done > self.first[0] and done < self.members:
-            pace = (now - self.first[1]) / (done - self.first[0])
-            require_time(pace * (self.members - done), f"{self.what} ({self.members} members; pace measured)",
-                         "--monte-carlo")
-        if self.progress is not None:
-            self.progress(done, total)
-
-
-def write_result(result: Result, out_dir: Path, data_files: Callable[[Result, Path], list[Path]] | None = None
-                 ) -> list[Path]:
-    """The one writer of every system: histories as CSV (``STEM.csv``), figures (``STEM.png``, ``.svg``), data files.
-
-    Each CSV has the time column ``t_s`` first and one column per channel, the
-    SI unit in the column's name; ``data_files(result, out_dir)`` adds files in
-    a field's own formats (a KF-GINS navigation file).
-
-    Parameters
-    ----------
-    result : Result
-        What a system returned (its figures from :meth:`Result.figures`).
-    out_dir : Path
-        Folder to write into (created if missing).
-    data_files : callable, optional
-        ``data_files(result, out_dir) -> [paths]``: the system's own data files.
-    """
-    from schuler.io import save_figure_formats, write_dataframe_csv
-
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    paths: list[Path] = []
-    for stem, histories in getattr(result, "histories", {}).items():
-        paths.append(write_dataframe_csv(histories.to_dataframe().reset_index(), out_dir / f"{stem}.csv"))
-    for stem, figure in result.figures().items():
-        paths += save_figure_formats(figure, out_dir / stem)
-    if data_files is not None:
-        paths += data_files(result, out_dir)
-    return paths
-
-
 def _attaching(function: Callable[..., Result], figures: Callable[[Result], dict[str, Any]] | None
                ) -> Callable[..., Result]:
     """``function`` whose result draws its figures with ``figures`` (:meth:`Result.attach_figures`)."""
@@ -731,3 +549,7 @@ class ReportSection:
     figures: list[FigureRef] = field(default_factory=list)
     commands: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+
+
+__all__ = ["MONTE_CARLO_CHUNK", "MONTE_CARLO_SAMPLES", "RUN_OPTIONS", "Action", "Argument", "Cases", "Evaluation",
+           "FigureRef", "Output", "ReportSection", "System", "monte_carlo", "write_result"]

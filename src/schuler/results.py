@@ -10,9 +10,38 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
+
+
+@dataclasses.dataclass(frozen=True)
+class Output:
+    """One output of a system's ``evaluate``: its key, SI unit, display unit and meaning.
+
+    Parameters
+    ----------
+    name : str
+        Key in ``evaluate``'s dict and in the result's ``to_dict()`` (unit in
+        the name where it is not obvious: ``azimuth_error_rad``).
+    unit : str
+        SI unit of the values (``"rad"``, ``"s"``, ``"1"``).
+    display : str
+        Unit shown to people (``"arcmin"``); empty: the SI unit.
+    description : str
+        One line for tables, plots and documentation.
+    """
+
+    name: str
+    unit: str
+    display: str = ""
+    description: str = ""
+
+    @property
+    def shown_unit(self) -> str:
+        return self.display or ("" if self.unit == "1" else self.unit)
 
 
 def json_safe(value: Any) -> Any:
@@ -456,3 +485,70 @@ def display_label(name: str, unit: str = "") -> str:
         if name.endswith(suffix):
             return f"{name[: -len(suffix)]} ({unit})"
     return f"{name} ({unit})"
+
+
+class Evaluation(Mapping[str, np.ndarray]):
+    """What a system's ``evaluate(cases, histories=False)`` returns: its outputs and, when asked, histories.
+
+    It reads as the mapping of outputs (``evaluation["azimuth_error_rad"]``, an
+    array of length ``len(cases)``, SI), so sweeps and Monte Carlo use it as
+    the dict of outputs; ``histories`` holds named
+    :class:`~schuler.core.response.Histories` (keyed by file stem) and
+    ``extras`` structured results (tables, lists) of a batch's first case,
+    present only when ``evaluate`` was asked for histories.
+
+    Parameters
+    ----------
+    outputs : mapping of str to array_like
+        Every declared output, one value per case (SI).
+    histories : mapping of str to Histories, optional
+        Time histories by file stem (``align_time_history``).
+    extras : mapping of str to object, optional
+        JSON-safe structured results beside the outputs.
+    """
+
+    def __init__(self, outputs: Mapping[str, Any], histories: Mapping[str, Any] | None = None,
+                 extras: Mapping[str, Any] | None = None):
+        self.outputs = dict(outputs)
+        self.histories = dict(histories or {})
+        self.extras = dict(extras or {})
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.outputs[name]
+
+    def __iter__(self):
+        return iter(self.outputs)
+
+    def __len__(self) -> int:
+        return len(self.outputs)
+
+
+def write_result(result: Result, out_dir: Path, data_files: Callable[[Result, Path], list[Path]] | None = None
+                 ) -> list[Path]:
+    """The one writer of every system: histories as CSV (``STEM.csv``), figures (``STEM.png``, ``.svg``), data files.
+
+    Each CSV has the time column ``t_s`` first and one column per channel, the
+    SI unit in the column's name; ``data_files(result, out_dir)`` adds files in
+    a field's own formats (a KF-GINS navigation file).
+
+    Parameters
+    ----------
+    result : Result
+        What a system returned (its figures from :meth:`Result.figures`).
+    out_dir : Path
+        Folder to write into (created if missing).
+    data_files : callable, optional
+        ``data_files(result, out_dir) -> [paths]``: the system's own data files.
+    """
+    from schuler.io import save_figure_formats, write_dataframe_csv
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    for stem, histories in getattr(result, "histories", {}).items():
+        paths.append(write_dataframe_csv(histories.to_dataframe().reset_index(), out_dir / f"{stem}.csv"))
+    for stem, figure in result.figures().items():
+        paths += save_figure_formats(figure, out_dir / stem)
+    if data_files is not None:
+        paths += data_files(result, out_dir)
+    return paths

@@ -121,9 +121,10 @@ class OutageDrift:
     heading_error_max_rad : float
         Largest |heading error| inside it, rad (likewise).
     horizontal_error_end_m : float
-        Horizontal error at its end, m (RMS over members).
+        Horizontal error at its end, m (RMS over members): at the last covariance time before the epoch that ends
+        it (the covariance stored at that epoch is already updated).
     horizontal_error_sigma_m : float
-        The filter's predicted sqrt(P_NN + P_EE) at its end, m (RMS over members).
+        The filter's predicted sqrt(P_NN + P_EE) at that time, m (RMS over members).
     """
 
     start_s: float
@@ -157,9 +158,10 @@ def outage_drift(run: FilterRun, run_errors: Errors, outages) -> list[OutageDrif
         inside = (run_errors.t_s > start) & (run_errors.t_s <= end + 1e-9)
         if not inside.any():
             continue
-        last = np.flatnonzero(inside)[-1]
-        # the covariance at the outage's end: the last one stored at or before it (no update came since)
-        index = int(np.searchsorted(run.covariance_t_s, end + 1e-9)) - 1
+        # the outage's end, as stored: the last covariance strictly before the epoch that ends it (the covariance
+        # stored at that epoch is already updated), and the errors at that same time
+        index = max(int(np.searchsorted(run.covariance_t_s, end - 1e-9)) - 1, 0)
+        last = min(int(np.searchsorted(run_errors.t_s, run.covariance_t_s[index] - 1e-9)), run_errors.t_s.size - 1)
         P = run.covariance[:, index]
         drifts.append(OutageDrift(
             float(start), float(duration),

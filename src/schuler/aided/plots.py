@@ -1,0 +1,85 @@
+"""The figures of ``schuler aided``: the errors inside the filter's +-3-sigma envelopes, and the drift per outage."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from schuler.units import to_unit
+
+
+def _outage_spans(axis, outages, scale: float = 1.0 / 60.0) -> None:
+    for outage in outages:
+        start, duration = outage["start_s"], outage["duration_s"]
+        axis.axvspan(start * scale, (start + duration) * scale, color="0.85", lw=0)
+
+
+def error_envelopes(histories, outages):
+    """North, east, down and heading errors of one member with the filter's +-3-sigma (outages shaded).
+
+    Parameters
+    ----------
+    histories : Histories
+        ``aided_errors`` of a run (m, rad).
+    outages : list of dict
+        The run's outages (``start_s``, ``duration_s``, s).
+    """
+    import matplotlib.pyplot as plt
+
+    minutes = histories.time / 60.0
+    fig, axes = plt.subplots(4, 1, sharex=True, figsize=(8, 8.5))
+    rows = [("north_error_m", "north_sigma_m", "north [m]", 1.0), ("east_error_m", "east_sigma_m", "east [m]", 1.0),
+            ("down_error_m", "down_sigma_m", "down [m]", 1.0),
+            ("heading_error_rad", "heading_sigma_rad", "heading [deg]", float(to_unit(1.0, "deg")))]
+    for axis, (error, sigma, label, scale) in zip(axes, rows):
+        _outage_spans(axis, outages)
+        envelope = 3 * histories[sigma] * scale
+        axis.fill_between(minutes, -envelope, envelope, color="tab:blue", alpha=0.2, lw=0, label="+-3 sigma")
+        axis.plot(minutes, histories[error] * scale, color="tab:red", lw=0.8, label="error")
+        axis.set_ylabel(label)
+        axis.grid(True, alpha=0.3)
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[0].set_title("Aided INS: errors and the filter's +-3-sigma (GNSS outages shaded)")
+    axes[-1].set_xlabel("time [min]")
+    fig.tight_layout()
+    return fig
+
+
+def outage_drift(outages):
+    """Largest horizontal error in each outage beside the filter's 1-sigma at its end.
+
+    Parameters
+    ----------
+    outages : list of dict
+        The run's outages (``start_s``, ``horizontal_error_max_m``, ``horizontal_error_sigma_m``; s, m).
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axis = plt.subplots(figsize=(7, 3.5))
+    x = np.arange(len(outages))
+    axis.bar(x - 0.2, [o["horizontal_error_max_m"] for o in outages], 0.4, label="largest horizontal error")
+    axis.bar(x + 0.2, [o["horizontal_error_sigma_m"] for o in outages], 0.4, label="filter 1-sigma at the end")
+    axis.set_xticks(x, [f"{o['start_s'] / 60:.0f} min, {o['duration_s']:.0f} s" for o in outages])
+    axis.set_ylabel("horizontal [m]")
+    axis.set_title("Drift through each GNSS outage")
+    axis.legend(fontsize=8)
+    axis.grid(True, axis="y", alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def figures(result) -> dict:
+    """The figures of an aided run (``{}`` for results without histories).
+
+    Parameters
+    ----------
+    result : SystemResult
+        What ``schuler aided run`` returned.
+    """
+    histories = getattr(result, "histories", {})
+    if "aided_errors" not in histories:
+        return {}
+    outages = result.extras.get("outages", [])
+    drawn = {"aided_errors": error_envelopes(histories["aided_errors"], outages)}
+    if outages:
+        drawn["aided_outage_drift"] = outage_drift(outages)
+    return drawn
