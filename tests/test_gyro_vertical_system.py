@@ -1,4 +1,4 @@
-"""``schuler vertical`` on the contract: parameters, ``evaluate`` = ``run_case``, fidelities, memory, files."""
+"""``schuler vertical`` on the contract: parameters, ``evaluate`` = the run in full, fidelities, memory, files."""
 
 from __future__ import annotations
 
@@ -16,10 +16,9 @@ from schuler.core.earth import DROZDOVICH, STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
 from schuler.gyro_vertical.actions import friction
 from schuler.gyro_vertical.api import SYSTEM
-from schuler.gyro_vertical.evaluation import OUTPUTS, PARAMETERS, member_bytes, parse_speed_profile, run_case
+from schuler.gyro_vertical.evaluation import OUTPUTS, PARAMETERS, member_bytes, parse_speed_profile
 from schuler.gyro_vertical.model import error_state_space
 from schuler.gyro_vertical.quasi_steady import mode_frequencies
-from schuler.gyro_vertical.results import write_files
 from schuler.memory import MemoryBudgetExceeded
 
 R, G, OMEGA = DROZDOVICH.radius, DROZDOVICH.gravity, DROZDOVICH.rate
@@ -139,7 +138,7 @@ def test_closed_fidelity_is_the_quasi_steady_error_of_the_simulation():
         simulated.quasi_steady_velocity_error_y_mean_m_s, rel=1e-12)
     assert closed.velocity_error_y_mean_m_s == closed.quasi_steady_velocity_error_y_mean_m_s
     assert math.isnan(closed.velocity_error_y_rms_m_s) and math.isnan(closed.fitted_period_fast_s)
-    assert closed.analysis is None and closed.method == "quasi-steady (29)"
+    assert list(closed.histories) == ["vertical_quasi_steady"] and closed.method == "quasi-steady (29)"
     assert simulated.method == "DOP853" and simulated.fitted_amplitudes_m_s is not None
     with pytest.raises(InvalidParameter, match="fidelity"):
         SYSTEM.run(fidelity="rough")
@@ -180,12 +179,12 @@ def test_defaults_and_cross_checks():
 def test_awkward_grids_give_numbers_not_tracebacks():
     # a speed-profile piece shorter than the output step holds no output time (formerly a ValueError in scipy)
     quick = SYSTEM.run(speed_profile="0: 0, 1: 20", duration=3 * HOUR, output_step=10.0)
-    assert quick.analysis.response.true_velocity_y[-1] == pytest.approx(20.0)
+    assert quick.histories["vertical_timeseries"]["true_velocity_y_m_s"][-1] == pytest.approx(20.0)
     assert math.isfinite(quick.velocity_error_y_rms_m_s)
     # an output step above half the faster split period would alias the modes: no fit rather than a wrong one
     for step in (3 * HOUR, 48 * HOUR):
         coarse = SYSTEM.run(output_step=step)
-        assert math.isnan(coarse.fitted_period_fast_s) and coarse.analysis.spectrum is None
+        assert math.isnan(coarse.fitted_period_fast_s) and "vertical_spectrum" not in coarse.figures()
         assert math.isfinite(coarse.velocity_error_y_max_abs_m_s)
     fine = SYSTEM.run(output_step=1200.0)  # 20 min < 41 min: resolved, and the fit finds the eigenvalue
     assert fine.fitted_period_fast_s == pytest.approx(fine.split_period_fast_s, rel=1e-3)
@@ -227,41 +226,68 @@ def test_monte_carlo_of_scenario_draws():
         return {"accel_bias_y": 1e-4 * STANDARD_GRAVITY * (members - 1.0)}
 
     result = SYSTEM.run(monte_carlo=3, draw=draw, trajectory="frozen", duration=3 * HOUR, output_step=60.0)
-    stats = result.monte_carlo.statistics["steady_tilt_alpha_rad"]
+    stats = result.monte_carlo["steady_tilt_alpha_rad"]
     # alpha_r = -(W*_y + b_y) / g: biases of -1e-4, 0, 1e-4 g give a sample std of exactly 1e-4 rad
-    assert stats["std"] == pytest.approx(1e-4, rel=1e-12)
-    assert stats["mean"] == pytest.approx(result.steady_tilt_alpha_rad, abs=1e-15)
+    assert stats.std == pytest.approx(1e-4, rel=1e-12)
+    assert stats.mean == pytest.approx(result.steady_tilt_alpha_rad, abs=1e-15)
     assert np.concatenate(draws).tolist() == [0, 1, 2]
 
 
+def test_run_as_a_python_result():
+    import matplotlib.pyplot as plt
+
+    values = {"earth": "drozdovich", "duration": 3 * HOUR, "output_step": 60.0}
+    result = SYSTEM.run(**values)
+    frame = result.to_dataframe()
+    assert isinstance(frame, pd.DataFrame) and frame.index.name == "time_s" and len(frame) == 3 * 60 + 1
+    assert frame["true_velocity_y_m_s"].iloc[0] == pytest.approx(10.0)
+    figure = result.plot()
+    assert isinstance(figure, plt.Figure)
+    plt.close(figure)
+    assert "Gyro vertical" in result._repr_html_()
+    data, evaluated = result.to_dict(), SYSTEM.evaluate_values(values)
+    for output in OUTPUTS:
+        if math.isnan(evaluated[output.name][0]):
+            assert data[output.name] is None
+        else:
+            assert data[output.name] == pytest.approx(float(evaluated[output.name][0]), rel=1e-12, abs=1e-300)
+    assert data["method"] == result.method and data["units"]["nfev"] == "1"
+
+
 @pytest.mark.slow
-def test_write_files_of_each_result(tmp_path):
-    short = PARAMETERS.case(earth="drozdovich", duration=6 * HOUR, output_step=60.0)
-    files = write_files(run_case(short), tmp_path / "run")
+def test_files_of_each_command(tmp_path):
+    values = {"earth": "drozdovich", "duration": 6 * HOUR, "output_step": 60.0}
+    files = SYSTEM.write(SYSTEM.run(**values), tmp_path / "run")
     names = {p.name for p in files}
     assert {"vertical_timeseries.csv", "vertical_tilts.png", "vertical_tilts.svg", "vertical_velocity_errors.png",
             "vertical_velocity_errors.svg", "vertical_spectrum.png", "vertical_spectrum.svg"} == names
     table = pd.read_csv(tmp_path / "run" / "vertical_timeseries.csv")
     assert len(table) == 6 * 60 + 1 and table["true_velocity_y_m_s"].iloc[0] == pytest.approx(10.0)
+    assert table.columns[0] == "time_s" and len(table.columns) == 12
     assert all(column.endswith(("_s", "_rad", "_m_s")) for column in table.columns)
-    closed = write_files(run_case(short, "closed"), tmp_path / "closed")
+    closed = SYSTEM.write(SYSTEM.run(fidelity="closed", **values), tmp_path / "closed")
     assert {p.name for p in closed} == {"vertical_quasi_steady.csv", "vertical_quasi_steady.png",
                                         "vertical_quasi_steady.svg"}
     spread = SYSTEM.run(monte_carlo=40, fidelity="closed", duration=HOUR, output_step=60.0,
                         draw=lambda members: {"drift_x": 0.01 * DEG_PER_H * np.sin(members)})
-    names = {p.name for p in write_files(spread, tmp_path / "monte_carlo")}
+    names = {p.name for p in SYSTEM.write(spread, tmp_path / "monte_carlo")}
     assert names == {"vertical_quasi_steady.csv", "vertical_quasi_steady.png", "vertical_quasi_steady.svg",
                      "vertical_monte_carlo.png", "vertical_monte_carlo.svg"}
-    stuck = friction(initial_beta=math.radians(0.2 / 3600), duration=3 * HOUR)
-    names = {p.name for p in write_files(stuck, tmp_path / "friction")}
+    stuck = SYSTEM.action("friction")(initial_beta=math.radians(0.2 / 3600), duration=3 * HOUR)
+    names = {p.name for p in SYSTEM.write(stuck, tmp_path / "friction", "friction")}
     assert names == {"vertical_friction.csv", "vertical_friction_stick_intervals.csv", "vertical_friction.png",
                      "vertical_friction.svg"}
     intervals = pd.read_csv(tmp_path / "friction" / "vertical_friction_stick_intervals.csv")
     assert len(intervals) == stuck.stick_intervals and intervals["end_s"].iloc[0] > 0
+    names = {p.name for p in SYSTEM.write(SYSTEM.reproduce(), tmp_path / "reproduce")}
+    assert names == {f"vertical_example_{stem}.{ext}" for stem in ("tilts", "velocity_errors", "spectrum")
+                     for ext in ("png", "svg")} | {"vertical_example_timeseries.csv", "vertical_friction.csv",
+                                                   "vertical_friction_stick_intervals.csv", "vertical_friction.png",
+                                                   "vertical_friction.svg"}
+    assert list(pd.read_csv(tmp_path / "reproduce" / "vertical_example_timeseries.csv").columns) == list(table.columns)
     for path in tmp_path.rglob("*.*"):
         assert path.stat().st_size > (500 if path.suffix in (".png", ".svg") else 100), path
-    with pytest.raises(TypeError, match="vertical writes no files"):
-        write_files(SYSTEM.run(trajectory="frozen", duration=HOUR).monte_carlo, tmp_path)
+    assert SYSTEM.figures(spread.monte_carlo) == {} and SYSTEM.data_files(spread.monte_carlo, tmp_path) == []
 
 
 @pytest.mark.slow

@@ -1,4 +1,4 @@
-"""``errors`` on the contract: parameters, evaluate vs run_case, fidelities, Monte Carlo, memory, actions, files."""
+"""``errors`` on the contract: parameters, evaluate vs the run in full, fidelities, Monte Carlo, actions, files."""
 
 from __future__ import annotations
 
@@ -22,10 +22,9 @@ from schuler.navigation_errors.actions import (
     vertical,
 )
 from schuler.navigation_errors.api import SYSTEM
-from schuler.navigation_errors.evaluation import OUTPUTS, PARAMETERS, evaluate, run_case
-from schuler.navigation_errors.files import write_files
+from schuler.navigation_errors.evaluation import OUTPUTS, PARAMETERS, evaluate
 from schuler.navigation_errors.inputs import FLIGHT_TIME, grid_points, time_grid
-from schuler.navigation_errors.reproduction import plot, reproduce
+from schuler.navigation_errors.reproduction import plot
 from schuler.navigation_errors.single_channel import SOURCES
 
 DEG_PER_H = math.radians(1) / 3600
@@ -97,7 +96,7 @@ def test_time_grid_ends_on_the_duration():
     assert grid_points(np.array([10.0, 10.5]), 1.0).tolist() == [11, 12]
 
 
-# --- evaluate, run_case, fidelities ------------------------------------------------------------------
+# --- evaluate, the run in full, fidelities ------------------------------------------------------------------
 
 CASES = [
     {"source": "tilt", "duration": 5000.0, "earth": "bollay"},
@@ -110,14 +109,14 @@ CASES = [
 
 
 @pytest.mark.parametrize("fidelity", ["simulated", "closed"])
-def test_evaluate_equals_run_case_case_by_case(fidelity):
+def test_evaluate_equals_the_run_in_full_case_by_case(fidelity):
     cases = [SYSTEM.case(**values) for values in CASES]
     batch = Cases({name: np.array([case[name] for case in cases], dtype=object
                                   if any(isinstance(case[name], str) or case[name] is None for case in cases)
                                   else float) for name in PARAMETERS.names}, fidelity=fidelity)
     out = evaluate(batch)
     for k, case in enumerate(cases):
-        single = run_case(case, fidelity).to_dict()
+        single = SYSTEM.result(case, fidelity).to_dict()
         for output in OUTPUTS:
             if math.isnan(out[output.name][k]):
                 assert single[output.name] is None and fidelity == "closed"
@@ -132,7 +131,8 @@ def test_simulated_and_closed_fidelities_agree_to_rounding(source):
     # exact matrix exponential: rounding only, relative to the largest error of the run
     assert simulated.final_spherical_m == pytest.approx(closed.final_spherical_m, abs=1e-9 * closed.max_spherical_m)
     assert simulated.simulation_minus_closed_m <= 1e-9 * closed.max_spherical_m
-    assert math.isnan(closed.simulation_minus_closed_m) and closed.simulated_m is None
+    assert math.isnan(closed.simulation_minus_closed_m)
+    assert "simulated_m" not in closed.histories[f"errors_run_{source}"]
     assert closed.to_dict()["simulation_minus_closed_m"] is None
     assert simulated.fidelity == "simulated" and closed.fidelity == "closed"
 
@@ -163,18 +163,21 @@ def test_run_bollay_velocity_case_and_its_histories():
     result = SYSTEM.run(source="velocity", magnitude=FOOT, duration=FLIGHT_TIME, output_step=10.0, earth="bollay")
     assert result.schuler_period_s == pytest.approx(5060.0, rel=1e-12)
     assert result.max_spherical_m / FOOT == pytest.approx(805.32, abs=0.01)  # Bollay, Problem 3: 805 ft
-    assert result.t_s[-1] == FLIGHT_TIME and result.t_s.size == 1013
-    np.testing.assert_allclose(result.simulated_m, result.spherical_m, rtol=0, atol=1e-9 * result.max_spherical_m)
+    histories = result.histories["errors_run_velocity"]
+    assert histories.time[-1] == FLIGHT_TIME and histories.time.size == 1013
+    np.testing.assert_allclose(histories["simulated_m"], histories["spherical_m"], rtol=0,
+                               atol=1e-9 * result.max_spherical_m)
     assert result.final_flat_m / FOOT == pytest.approx(10_120, rel=1e-12)  # Delta_V t
-    assert result.to_dict()["units"] == {"magnitude": "m/s"}
+    assert result.to_dict()["units"] == {**{output.name: output.unit for output in OUTPUTS}, "magnitude": "m/s"}
     assert "t_s" not in result.to_dict()  # histories go to the CSV of --out, not to JSON
 
 
 def test_largest_spherical_error_bounds_the_sampled_history():
     for source in SOURCES:
         result = SYSTEM.run(source=source, duration=30_000.0, output_step=15.0)
-        assert np.max(np.abs(result.spherical_m)) <= result.max_spherical_m * (1 + 1e-12)
-        assert np.max(np.abs(result.spherical_m)) == pytest.approx(result.max_spherical_m, rel=1e-4)
+        spherical = result.histories[f"errors_run_{source}"]["spherical_m"]
+        assert np.max(np.abs(spherical)) <= result.max_spherical_m * (1 + 1e-12)
+        assert np.max(np.abs(spherical)) == pytest.approx(result.max_spherical_m, rel=1e-4)
 
 
 def test_a_sweep_over_sources_takes_each_source_default():
@@ -243,8 +246,8 @@ def test_a_monte_carlo_needs_random_terms_or_drawn_parameters():
     # ... unless parameters are drawn per member (a scenario's [monte_carlo] tables)
     result = SYSTEM.run(monte_carlo=5, seed=1, source="tilt",
                         draw=lambda members: {"duration": 3600.0 + 60.0 * members.astype(float)})
-    stats = result.monte_carlo.statistics["final_spherical_m"]
-    assert stats["count"] == 5 and stats["std"] > 0
+    stats = result.monte_carlo["final_spherical_m"]
+    assert stats.count == 5 and stats.std > 0
 
 
 def test_memory_is_refused_before_allocating(monkeypatch):
@@ -312,35 +315,57 @@ def test_plot_action_summarises_problem3():
 
 # --- files ---------------------------------------------------------------------------------------------
 
+def test_run_as_a_python_result():
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    result = SYSTEM.run(source="tilt", duration=3600.0)
+    frame = result.to_dataframe()
+    assert isinstance(frame, pd.DataFrame) and list(frame.columns) == ["flat_m", "spherical_m", "simulated_m"]
+    assert frame.index.name == "t_s" and frame["spherical_m"].iloc[-1] == pytest.approx(
+        result.histories["errors_run_tilt"]["spherical_m"][-1])
+    figure = result.plot()
+    assert isinstance(figure, plt.Figure)
+    plt.close(figure)
+    assert "Schuler period" in result._repr_html_()
+    data = result.to_dict()
+    evaluated = SYSTEM.evaluate_values({"source": "tilt", "duration": 3600.0})
+    for output in OUTPUTS:
+        assert data[output.name] == pytest.approx(float(evaluated[output.name][0]), rel=1e-12)
+    assert data["source"] == "tilt" and data["warnings"] == []
+
+
 @pytest.mark.slow
-def test_write_files_for_every_result_type(tmp_path, monkeypatch):
-    from schuler.navigation_errors import files
+def test_files_of_every_command(tmp_path):
+    import pandas as pd
 
     results = {
-        "run": SYSTEM.run(source="azimuth", duration=3600.0),
-        "vertical": vertical(**VERTICAL_PARAMETERS.case(duration=1000.0)),
-        "period": period(**PERIOD_PARAMETERS.case(speed=3000.0)),
+        "run": (SYSTEM.run(source="azimuth", duration=3600.0), None),
+        "vertical": (SYSTEM.action("vertical")(**VERTICAL_PARAMETERS.case(duration=1000.0)), "vertical"),
+        "period": (SYSTEM.action("period")(**PERIOD_PARAMETERS.case(speed=3000.0)), "period"),
+        "three-d": (SYSTEM.action("three-d")(**SYSTEM.actions[3].parameters.case(duration=3600.0)), "three-d"),
+        "reproduce": (SYSTEM.reproduce(), None),
+        "plot": (SYSTEM.action("plot")(points=11), "plot"),
     }
+    problem3 = ({f"errors_{stem}.{ext}" for stem in (*SOURCES, "overview", "vertical") for ext in ("png", "svg")}
+                | {"errors_problem3.csv", "errors_problem4.csv"})
     expected = {
         "run": {"errors_run_azimuth.png", "errors_run_azimuth.svg", "errors_run_azimuth.csv"},
         "vertical": {"errors_vertical_run.png", "errors_vertical_run.svg", "errors_vertical_run.csv"},
         "period": {"errors_period.png", "errors_period.svg", "errors_period.csv"},
+        "three-d": {"errors_three_d.png", "errors_three_d.svg", "errors_three_d_track.png",
+                    "errors_three_d_track.svg", "errors_three_d.csv"},
+        "reproduce": problem3,
+        "plot": problem3,
     }
-    for name, result in results.items():
+    for name, (result, action) in results.items():
         folder = tmp_path / name
-        paths = write_files(result, folder)
+        paths = SYSTEM.write(result, folder, action)
         assert {p.name for p in paths} == expected[name] == {p.name for p in folder.iterdir()}
-    import pandas as pd
-
     run = pd.read_csv(tmp_path / "run" / "errors_run_azimuth.csv")
     assert list(run.columns) == ["t_s", "flat_m", "spherical_m", "simulated_m"]
-    assert run["spherical_m"].iloc[-1] == pytest.approx(results["run"].final_spherical_m, rel=1e-12)
-    # reproduce and plot write the same Problem 3 figures (drawn in the CLI test of plot)
-    drawn = []
-    monkeypatch.setattr(files, "write_problem3", lambda curves, out_dir, formats: drawn.append(curves) or [])
-    reproduction, figures = reproduce(), plot(points=11)
-    write_files(reproduction, tmp_path)
-    write_files(figures, tmp_path)
-    assert drawn == [reproduction.data, figures.curves]
-    with pytest.raises(TypeError, match="errors writes no files"):
-        write_files(object(), tmp_path)
+    assert run["spherical_m"].iloc[-1] == pytest.approx(results["run"][0].final_spherical_m, rel=1e-12)
+    three_d = pd.read_csv(tmp_path / "three-d" / "errors_three_d.csv")
+    assert three_d.columns[0] == "t_s" and "attitude_error_north_rad" in three_d.columns
+    assert pd.read_csv(tmp_path / "plot" / "errors_problem3.csv").shape[0] == 11
+    assert SYSTEM.figures(object()) == {} and SYSTEM.data_files(object(), tmp_path) == []

@@ -151,16 +151,16 @@ def test_action_sign_convention_a_positive_east_drift_makes_a_positive_north_err
     epsilon = math.radians(0.01) / 3600
     result = _three_d(drift_east=epsilon, earth_rate=0.0, earth="bollay", duration=10_120.0, output_step=10.0)
     closed = spherical_error("drift", epsilon, result.t_s, BOLLAY.radius, BOLLAY.effective_gravity)
-    np.testing.assert_allclose(result.histories["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
+    np.testing.assert_allclose(result.states["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
     assert result.final_position_error_north_m / 0.3048 == pytest.approx(10_258.5, abs=0.05)  # Bollay: 10,250 ft
-    np.testing.assert_allclose(result.histories["position_error_east"], 0.0, atol=1e-12)
+    np.testing.assert_allclose(result.states["position_error_east"], 0.0, atol=1e-12)
 
 
 def test_action_accelerometer_bias_north_gives_the_single_channel_error():
     bias = 1e-4 * STANDARD_GRAVITY
     result = _three_d(accel_bias_north=bias, earth_rate=0.0, duration=8000.0, output_step=20.0)
     closed = spherical_error("accelerometer", bias, result.t_s, MEAN_RADIUS, STANDARD_GRAVITY)
-    np.testing.assert_allclose(result.histories["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
+    np.testing.assert_allclose(result.states["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
 
 
 def test_action_foucault_rotation_and_modes_on_the_rotating_earth():
@@ -168,8 +168,8 @@ def test_action_foucault_rotation_and_modes_on_the_rotating_earth():
     result = _three_d(latitude=L, initial_velocity_error_north=1.0, duration=86_400.0, output_step=180.0)
     north, east = foucault_velocity_response(result.t_s, 1.0, L, MEAN_RADIUS, STANDARD_GRAVITY, EARTH_RATE)
     amplitude = 1.0 / math.sqrt(STANDARD_GRAVITY / MEAN_RADIUS)
-    np.testing.assert_allclose(result.histories["position_error_north"], north, atol=1e-7 * amplitude)
-    np.testing.assert_allclose(result.histories["position_error_east"], east, atol=1e-7 * amplitude)
+    np.testing.assert_allclose(result.states["position_error_north"], north, atol=1e-7 * amplitude)
+    np.testing.assert_allclose(result.states["position_error_east"], east, atol=1e-7 * amplitude)
     assert result.foucault_rate_rad_s == pytest.approx(EARTH_RATE * math.sin(L), rel=1e-15)
     eigenvalues = result.eigenvalues_real_per_s + 1j * result.eigenvalues_imag_rad_s
     np.testing.assert_allclose(_sorted_by_frequency(eigenvalues),
@@ -184,7 +184,7 @@ def test_action_initial_attitude_error_is_a_tilt():
     psi = math.radians(0.01)
     result = _three_d(initial_attitude_error_east=psi, earth_rate=0.0, duration=6000.0, output_step=30.0)
     closed = spherical_error("tilt", psi, result.t_s, MEAN_RADIUS, STANDARD_GRAVITY)
-    np.testing.assert_allclose(result.histories["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
+    np.testing.assert_allclose(result.states["position_error_north"], closed, rtol=0, atol=1e-9 * closed.max())
 
 
 def test_action_warns_when_the_latitude_changes_much():

@@ -60,5 +60,16 @@ for source, (label, size) in sources.items():
     print(f"{label:28s} flat {round(flat):12,d} ft   spherical {round(sphere):8,d} ft")
 
 # %%
+# One source through the system, as ``schuler errors run`` runs it: the result
+# holds the outputs, the error histories (the CSV of ``--out``) and its figure.
+import schuler
+
+run = schuler.get_system("errors").run(source="drift", earth="bollay")
+print(f"largest spherical error {run.max_spherical_m / FOOT:,.0f} ft, Schuler period {run.schuler_period_s:.0f} s")
+print(run.to_dataframe().iloc[::250])
+run.plot()
+plt.show()
+
+# %%
 # The same table with the printed values and the source's errata:
 # ``schuler errors reproduce``; the curves as figures: ``schuler errors plot --out results/errors``.

@@ -48,5 +48,18 @@ print(f"split Schuler periods {2 * math.pi / fast / 60:.2f} and {2 * math.pi / s
       f"beat {2 * math.pi / (fast - slow) / 3600:.1f} h")
 
 # %%
+# The same case through the system, as ``schuler vertical run`` runs it: the
+# outputs, the histories (the CSV of ``--out``) and its figures.
+import schuler
+
+run = schuler.get_system("vertical").run(latitude=latitude, earth="drozdovich", duration=48 * 3600.0,
+                                         output_step=60.0, trajectory="frozen")
+print(f"systematic error {run.velocity_error_y_mean_m_s:.3f} m/s, fitted periods "
+      f"{run.fitted_period_fast_s / 60:.2f} and {run.fitted_period_slow_s / 60:.2f} min")
+print(run.to_dataframe()[["velocity_error_x_m_s", "velocity_error_y_m_s"]].iloc[::720])
+run.plot("vertical_velocity_errors")
+plt.show()
+
+# %%
 # The reproduction with every printed number: ``schuler vertical reproduce``;
 # friction and its dead zone: ``schuler vertical friction --out results/friction``.

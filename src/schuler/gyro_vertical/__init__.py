@@ -13,9 +13,9 @@ Izvestiya VUZ, Priborostroyeniye, no. 3, pp. 29-39, 1959
   analysis and mode fit of simulations.
 - :mod:`~schuler.gyro_vertical.friction`: Coulomb friction (30)-(32) with exact
   stick/slip switching.
-- :mod:`~schuler.gyro_vertical.evaluation`: parameters, outputs, ``evaluate``, ``run_case``.
+- :mod:`~schuler.gyro_vertical.evaluation`: parameters, outputs, ``evaluate``.
 - :mod:`~schuler.gyro_vertical.actions`: the ``friction`` command.
 - :mod:`~schuler.gyro_vertical.reproduction`: the source's worked example and errata, ``report``.
-- :mod:`~schuler.gyro_vertical.results`: the result types and ``write_files``.
+- :mod:`~schuler.gyro_vertical.results`: the result types, ``figures`` and ``data_files``.
 - :mod:`~schuler.gyro_vertical.api`: ``SYSTEM`` (``schuler vertical``).
 """

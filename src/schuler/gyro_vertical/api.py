@@ -2,10 +2,10 @@
 
 Source: Drozdovich, "On an inertial method of measuring velocities" (1959)
 (:data:`schuler.references.DROZDOVICH_1959`). The pieces:
-:mod:`~schuler.gyro_vertical.evaluation` (parameters, outputs, ``evaluate``,
-``run_case``), :mod:`~schuler.gyro_vertical.actions` (``friction``),
+:mod:`~schuler.gyro_vertical.evaluation` (parameters, outputs, ``evaluate``),
+:mod:`~schuler.gyro_vertical.actions` (``friction``),
 :mod:`~schuler.gyro_vertical.reproduction` (``reproduce``, ``report``),
-:mod:`~schuler.gyro_vertical.results` (the result types and ``write_files``).
+:mod:`~schuler.gyro_vertical.results` (the result types, ``figures`` and ``data_files``).
 
 Examples
 --------
@@ -26,10 +26,9 @@ from schuler.gyro_vertical.evaluation import (
     evaluate,
     member_bytes,
     output_points,
-    run_case,
 )
 from schuler.gyro_vertical.reproduction import report, reproduce
-from schuler.gyro_vertical.results import write_files
+from schuler.gyro_vertical.results import VerticalResult, data_files, figures
 from schuler.params import Case, ParameterSet
 from schuler.references import DROZDOVICH_1959
 
@@ -56,10 +55,11 @@ SYSTEM = System(
     parameters=PARAMETERS,
     outputs=OUTPUTS,
     evaluate=evaluate,
-    run_case=run_case,
     reproduce=reproduce,
     reproduce_parameters=ParameterSet((), owner="vertical reproduce"),
-    write_files=write_files,
+    figures=figures,
+    data_files=data_files,
+    result_type=VerticalResult,
     report=report,
     fidelities=FIDELITIES,
     actions=(FRICTION,),

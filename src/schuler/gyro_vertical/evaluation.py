@@ -1,4 +1,4 @@
-"""What the gyro vertical evaluates: its parameters, outputs, ``evaluate`` and ``run_case``.
+"""What the gyro vertical evaluates: its parameters, outputs and ``evaluate``.
 
 Source: Drozdovich (1959) (:data:`schuler.references.DROZDOVICH_1959`); every
 equation number below is that paper's.
@@ -47,12 +47,14 @@ their beat, the initial-tilt amplitude of (23).
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 
-from schuler.contract import Cases, Output
+from schuler.contract import Cases, Evaluation, Output
 from schuler.core.earth import PRESETS
+from schuler.core.response import Histories
 from schuler.exceptions import InvalidParameter
 from schuler.gyro_vertical.model import GyroVertical, forcing
 from schuler.gyro_vertical.quasi_steady import (
@@ -61,7 +63,6 @@ from schuler.gyro_vertical.quasi_steady import (
     split_schuler_frequencies,
     steady_errors,
 )
-from schuler.gyro_vertical.results import VerticalResult
 from schuler.gyro_vertical.trajectory import (
     GreatCircleTrajectory,
     SpeedProfile,
@@ -262,7 +263,7 @@ def member_bytes(case: Case) -> int:
     return int(POINT_BYTES * output_points(case["duration"], case["output_step"]) + CASE_BYTES)
 
 
-def evaluate(cases: Cases) -> dict[str, np.ndarray]:
+def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
 
     The closed forms at the start of each path are evaluated for the whole batch
@@ -274,6 +275,11 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     ----------
     cases : Cases
         A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
+    histories : bool
+        Also the first case in full (an :class:`~schuler.contract.Evaluation`): simulated, the histories
+        ``vertical_timeseries`` (tilts, latitude, measured and true velocities, velocity errors and the
+        quasi-steady error (29)); closed, ``vertical_quasi_steady`` (the forced motion (26), (29), its
+        slowly-varying form and W* (21)); extras ``method``, ``nfev``, ``n_steps``, ``fitted_amplitudes_m_s``.
 
     Examples
     --------
@@ -281,8 +287,14 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     >>> out = evaluate(Cases.from_case(case, fidelity="closed"))
     >>> round(float(out["steady_velocity_error_y_m_s"][0]), 3), bool(np.isnan(out["velocity_error_y_rms_m_s"][0]))
     (0.557, True)
+    >>> list(evaluate(Cases.from_case(case, fidelity="closed"), histories=True).histories)
+    ['vertical_quasi_steady']
     """
-    return _evaluate(cases, keep_histories=False)[0]
+    outputs, details = _evaluate(cases, keep_histories=histories)
+    if not histories:
+        return outputs
+    stems, extras = run_histories(cases.fidelity or FIDELITIES[0], details[0])
+    return Evaluation(outputs, histories=stems, extras=extras)
 
 
 def _evaluate(cases: Cases, keep_histories: bool) -> tuple[dict[str, np.ndarray], list[Any]]:
@@ -371,37 +383,68 @@ def _start_closed_forms(cases: Cases, each: list[Case]) -> dict[str, np.ndarray]
     }
 
 
-def run_case(case: Case, fidelity: str | None = None) -> VerticalResult:
-    """One case in full: the outputs of :func:`evaluate` for the one-case batch, and its histories.
+def run_histories(fidelity: str, detail: Any) -> tuple[dict[str, Histories], dict[str, Any]]:
+    """A case's histories (the CSV of ``--out``: ``vertical_timeseries`` or ``vertical_quasi_steady``) and extras.
+
+    Parameters
+    ----------
+    fidelity : str
+        ``"simulated"`` (``detail`` an :class:`~schuler.gyro_vertical.quasi_steady.Analysis`) or ``"closed"``
+        (``detail`` a :class:`~schuler.gyro_vertical.quasi_steady.QuasiSteady`); times s, SI values.
+    detail : Analysis or QuasiSteady
+        What the evaluation kept of the case.
+    """
+    if fidelity == "simulated":
+        r, q, fit = detail.response, detail.quasi_steady, detail.fit
+        channels = {
+            "alpha_rad": r.alpha, "beta_rad": r.beta, "latitude_rad": r.latitude,
+            "measured_velocity_x_m_s": r.measured_velocity_x, "measured_velocity_y_m_s": r.measured_velocity_y,
+            "true_velocity_x_m_s": r.true_velocity_x, "true_velocity_y_m_s": r.true_velocity_y,
+            "velocity_error_x_m_s": r.velocity_error_x, "velocity_error_y_m_s": r.velocity_error_y,
+            "quasi_steady_velocity_error_x_m_s": q.dv_x, "quasi_steady_velocity_error_y_m_s": q.dv_y,
+        }
+        stem, time = "vertical_timeseries", r.time
+        extras = {"method": r.method, "nfev": r.nfev, "n_steps": r.n_steps,
+                  "fitted_amplitudes_m_s": None if fit is None else [float(a) for a in fit.amplitudes]}
+    else:
+        q = detail
+        channels = {
+            "alpha_r_rad": q.alpha_r, "beta_r_rad": q.beta_r,
+            "quasi_steady_velocity_error_x_m_s": q.dv_x, "quasi_steady_velocity_error_y_m_s": q.dv_y,
+            "slowly_varying_velocity_error_x_m_s": q.slow_dv_x, "slowly_varying_velocity_error_y_m_s": q.slow_dv_y,
+            "transport_coriolis_x_m_s2": q.W_star_x, "transport_coriolis_y_m_s2": q.W_star_y,
+        }
+        stem, time = "vertical_quasi_steady", q.time
+        extras = {"method": "quasi-steady (29)", "nfev": 0, "n_steps": 0, "fitted_amplitudes_m_s": None}
+    units = {name: _unit_of(name) for name in channels}
+    return {stem: Histories(time, channels, units, time_name="time_s")}, extras
+
+
+def _unit_of(name: str) -> str:
+    """The SI unit a channel's name ends in (``_rad``, ``_m_s``, ``_m_s2``)."""
+    for suffix, unit in (("_m_s2", "m/s^2"), ("_m_s", "m/s"), ("_rad", "rad")):
+        if name.endswith(suffix):
+            return unit
+    raise ValueError(f"no unit in {name!r}")
+
+
+def simulated_run(case: Case) -> SimpleNamespace:
+    """One case simulated: its outputs (attributes, SI) and ``analysis``, the simulation with its modes.
 
     Parameters
     ----------
     case : Case
         A validated case (SI values).
-    fidelity : str, optional
-        One of the system's fidelities (default: the first).
 
     Examples
     --------
-    >>> case = PARAMETERS.case(latitude=np.radians(60), earth="drozdovich", duration=6 * 3600.0)
-    >>> r = run_case(case)
-    >>> round(r.steady_velocity_error_y_m_s, 3), round(r.split_period_fast_s / 60, 2), r.method
-    (0.557, 82.45, 'DOP853')
+    >>> run = simulated_run(PARAMETERS.case(latitude=np.radians(60), earth="drozdovich", duration=6 * 3600.0))
+    >>> round(run.steady_velocity_error_y_m_s, 3), run.analysis.response.method
+    (0.557, 'DOP853')
     """
-    fidelity = fidelity or FIDELITIES[0]
-    outputs, details = _evaluate(Cases.from_case(case, fidelity=fidelity), keep_histories=True)
-    values: dict[str, Any] = {name: float(array[0]) for name, array in outputs.items()}
-    detail = details[0]
-    if fidelity == "simulated":
-        response, fit = detail.response, detail.fit
-        extra = {"method": response.method, "nfev": response.nfev, "n_steps": response.n_steps,
-                 "fitted_amplitudes_m_s": None if fit is None else [float(a) for a in fit.amplitudes],
-                 "analysis": detail, "quasi_steady": detail.quasi_steady}
-    else:
-        extra = {"method": "quasi-steady (29)", "nfev": 0, "n_steps": 0, "fitted_amplitudes_m_s": None,
-                 "analysis": None, "quasi_steady": detail}
-    return VerticalResult(fidelity=fidelity, **values, **extra)
+    outputs, details = _evaluate(Cases.from_case(case, fidelity="simulated"), keep_histories=True)
+    return SimpleNamespace(**{name: float(values[0]) for name, values in outputs.items()}, analysis=details[0])
 
 
 __all__ = ["FIDELITIES", "OUTPUTS", "PARAMETERS", "build_model", "evaluate", "member_bytes",
-           "parse_speed_profile", "run_case"]
+           "parse_speed_profile", "simulated_run"]

@@ -437,7 +437,21 @@ def analyse(vertical: GyroVertical, time, method: str = "auto") -> Analysis:
         Simulation method: ``"auto"``, ``"exact"`` or a ``solve_ivp`` method.
 
     """
-    response = vertical.simulate(time, method=method)
+    return analyse_response(vertical, vertical.simulate(time, method=method))
+
+
+def analyse_response(vertical: GyroVertical, response, fit_modes_too: bool = True) -> Analysis:
+    """The forced motion, spectrum and (with ``fit_modes_too``) fitted modes of a simulation of ``vertical``.
+
+    Parameters
+    ----------
+    vertical : GyroVertical
+        The instrument on its trajectory.
+    response : VerticalResponse
+        Its simulation (times s, tilts rad, velocities m/s).
+    fit_modes_too : bool
+        Fit the two split Schuler modes (figures need only the spectrum: False).
+    """
     t = response.time
     q = quasi_steady_response(vertical, t)
     omega_2 = float(np.mean(np.broadcast_to(vertical.trajectory.kinematics(t).omega_2, t.shape)))
@@ -451,7 +465,7 @@ def analyse(vertical: GyroVertical, time, method: str = "auto") -> Analysis:
     spectrum = velocity_error_spectrum(t, ox, oy) if uniform and resolved else None
     fit = None
     moving = np.sqrt(np.mean(ox**2 + oy**2)) > 1e-9
-    if moving and resolved:
+    if fit_modes_too and moving and resolved:
         # sign of each mode on the complex axis: the fast one turns with omega_2
         signs = (1, -1) if omega_2 >= 0 else (-1, 1)
         guesses = [s * w for s, w in zip(signs, eigen)]

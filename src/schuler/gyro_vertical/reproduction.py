@@ -23,11 +23,12 @@ from pathlib import Path
 from schuler.contract import FigureRef, ReportSection
 from schuler.core.earth import DROZDOVICH, EarthModel
 from schuler.gyro_vertical.actions import friction
-from schuler.gyro_vertical.evaluation import PARAMETERS, run_case
+from schuler.gyro_vertical.evaluation import PARAMETERS, simulated_run
 from schuler.gyro_vertical.friction import friction_from_velocity_error
 from schuler.gyro_vertical.quasi_steady import steady_errors
-from schuler.gyro_vertical.results import write_files
+from schuler.gyro_vertical.results import data_files, figures
 from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, transport_coriolis_acceleration
+from schuler.io import save_figure_formats
 from schuler.references import DROZDOVICH_1959
 from schuler.reproduction import Reproduction, Tolerance, compare
 from schuler.units import from_unit, to_unit
@@ -100,9 +101,9 @@ def reproduce() -> Reproduction:
     """
     earth = DROZDOVICH
     example = worked_example(earth)
-    run = run_case(_example_case())
-    tilted = run_case(_example_case(initial_beta=LEVELLING_ERROR))
-    compensated = run_case(_example_case(initial_beta=LEVELLING_ERROR, compensation="trajectory"))
+    run = simulated_run(_example_case())
+    tilted = simulated_run(_example_case(initial_beta=LEVELLING_ERROR))
+    compensated = simulated_run(_example_case(initial_beta=LEVELLING_ERROR, compensation="trajectory"))
     stuck = friction(dead_zone=FRICTION_VELOCITY_ERROR, initial_beta=FRICTION_TILT, duration=FRICTION_TIME,
                      output_step=OUTPUT_STEP)
     q = float(friction_from_velocity_error(FRICTION_VELOCITY_ERROR, earth.radius))
@@ -225,8 +226,12 @@ def report(figures_dir: Path) -> ReportSection:
         The report's figure folder.
     """
     reproduction = reproduce()
-    files = write_files(reproduction, Path(figures_dir))
-    figures = [FigureRef(path.name, CAPTIONS[path.stem]) for path in files if path.suffix == ".png"]
+    figures_dir = Path(figures_dir)
+    refs = []
+    for stem, figure in figures(reproduction).items():
+        save_figure_formats(figure, figures_dir / stem)
+        refs.append(FigureRef(f"{stem}.png", CAPTIONS[stem]))
+    data_files(reproduction, figures_dir)
     return ReportSection(
         system="vertical",
         title="Gyro vertical with integral correction measuring velocity",
@@ -238,7 +243,7 @@ def report(figures_dir: Path) -> ReportSection:
                  "2 pi/(Omega sin phi); compensating them from the trajectory removes the systematic error. "
                  "Coulomb friction leaves static errors within +-R q, but its coupled slip is self-exciting."),
         rows=reproduction.rows,
-        figures=figures,
+        figures=refs,
         commands=[
             "schuler vertical reproduce --out DIR",
             "schuler vertical run --latitude 60 --speed 10 --earth drozdovich --duration '48 h' --out DIR",

@@ -1,8 +1,9 @@
-"""What ``schuler vertical`` returns and writes: :class:`VerticalResult`, :class:`FrictionResult`, :func:`write_files`.
+"""What ``schuler vertical`` returns and draws: :class:`VerticalResult`, :class:`FrictionResult`, :func:`figures`.
 
 Fields are SI with the unit in the name (``velocity_error_y_mean_m_s``,
 ``split_period_fast_s``); ``render()`` shows arcmin, minutes and hours. The
-histories for figures and files are kept out of ``to_dict``.
+histories for figures and files are kept out of ``to_dict``; :func:`data_files`
+writes the tables that are not a run's histories.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from schuler.reproduction import Reproduction
-from schuler.results import Result, RunResult
+from schuler.results import Result, SystemResult
 from schuler.units import to_unit
 
 
@@ -38,49 +39,14 @@ def _shown(value: float | None, unit: str = "", digits: int = 5, scale: float = 
     return text[1:] if text.startswith("-") and float(text) == 0 else text
 
 
-@dataclass
-class VerticalResult(RunResult):
-    """One gyro-vertical case: every output of the system's ``evaluate`` and the histories behind them.
+@dataclass(kw_only=True)
+class VerticalResult(SystemResult):
+    """What ``SYSTEM.run`` returns: every output of the system's ``evaluate``, the extras and the histories.
 
     With ``fidelity="closed"`` the outputs only a simulation gives are NaN and
-    ``analysis`` is None; ``quasi_steady`` holds the forced motion (26) and the
-    quasi-steady error (29) along the path in both fidelities.
+    the histories are ``vertical_quasi_steady``, the forced motion (26) and the
+    quasi-steady error (29) along the path; simulated, ``vertical_timeseries``.
     """
-
-    fidelity: str
-    end_time_s: float
-    final_latitude_rad: float
-    transport_coriolis_x_m_s2: float
-    transport_coriolis_y_m_s2: float
-    steady_tilt_alpha_rad: float
-    steady_tilt_beta_rad: float
-    steady_velocity_error_x_m_s: float
-    steady_velocity_error_y_m_s: float
-    quasi_steady_velocity_error_x_mean_m_s: float
-    quasi_steady_velocity_error_y_mean_m_s: float
-    velocity_error_x_mean_m_s: float
-    velocity_error_y_mean_m_s: float
-    velocity_error_x_rms_m_s: float
-    velocity_error_y_rms_m_s: float
-    velocity_error_x_max_abs_m_s: float
-    velocity_error_y_max_abs_m_s: float
-    velocity_error_x_final_m_s: float
-    velocity_error_y_final_m_s: float
-    tilt_alpha_max_abs_rad: float
-    tilt_beta_max_abs_rad: float
-    schuler_period_s: float
-    split_period_fast_s: float
-    split_period_slow_s: float
-    beat_period_s: float
-    fitted_period_fast_s: float
-    fitted_period_slow_s: float
-    tilt_oscillation_amplitude_m_s: float
-    method: str
-    nfev: int
-    n_steps: int
-    fitted_amplitudes_m_s: list[float] | None
-    analysis: Any = field(default=None, repr=False)
-    quasi_steady: Any = field(default=None, repr=False)
 
     units: ClassVar[dict[str, str]] = {"nfev": "1", "n_steps": "1"}
 
@@ -154,6 +120,26 @@ class FrictionResult(Result):
 
     units: ClassVar[dict[str, str]] = {"stick_intervals": "1", "switches": "1", "nfev": "1"}
 
+    def to_dataframe(self):
+        """The histories, one row per time: ``time_s``, the tilts (rad) and the velocity errors (m/s)."""
+        import pandas as pd
+
+        r = self.response
+        return pd.DataFrame({"time_s": r.time, "alpha_rad": r.alpha, "beta_rad": r.beta,
+                             "velocity_error_x_m_s": r.velocity_error_x, "velocity_error_y_m_s": r.velocity_error_y})
+
+    def stick_frame(self):
+        """The stick intervals, one row each: start and end (s), the velocity errors there (m/s)."""
+        import pandas as pd
+
+        errors = np.asarray(self.response.stick_velocity_errors).reshape(-1, 4)
+        intervals = np.asarray(self.response.stick_intervals).reshape(-1, 2)
+        return pd.DataFrame({
+            "start_s": intervals[:, 0], "end_s": intervals[:, 1],
+            "velocity_error_x_at_start_m_s": errors[:, 0], "velocity_error_y_at_start_m_s": errors[:, 1],
+            "velocity_error_x_at_end_m_s": errors[:, 2], "velocity_error_y_at_end_m_s": errors[:, 3],
+        })
+
     def render(self):
         from rich.table import Table
 
@@ -177,102 +163,101 @@ class FrictionResult(Result):
         return table
 
 
-def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """Figures (PNG and SVG) and CSV data of a run, of the friction action or of the reproduction.
+def figures(result: Result) -> dict[str, Any]:
+    """The figures of a run, of the friction action or of the reproduction, file stem -> Figure.
+
+    Parameters
+    ----------
+    result : Result
+        What ``run``, ``reproduce`` or an action returned ({} for any other result).
+    """
+    from schuler.gyro_vertical import plots
+
+    if isinstance(result, Reproduction):
+        data = result.data
+        return {**_analysis_figures(data["example"], "vertical_example", data["compensated"]),
+                **figures(data["friction"])}
+    if isinstance(result, FrictionResult):
+        radius = result.dead_zone_x_m_s / result.friction_x_rad_s  # q_1 = R q_1 / R > 0: the dead zone is positive
+        return {"vertical_friction": plots.plot_friction(result.response,
+                                                         (result.friction_x_rad_s, result.friction_y_rad_s), radius)}
+    if not isinstance(result, SystemResult):
+        return {}
+    if "vertical_timeseries" in result.histories:
+        drawn = _analysis_figures(_analysis_of(result), "vertical")
+    else:
+        drawn = {"vertical_quasi_steady": plots.plot_quasi_steady(_quasi_steady_of(result))}
+    if result.monte_carlo is not None:
+        samples = result.monte_carlo.samples
+        drawn["vertical_monte_carlo"] = plots.plot_monte_carlo(samples["velocity_error_x_mean_m_s"],
+                                                               samples["velocity_error_y_mean_m_s"])
+    return drawn
+
+
+def data_files(result: Result, out_dir: Path) -> list[Path]:
+    """The CSV files beside a run's histories: the reproduction's example and the friction action's tables.
 
     Parameters
     ----------
     result : Result
         What ``run``, ``reproduce`` or an action returned.
     out_dir : Path
-        Folder for the figures (PNG, SVG) and data files (CSV); created if missing.
+        Folder for the CSV files (created if missing).
     """
+    from schuler.io import write_dataframe_csv
+
     out_dir = Path(out_dir)
     if isinstance(result, Reproduction):
-        data = result.data
-        files = _analysis_files(data["example"], out_dir, "vertical_example", compensated=data["compensated"])
-        return files + _friction_files(data["friction"], out_dir)
-    if isinstance(result, VerticalResult):
-        files = (_analysis_files(result.analysis, out_dir, "vertical") if result.analysis is not None
-                 else _quasi_steady_files(result.quasi_steady, out_dir))
-        return files + (_monte_carlo_files(result.monte_carlo, out_dir) if result.monte_carlo is not None else [])
+        table = _timeseries_frame(result.data["example"])
+        return [write_dataframe_csv(table, out_dir / "vertical_example_timeseries.csv"),
+                *data_files(result.data["friction"], out_dir)]
     if isinstance(result, FrictionResult):
-        return _friction_files(result, out_dir)
-    raise TypeError(f"vertical writes no files for {type(result).__name__}")
+        return [write_dataframe_csv(result.to_dataframe(), out_dir / "vertical_friction.csv"),
+                write_dataframe_csv(result.stick_frame(), out_dir / "vertical_friction_stick_intervals.csv")]
+    return []
 
 
-def _analysis_files(analysis, out_dir: Path, prefix: str, compensated=None) -> list[Path]:
-    """Tilts, velocity errors and (for long enough runs) the spectrum; the histories as CSV."""
-    import pandas as pd
-
+def _analysis_figures(analysis, prefix: str, compensated=None) -> dict[str, Any]:
+    """Tilts, velocity errors and (for long enough runs) the spectrum."""
     from schuler.gyro_vertical import plots
-    from schuler.io import save_figure_formats, write_dataframe_csv
 
-    r, q = analysis.response, analysis.quasi_steady
-    table = pd.DataFrame({
-        "time_s": r.time, "alpha_rad": r.alpha, "beta_rad": r.beta, "latitude_rad": r.latitude,
-        "measured_velocity_x_m_s": r.measured_velocity_x, "measured_velocity_y_m_s": r.measured_velocity_y,
-        "true_velocity_x_m_s": r.true_velocity_x, "true_velocity_y_m_s": r.true_velocity_y,
-        "velocity_error_x_m_s": r.velocity_error_x, "velocity_error_y_m_s": r.velocity_error_y,
-        "quasi_steady_velocity_error_x_m_s": q.dv_x, "quasi_steady_velocity_error_y_m_s": q.dv_y,
-    })
-    files = [write_dataframe_csv(table, out_dir / f"{prefix}_timeseries.csv")]
-    files += save_figure_formats(plots.plot_tilts(analysis), out_dir / f"{prefix}_tilts")
-    files += save_figure_formats(plots.plot_velocity_errors(analysis, compensated),
-                                 out_dir / f"{prefix}_velocity_errors")
+    drawn = {f"{prefix}_tilts": plots.plot_tilts(analysis),
+             f"{prefix}_velocity_errors": plots.plot_velocity_errors(analysis, compensated)}
     if analysis.spectrum is not None:
-        files += save_figure_formats(plots.plot_spectrum(analysis), out_dir / f"{prefix}_spectrum")
-    return files
+        drawn[f"{prefix}_spectrum"] = plots.plot_spectrum(analysis)
+    return drawn
 
 
-def _monte_carlo_files(summary, out_dir: Path) -> list[Path]:
-    """Histograms of the members' systematic velocity errors."""
-    from schuler.gyro_vertical import plots
-    from schuler.io import save_figure_formats
+def _timeseries_frame(analysis):
+    """A simulation's histories as the CSV ``--out`` writes them (``time_s`` first)."""
+    from schuler.gyro_vertical.evaluation import FIDELITIES, run_histories
 
-    figure = plots.plot_monte_carlo(summary.samples["velocity_error_x_mean_m_s"],
-                                    summary.samples["velocity_error_y_mean_m_s"])
-    return save_figure_formats(figure, out_dir / "vertical_monte_carlo")
+    [histories] = run_histories(FIDELITIES[0], analysis)[0].values()
+    return histories.to_dataframe().reset_index()
 
 
-def _quasi_steady_files(quasi, out_dir: Path) -> list[Path]:
-    """The forced motion (26) and the quasi-steady error (29) of a closed-form run."""
-    import pandas as pd
+def _analysis_of(result: SystemResult):
+    """The run's simulation with its forced motion and spectrum, from its histories (for the figures)."""
+    from schuler.gyro_vertical.evaluation import build_model
+    from schuler.gyro_vertical.model import VerticalResponse
+    from schuler.gyro_vertical.quasi_steady import analyse_response
 
-    from schuler.gyro_vertical import plots
-    from schuler.io import save_figure_formats, write_dataframe_csv
-
-    table = pd.DataFrame({
-        "time_s": quasi.time, "alpha_r_rad": quasi.alpha_r, "beta_r_rad": quasi.beta_r,
-        "quasi_steady_velocity_error_x_m_s": quasi.dv_x, "quasi_steady_velocity_error_y_m_s": quasi.dv_y,
-        "slowly_varying_velocity_error_x_m_s": quasi.slow_dv_x, "slowly_varying_velocity_error_y_m_s": quasi.slow_dv_y,
-        "transport_coriolis_x_m_s2": quasi.W_star_x, "transport_coriolis_y_m_s2": quasi.W_star_y,
-    })
-    files = [write_dataframe_csv(table, out_dir / "vertical_quasi_steady.csv")]
-    return files + save_figure_formats(plots.plot_quasi_steady(quasi), out_dir / "vertical_quasi_steady")
+    h = result.histories["vertical_timeseries"]
+    response = VerticalResponse(
+        time=h.time, alpha=h["alpha_rad"], beta=h["beta_rad"], measured_velocity_x=h["measured_velocity_x_m_s"],
+        measured_velocity_y=h["measured_velocity_y_m_s"], true_velocity_x=h["true_velocity_x_m_s"],
+        true_velocity_y=h["true_velocity_y_m_s"], latitude=h["latitude_rad"], method=result.method,
+        nfev=result.nfev, n_steps=result.n_steps)
+    return analyse_response(build_model(result.parameters), response, fit_modes_too=False)
 
 
-def _friction_files(result: FrictionResult, out_dir: Path) -> list[Path]:
-    """The friction figure, the histories and the stick intervals as CSV."""
-    import pandas as pd
+def _quasi_steady_of(result: SystemResult):
+    """The closed-form run's forced motion and quasi-steady error, from its histories."""
+    from schuler.gyro_vertical.quasi_steady import QuasiSteady
 
-    from schuler.gyro_vertical import plots
-    from schuler.io import save_figure_formats, write_dataframe_csv
-
-    response = result.response
-    histories = pd.DataFrame({
-        "time_s": response.time, "alpha_rad": response.alpha, "beta_rad": response.beta,
-        "velocity_error_x_m_s": response.velocity_error_x, "velocity_error_y_m_s": response.velocity_error_y,
-    })
-    errors = np.asarray(response.stick_velocity_errors).reshape(-1, 4)
-    intervals = np.asarray(response.stick_intervals).reshape(-1, 2)
-    stick = pd.DataFrame({
-        "start_s": intervals[:, 0], "end_s": intervals[:, 1],
-        "velocity_error_x_at_start_m_s": errors[:, 0], "velocity_error_y_at_start_m_s": errors[:, 1],
-        "velocity_error_x_at_end_m_s": errors[:, 2], "velocity_error_y_at_end_m_s": errors[:, 3],
-    })
-    files = [write_dataframe_csv(histories, out_dir / "vertical_friction.csv"),
-             write_dataframe_csv(stick, out_dir / "vertical_friction_stick_intervals.csv")]
-    radius = result.dead_zone_x_m_s / result.friction_x_rad_s  # q_1 = R q_1 / R > 0: the dead zone is positive
-    figure = plots.plot_friction(response, (result.friction_x_rad_s, result.friction_y_rad_s), radius)
-    return files + save_figure_formats(figure, out_dir / "vertical_friction")
+    h = result.histories["vertical_quasi_steady"]
+    return QuasiSteady(time=h.time, alpha_r=h["alpha_r_rad"], beta_r=h["beta_r_rad"],
+                       dv_x=h["quasi_steady_velocity_error_x_m_s"], dv_y=h["quasi_steady_velocity_error_y_m_s"],
+                       slow_dv_x=h["slowly_varying_velocity_error_x_m_s"],
+                       slow_dv_y=h["slowly_varying_velocity_error_y_m_s"],
+                       W_star_x=h["transport_coriolis_x_m_s2"], W_star_y=h["transport_coriolis_y_m_s2"])

@@ -18,8 +18,8 @@ Modules, from the source's single channel outwards:
   model on the rotating Earth (Schuler, Foucault and Earth-rate modes);
 - :mod:`~schuler.navigation_errors.inputs`  the error magnitude (unit by source),
   the Earth constants and the output grid;
-- :mod:`~schuler.navigation_errors.evaluation`  ``run``: parameters, outputs,
-  ``evaluate`` (vectorised) and ``run_case``;
+- :mod:`~schuler.navigation_errors.evaluation`  ``run``: parameters, outputs and
+  ``evaluate`` (vectorised, and the run in full);
 - :mod:`~schuler.navigation_errors.reproduction`  Problem 3's table and the hover
   number with the source's constants, the ``plot`` action and the report;
 - :mod:`~schuler.navigation_errors.actions`  ``vertical`` and ``period``;

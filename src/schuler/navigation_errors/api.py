@@ -2,10 +2,10 @@
 
 Source: Bollay (1966), "The Story of 84 Minutes" (:data:`schuler.references.BOLLAY_1966`).
 The pieces: :mod:`~schuler.navigation_errors.evaluation` (``run``'s parameters,
-outputs, ``evaluate``, ``run_case``), :mod:`~schuler.navigation_errors.reproduction`
+outputs, ``evaluate``), :mod:`~schuler.navigation_errors.reproduction`
 (``reproduce``, ``report``, the ``plot`` action), :mod:`~schuler.navigation_errors.actions`
 (``vertical``, ``period``), :mod:`~schuler.navigation_errors.three_d_run` (``three-d``)
-and :mod:`~schuler.navigation_errors.files` (``write_files``).
+and :mod:`~schuler.navigation_errors.files` (``figures``, ``data_files``).
 
 Examples
 --------
@@ -32,15 +32,15 @@ from schuler.navigation_errors.evaluation import (
     PARAMETERS,
     evaluate,
     member_bytes,
-    run_case,
 )
-from schuler.navigation_errors.files import write_files
+from schuler.navigation_errors.files import data_files, figures
 from schuler.navigation_errors.reproduction import (
     PLOT_PARAMETERS,
     plot,
     report,
     reproduce,
 )
+from schuler.navigation_errors.results import ErrorRunResult
 from schuler.navigation_errors.three_d_run import THREE_D_PARAMETERS, three_d
 from schuler.params import Case
 from schuler.references import BOLLAY_1966
@@ -88,9 +88,10 @@ SYSTEM = System(
     parameters=PARAMETERS,
     outputs=OUTPUTS,
     evaluate=evaluate,
-    run_case=run_case,
     reproduce=reproduce,
-    write_files=write_files,
+    figures=figures,
+    data_files=data_files,
+    result_type=ErrorRunResult,
     report=report,
     fidelities=FIDELITIES,
     actions=ACTIONS,

@@ -1,4 +1,4 @@
-"""What ``schuler errors run`` evaluates: its parameters, outputs, ``evaluate`` and ``run_case``.
+"""What ``schuler errors run`` evaluates: its parameters, outputs and ``evaluate``.
 
 One horizontal channel of a Schuler-tuned INS (Bollay 1966, equations (1)-(4)
 of the teaching note and Problems 1-3; :mod:`~schuler.navigation_errors.single_channel`):
@@ -14,7 +14,7 @@ simulation that departs from the closed form by more than
 :data:`SIMULATION_TOLERANCE` of the error's size (far more Schuler periods than
 the matrix exponential holds its accuracy over) raises a
 :class:`~schuler.navigation_errors.results.SimulationAccuracyWarning`, which
-``run_case`` also keeps in the result's ``warnings``. The
+a run in full (``histories=True``) also keeps in its ``warnings``. The
 flat-Earth errors and the largest errors over the run are closed forms in both
 (the largest spherical error is exact over continuous time, not sampled).
 
@@ -31,7 +31,8 @@ import warnings
 
 import numpy as np
 
-from schuler.contract import Cases, Output
+from schuler.contract import Cases, Evaluation, Output
+from schuler.core.response import Histories
 from schuler.exceptions import InvalidParameter
 from schuler.memory import require
 from schuler.navigation_errors.inputs import (
@@ -45,7 +46,7 @@ from schuler.navigation_errors.inputs import (
     magnitude_si,
     time_grid,
 )
-from schuler.navigation_errors.results import ErrorRunResult, SimulationAccuracyWarning
+from schuler.navigation_errors.results import SimulationAccuracyWarning
 from schuler.navigation_errors.single_channel import (
     SOURCES,
     flat_error,
@@ -66,7 +67,7 @@ SIMULATION_BYTES_PER_POINT = 480
 the closed form beside it (float64)."""
 
 HISTORY_BYTES_PER_POINT = SIMULATION_BYTES_PER_POINT + 4 * 8
-"""Memory one output point of ``run_case`` holds: a simulation and the four histories."""
+"""Memory one output point of a run in full holds: a simulation and the four histories."""
 
 PARAMETERS = SourceParameters((
     Parameter("source", "", "drift", "Error source: tilt (level misalignment), velocity (initial velocity error), "
@@ -144,7 +145,7 @@ def _batch(cases: Cases) -> dict[str, np.ndarray]:
     }
 
 
-def evaluate(cases: Cases) -> dict[str, np.ndarray]:
+def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
 
     Closed forms are vectorised over the batch; the simulated fidelity runs one
@@ -155,8 +156,25 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     ----------
     cases : Cases
         A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
+    histories : bool
+        Also the first case in full (an :class:`~schuler.contract.Evaluation`): the flat, spherical and
+        simulated errors over time (m, CSV ``errors_run_<source>``), ``source``, ``earth``, ``magnitude``
+        (SI in the source's unit), ``speed_m_s``, ``duration_s`` and ``warnings``, what the run warned of.
 
+    Examples
+    --------
+    >>> run = evaluate(Cases.from_case(PARAMETERS.case(source="velocity", earth="bollay")), histories=True)
+    >>> round(run["max_spherical_m"][0] / 0.3048), list(run.histories["errors_run_velocity"].names)
+    (805, ['flat_m', 'spherical_m', 'simulated_m'])
     """
+    if histories:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", SimulationAccuracyWarning)
+            out = evaluate(cases)
+        notes = [str(w.message) for w in caught if issubclass(w.category, SimulationAccuracyWarning)]
+        for warning in caught:  # shown to the caller as they came, and kept in the result
+            warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
+        return _run_histories(cases, dict(out), notes)
     n = len(cases)
     batch = _batch(cases)
     points = grid_points(batch["duration"], batch["step"])
@@ -222,44 +240,20 @@ def member_bytes(case: Case) -> int:
     return 64 * len(OUTPUTS) + 256
 
 
-def run_case(case: Case, fidelity: str | None = None) -> ErrorRunResult:
-    """One case in full: the outputs of :func:`evaluate` and the error histories for figures and CSV.
-
-    Parameters
-    ----------
-    case : Case
-        A validated case (SI values).
-    fidelity : str, optional
-        One of the system's fidelities (default: the first).
-
-    Examples
-    --------
-    >>> r = run_case(PARAMETERS.case(source="velocity", earth="bollay"))
-    >>> round(r.max_spherical_m / 0.3048), r.simulation_minus_closed_m < 1e-9 * r.max_spherical_m
-    (805, True)
-    """
-    fidelity = fidelity or FIDELITIES[0]
-    cases = Cases.from_case(case, fidelity=fidelity)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", SimulationAccuracyWarning)
-        outputs = {name: float(values[0]) for name, values in evaluate(cases).items()}
-    notes = [str(w.message) for w in caught if issubclass(w.category, SimulationAccuracyWarning)]
-    for warning in caught:  # shown to the caller as they came, and kept in the result
-        warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
+def _run_histories(cases: Cases, out: dict[str, np.ndarray], notes: list[str]) -> Evaluation:
+    """The batch's first case in full: its outputs, the error histories (CSV ``errors_run_<source>``), extras."""
+    fidelity = cases.fidelity or FIDELITIES[0]
     batch = {name: values[0] for name, values in _batch(cases).items()}
     count = float(grid_points(batch["duration"], batch["step"]))
     require(count * HISTORY_BYTES_PER_POINT, "this run", "--duration or --output-step")
     t = time_grid(batch["duration"], batch["step"])
     source, magnitude = str(batch["source"]), float(batch["magnitude"])
     R, g, V = float(batch["radius"]), float(batch["gravity"]), float(batch["speed"])
-    simulated = simulate_error(source, magnitude, t, R, g, V) if fidelity == "simulated" else None
-    return ErrorRunResult(
-        source=source, earth=str(case["earth"]), fidelity=fidelity, magnitude=magnitude, radius_m=R,
-        gravity_m_s2=g, speed_m_s=V, duration_s=float(batch["duration"]),
-        schuler_period_s=outputs["schuler_period_s"], final_flat_m=outputs["final_flat_m"],
-        final_spherical_m=outputs["final_spherical_m"], max_flat_m=outputs["max_flat_m"],
-        max_spherical_m=outputs["max_spherical_m"], simulation_minus_closed_m=outputs["simulation_minus_closed_m"],
-        t_s=t, flat_m=flat_error(source, magnitude, t, g, V),
-        spherical_m=spherical_error(source, magnitude, t, R, g, V),
-        simulated_m=simulated, warnings=notes,
-    )
+    channels = {"flat_m": flat_error(source, magnitude, t, g, V),
+                "spherical_m": spherical_error(source, magnitude, t, R, g, V)}
+    if fidelity == "simulated":
+        channels["simulated_m"] = simulate_error(source, magnitude, t, R, g, V)
+    histories = Histories(t, channels, dict.fromkeys(channels, "m"))
+    extras = {"source": source, "earth": str(cases["earth"][0]), "magnitude": magnitude, "speed_m_s": V,
+              "duration_s": float(batch["duration"]), "warnings": notes}
+    return Evaluation(out, histories={f"errors_run_{source}": histories}, extras=extras)

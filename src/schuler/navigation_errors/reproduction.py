@@ -36,7 +36,7 @@ from schuler.contract import FigureRef, ReportSection
 from schuler.core.earth import BOLLAY, FOOT, PRESETS, STATUTE_MILE
 from schuler.navigation_errors import plots
 from schuler.navigation_errors.actions import altitude_errors, loop_gains
-from schuler.navigation_errors.files import write_problem3
+from schuler.navigation_errors.files import problem3_figures, problem3_tables
 from schuler.navigation_errors.inputs import FLIGHT_TIME, time_grid
 from schuler.navigation_errors.results import Problem3Curves, Problem3Figures
 from schuler.navigation_errors.single_channel import (
@@ -195,7 +195,7 @@ def problem3_rows() -> list[ReproductionRow]:
 def reproduce() -> Reproduction:
     """Bollay's Problem 3 table (summary and solution text) and Problem 4's hover error, with the source's constants.
 
-    ``data`` holds the Problem 3 curves for ``write_files`` (the figures of ``--out``).
+    ``data`` holds the Problem 3 curves (the figures and CSV of ``--out``).
 
     Examples
     --------
@@ -320,7 +320,9 @@ def report(figures_dir: Path) -> ReportSection:
 
     figures_dir = Path(figures_dir)
     reproduction = reproduce()
-    write_problem3(reproduction.data, figures_dir)
+    for stem, figure in problem3_figures(reproduction.data).items():
+        save_figure_formats(figure, figures_dir / stem)
+    problem3_tables(reproduction.data, figures_dir)
     t = np.linspace(0.0, 86_400.0, 1441)
     earth = PRESETS["default"]
     north, east = foucault_velocity_response(t, FOOT, math.radians(45.0), earth.radius, earth.gravity, earth.rate)

@@ -3,7 +3,7 @@
 Every field is SI with its unit in the name (``final_spherical_m``,
 ``schuler_period_s``) or in the class's ``units`` map; ``render()`` shows
 lengths in metres and feet. Time histories are kept for the figures and CSV
-files (``write_files``) but left out of ``to_dict()`` (``repr=False``).
+files (``--out``) but left out of ``to_dict()``.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from schuler.navigation_errors.inputs import SOURCE_SI_UNITS, SOURCE_UNITS
-from schuler.results import Result, RunResult
+from schuler.results import Result, SystemResult
 from schuler.units import to_unit
 
 LENGTH_UNITS = ("m", "ft")
@@ -82,43 +82,23 @@ def sample_indices(size: int, count: int = 11) -> np.ndarray:
     return np.unique(np.linspace(0, size - 1, min(size, count)).round().astype(int))
 
 
-@dataclass
-class ErrorRunResult(RunResult):
-    """Position error of one source: flat and spherical Earth, closed forms and the simulated error equations.
+@dataclass(kw_only=True)
+class ErrorRunResult(SystemResult):
+    """What ``SYSTEM.run`` returns: the outputs, extras and histories of one source, shown in metres and feet.
 
-    ``magnitude`` is SI in the source's unit (``units["magnitude"]``). With
+    ``magnitude`` is SI in the source's unit (``to_dict()["units"]["magnitude"]``). With
     ``fidelity="simulated"`` ``final_spherical_m`` is the simulated error and
     ``simulation_minus_closed_m`` the largest difference from the closed form on
     the output grid; with ``"closed"`` both come from the closed form (the
     difference is NaN). ``warnings`` holds what the run warned of (a simulation
-    that lost its accuracy), also shown on stderr. Histories ``t_s``, ``flat_m``, ``spherical_m`` (closed
-    forms) and ``simulated_m`` (None with ``"closed"``) feed the figures and
-    CSV, not ``to_dict()``.
+    that lost its accuracy), also shown on stderr. ``histories["errors_run_<source>"]``
+    holds ``flat_m``, ``spherical_m`` (closed forms) and, simulated, ``simulated_m``.
     """
-
-    source: str
-    earth: str
-    fidelity: str
-    magnitude: float
-    radius_m: float
-    gravity_m_s2: float
-    speed_m_s: float
-    duration_s: float
-    schuler_period_s: float
-    final_flat_m: float
-    final_spherical_m: float
-    max_flat_m: float
-    max_spherical_m: float
-    simulation_minus_closed_m: float
-    t_s: np.ndarray = field(repr=False)
-    flat_m: np.ndarray = field(repr=False)
-    spherical_m: np.ndarray = field(repr=False)
-    simulated_m: np.ndarray | None = field(default=None, repr=False)
-    warnings: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
         data = super().to_dict()
-        data["units"] = {**data.get("units", {}), "magnitude": SOURCE_SI_UNITS[self.source]}
+        # the magnitude's unit is the source's, so it is known only per result
+        data["units"]["magnitude"] = SOURCE_SI_UNITS[self.source]
         return data
 
     def render(self):
@@ -127,6 +107,9 @@ class ErrorRunResult(RunResult):
 
         from schuler.navigation_errors.plots import SOURCE_TITLES
 
+        histories = self.histories[f"errors_run_{self.source}"]
+        t_s, flat_m, spherical_m = histories.time, histories["flat_m"], histories["spherical_m"]
+        simulated_m = histories["simulated_m"] if "simulated_m" in histories else None
         flat_floor = NOISE_FRACTION * abs(self.max_flat_m)
         spherical_floor = NOISE_FRACTION * abs(self.max_spherical_m)
         shown_unit = SOURCE_UNITS[self.source]
@@ -149,14 +132,14 @@ class ErrorRunResult(RunResult):
         for row in rows:
             summary.add_row(*row)
         series = Table(title="error versus time")
-        columns = ["t (s)", "flat (m)", "spherical (m)"] + (["simulated (m)"] if self.simulated_m is not None else [])
+        columns = ["t (s)", "flat (m)", "spherical (m)"] + (["simulated (m)"] if simulated_m is not None else [])
         for column in columns:
             series.add_column(column, justify="right")
-        for k in sample_indices(self.t_s.size):
-            cells = [f"{self.t_s[k]:,.6g}", length_text(self.flat_m[k], "m", flat_floor),
-                     length_text(self.spherical_m[k], "m", spherical_floor)]
-            if self.simulated_m is not None:
-                cells.append(length_text(self.simulated_m[k], "m", spherical_floor))
+        for k in sample_indices(t_s.size):
+            cells = [f"{t_s[k]:,.6g}", length_text(flat_m[k], "m", flat_floor),
+                     length_text(spherical_m[k], "m", spherical_floor)]
+            if simulated_m is not None:
+                cells.append(length_text(simulated_m[k], "m", spherical_floor))
             series.add_row(*cells)
         parts = [summary, series]
         if self.monte_carlo is not None:
@@ -193,6 +176,13 @@ class VerticalResult(Result):
 
     units: ClassVar[dict[str, str]] = {"order": "1", "k1_per_s": "1/s", "k2_per_s2": "1/s^2", "k3_per_s3": "1/s^3",
                                        "poles_real_per_s": "1/s"}
+
+    def to_dataframe(self):
+        """The altitude errors, one row per time: ``t_s``, ``unaided_m``, ``closed_form_m``, ``aided_m``."""
+        import pandas as pd
+
+        return pd.DataFrame({"t_s": self.t_s, "unaided_m": self.unaided_m, "closed_form_m": self.closed_form_m,
+                             "aided_m": self.aided_m})
 
     def render(self):
         from rich.console import Group
@@ -294,7 +284,7 @@ class Problem3Curves:
 class Problem3Figures(Result):
     """Bollay's Problem 3 curves (each source, flat vs spherical, 0..10,120 s) and Problem 4's hover error.
 
-    ``write_files`` draws them (``--out``); ``to_dict()`` holds the number of
+    ``--out`` draws them; ``to_dict()`` holds the number of
     points and the largest errors, m.
     """
 

@@ -104,8 +104,9 @@ class ThreeDResult(Result):
     """A run of the 3-D psi-angle error model: final errors, modes, and histories for figures and CSV.
 
     Errors are computed - true in NED; attitude errors psi in rad. Down errors
-    are None without the vertical channel. ``histories`` (state name -> array
-    over ``t_s``) and ``state_units`` feed ``write_files``, not ``to_dict()``.
+    are None without the vertical channel. ``states`` (state name -> array
+    over ``t_s``) and ``state_units`` feed the figures and :meth:`to_dataframe`
+    (the CSV of ``--out``), not ``to_dict()``.
     """
 
     latitude_rad: float
@@ -131,17 +132,27 @@ class ThreeDResult(Result):
     eigenvalues_real_per_s: np.ndarray
     eigenvalues_imag_rad_s: np.ndarray
     t_s: np.ndarray = field(repr=False)
-    histories: dict[str, np.ndarray] = field(repr=False)
+    states: dict[str, np.ndarray] = field(repr=False)
     state_units: dict[str, str] = field(repr=False)
 
     units: ClassVar[dict[str, str]] = {"eigenvalues_real_per_s": "1/s"}
+
+    def to_dataframe(self):
+        """The state histories, one row per time: ``t_s`` then each state, its SI unit in the column name."""
+        import pandas as pd
+
+        columns = {"t_s": self.t_s}
+        for name, history in self.states.items():
+            column = name.replace("psi_", "attitude_error_")
+            columns[f"{column}_{self.state_units[name].replace('/', '_')}"] = history
+        return pd.DataFrame(columns)
 
     def render(self):
         from rich.console import Group
         from rich.table import Table
 
         # each channel hides rounding noise against its own scale: one channel may be far smaller, yet real
-        north_floor, east_floor = (NOISE_FRACTION * float(np.max(np.abs(self.histories[f"position_error_{axis}"])))
+        north_floor, east_floor = (NOISE_FRACTION * float(np.max(np.abs(self.states[f"position_error_{axis}"])))
                                    for axis in ("north", "east"))
         horizontal_floor = NOISE_FRACTION * self.max_horizontal_position_error_m
         title = (f"3-D psi-angle errors at {math.degrees(self.latitude_rad):.6g} deg, V_N = "
@@ -172,9 +183,9 @@ class ThreeDResult(Result):
         for column in ("t (h)", "north (m)", "east (m)", "psi down (arcsec)"):
             series.add_column(column, justify="right")
         for k in sample_indices(self.t_s.size):
-            series.add_row(f"{self.t_s[k] / 3600:.4g}", f"{self.histories['position_error_north'][k]:,.6g}",
-                           f"{self.histories['position_error_east'][k]:,.6g}",
-                           f"{to_unit(self.histories['psi_down'][k], 'arcsec'):.4g}")
+            series.add_row(f"{self.t_s[k] / 3600:.4g}", f"{self.states['position_error_north'][k]:,.6g}",
+                           f"{self.states['position_error_east'][k]:,.6g}",
+                           f"{to_unit(self.states['psi_down'][k], 'arcsec'):.4g}")
         return Group(summary, series)
 
 
@@ -292,5 +303,5 @@ def three_d(*, latitude: float, velocity_north: float, velocity_east: float, dur
                                                               histories["position_error_east"]))),
         schuler_period_s=2.0 * math.pi * math.sqrt(R / g), foucault_rate_rad_s=rate * math.sin(latitude),
         eigenvalues_real_per_s=eigenvalues.real, eigenvalues_imag_rad_s=eigenvalues.imag,
-        t_s=t, histories=histories, state_units=dict(zip(model.states, model.state_units)),
+        t_s=t, states=histories, state_units=dict(zip(model.states, model.state_units)),
     )
