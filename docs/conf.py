@@ -37,7 +37,8 @@ from sphinx_gallery.sorting import ExplicitOrder  # noqa: E402
 import schuler  # noqa: E402
 
 GALLERY = DOCS.parent / "examples" / "gallery"
-SYSTEM_ORDER = ("errors", "vertical", "calibrate", "align", "north", "navigate", "mission", "engine", "imu")
+SYSTEM_ORDER = ("errors", "vertical", "calibrate", "align", "north", "navigate", "mission", "aided", "engine",
+                "imu")
 """Gallery sections in the guide's order; a new system's folder is built after them ("*")."""
 
 project = "schuler"

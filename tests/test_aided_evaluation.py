@@ -1,5 +1,6 @@
-"""The aided run on simulated data (``schuler.aided.evaluation``): ideal sensors give the truth, outputs follow
-the histories, each member runs its own filter, and the filter's outage 1-sigma describes the members' drift."""
+"""The aided run on simulated data (``schuler aided``): ideal sensors give the truth, outputs follow the
+histories, each member runs its own filter, the filter's outage 1-sigma describes the members' drift; the command
+line's files and JSON."""
 
 from __future__ import annotations
 
@@ -8,19 +9,14 @@ import math
 import numpy as np
 import pytest
 
-from schuler.aided import evaluation
-from schuler.aided.plots import figures
-from schuler.contract import Cases, System
+from schuler.contract import Cases
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
+from schuler.registry import get_system
 
 SHORT = {"duration": 300.0, "outage_start": 120.0}
 
-AIDED = System(name="aided", title="Aided INS", reference="spec 07", parameters=evaluation.PARAMETERS,
-               outputs=evaluation.OUTPUTS, evaluate=evaluation.evaluate, reproduce=lambda: None,
-               report=lambda folder: None, figures=figures, random_terms=True, realisation=True,
-               member_bytes=evaluation.member_bytes)
-"""The evaluation on the contract, as the system will assemble it."""
+AIDED = get_system("aided")
 
 
 def test_ideal_sensors_and_noiseless_gnss_return_the_truth():
@@ -79,3 +75,27 @@ def test_unknown_aiding_is_refused_with_a_suggestion():
         AIDED.run(aiding="gnss-position,gnss-velocty", **SHORT)
     with pytest.raises(InvalidParameter, match="gnss-position is needed"):
         AIDED.run(aiding="gnss-velocity", **SHORT)
+
+
+def test_the_command_writes_the_histories_the_figures_and_the_json_names_scripts_rely_on(run_cli, tmp_path):
+    out = run_cli("aided", "run", "--duration", "300", "--outage-start", "120", "--json", "--out", str(tmp_path))
+    assert out.code == 0, out.stderr
+    data = out.json()
+    for key in ("position_error_horizontal_rms_m", "position_error_horizontal_max_m", "position_error_vertical_rms_m",
+                "velocity_error_horizontal_rms_m_s", "heading_error_rms_rad", "rejected_measurements"):
+        assert isinstance(data[key], float), key
+    assert set(data["outages"][0]) == {"start_s", "duration_s", "horizontal_error_max_m", "vertical_error_max_m",
+                                       "heading_error_max_rad", "horizontal_error_sigma_m"}
+    assert set(data["nees"]) == {"position", "velocity", "attitude"} and "band" in data["nis"]
+    files = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
+    assert files == ["aided_errors.csv", "aided_errors.png", "aided_errors.svg", "aided_outage_drift.png",
+                     "aided_outage_drift.svg"]
+    python = AIDED.run(duration=300.0, outage_start="2 min")
+    assert python.position_error_horizontal_rms_m == pytest.approx(data["position_error_horizontal_rms_m"], rel=1e-12)
+
+
+def test_bad_input_is_one_line_and_exit_2(run_cli):
+    out = run_cli("aided", "run", "--duration", "300", "--aiding", "gps")
+    assert out.code == 2 and out.stderr.count("\n") == 1 and "aiding" in out.stderr
+    out = run_cli("aided", "run", "--duration", "300", "--imu", "no-such-grade")
+    assert out.code == 2 and "neither a grade" in out.stderr

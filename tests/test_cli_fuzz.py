@@ -35,6 +35,7 @@ QUICK = {
     "imu": ["--duration", "120"],
     "navigate": ["--duration", "600", "--imu-rate", "10", "--output-step", "60"],
     "mission": ["--duration", "1200", "--output-step", "600"],
+    "aided": ["--duration", "300", "--imu-rate", "20", "--outage-start", "120"],
 }
 """Options that keep each system's base case short; the fuzzed option comes after them."""
 

@@ -359,6 +359,7 @@ class System:
             system=self.name, outputs=outputs, fidelity=fidelity, extras=dict(getattr(evaluation, "extras", {})),
             parameters=dict(case), histories=dict(getattr(evaluation, "histories", {})), monte_carlo=monte_carlo,
             output_units={output.name: output.unit for output in self.outputs},
+            extra_units=dict(getattr(evaluation, "units", {})),
             display_units={output.name: output.display for output in self.outputs if output.display})
         result.attach_figures(self.figures)
         return result

@@ -25,6 +25,7 @@ SYSTEM_MODULES: dict[str, str] = {
     "imu": "schuler.imu.api",
     "navigate": "schuler.navigate.api",
     "mission": "schuler.mission.api",
+    "aided": "schuler.aided.api",
 }
 """Command name of each system -> module holding its ``SYSTEM``: the one line that registers a system."""
 
@@ -37,6 +38,7 @@ SUMMARIES: dict[str, str] = {
     "imu": "IMU recordings, spec-sheet error models and Allan variance.",
     "navigate": "Nonlinear strapdown or platform INS on WGS-84.",
     "mission": "Calibrate, align, navigate: a mission's error budget.",
+    "aided": "The INS aided by GNSS through outages (error-state Kalman filter).",
 }
 """Short help of each system for ``schuler --help`` (so the help imports no system); a system without one shows
 its ``title``."""

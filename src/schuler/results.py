@@ -261,6 +261,7 @@ class SystemResult(RunResult):
     histories: dict[str, Any] = dataclasses.field(default_factory=dict, repr=False)
     output_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
     display_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
+    extra_units: dict[str, str] = dataclasses.field(default_factory=dict, repr=False)
 
     def __getattr__(self, name: str) -> Any:
         # only reached when normal lookup fails: outputs and extras read as attributes
@@ -278,7 +279,7 @@ class SystemResult(RunResult):
         if self.fidelity is not None:
             data["fidelity"] = self.fidelity
         data["monte_carlo"] = None if self.monte_carlo is None else self.monte_carlo.to_dict()
-        data["units"] = {**self.output_units, **type(self).units}
+        data["units"] = {**self.output_units, **self.extra_units, **type(self).units}
         return data
 
     def to_dataframe(self):
@@ -505,13 +506,16 @@ class Evaluation(Mapping[str, np.ndarray]):
         Time histories by file stem (``align_time_history``).
     extras : mapping of str to object, optional
         JSON-safe structured results beside the outputs.
+    units : mapping of str to str, optional
+        Units of the extras' numbers whose key does not end in one (``{"magnitude": "m/s"}``, ``"1"``: none).
     """
 
     def __init__(self, outputs: Mapping[str, Any], histories: Mapping[str, Any] | None = None,
-                 extras: Mapping[str, Any] | None = None):
+                 extras: Mapping[str, Any] | None = None, units: Mapping[str, str] | None = None):
         self.outputs = dict(outputs)
         self.histories = dict(histories or {})
         self.extras = dict(extras or {})
+        self.units = dict(units or {})
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.outputs[name]

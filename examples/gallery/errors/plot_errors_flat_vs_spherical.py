@@ -17,6 +17,7 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
+import schuler
 from schuler.navigation_errors.single_channel import flat_error, simulate_error, spherical_error
 
 FOOT = 0.3048  # m
@@ -62,8 +63,6 @@ for source, (label, size) in sources.items():
 # %%
 # One source through the system, as ``schuler errors run`` runs it: the result
 # holds the outputs, the error histories (the CSV of ``--out``) and its figure.
-import schuler
-
 run = schuler.get_system("errors").run(source="drift", earth="bollay")
 print(f"largest spherical error {run.max_spherical_m / FOOT:,.0f} ft, Schuler period {run.schuler_period_s:.0f} s")
 print(run.to_dataframe().iloc[::250])

@@ -18,6 +18,7 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
+import schuler
 from schuler.core.earth import DROZDOVICH
 from schuler.gyro_vertical.model import GyroVertical
 from schuler.gyro_vertical.quasi_steady import split_schuler_frequencies
@@ -50,8 +51,6 @@ print(f"split Schuler periods {2 * math.pi / fast / 60:.2f} and {2 * math.pi / s
 # %%
 # The same case through the system, as ``schuler vertical run`` runs it: the
 # outputs, the histories (the CSV of ``--out``) and its figures.
-import schuler
-
 run = schuler.get_system("vertical").run(latitude=latitude, earth="drozdovich", duration=48 * 3600.0,
                                          output_step=60.0, trajectory="frozen")
 print(f"systematic error {run.velocity_error_y_mean_m_s:.3f} m/s, fitted periods "

@@ -44,7 +44,7 @@ START_SIGMA = (1.0, 0.1, (math.radians(0.1), math.radians(0.1), math.radians(1.0
 
 PARAMETERS = ParameterSet((
     Parameter("duration", "s", 1500.0, "Length of the drive (stops, turns, town and road speeds).",
-              minimum=120.0, maximum=4 * 3600.0),
+              minimum=300.0, maximum=4 * 3600.0),
     Parameter("latitude", "deg", 30.5, "Latitude of the drive's start.", minimum=-80.0, maximum=80.0),
     Parameter("imu", "", "tactical", "IMU: a grade (navigation, tactical, industrial, consumer), a TOML spec file "
               "or a recording whose identified noise terms are used.", kind="text"),
@@ -242,7 +242,7 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
         return Evaluation(outputs)
     case, run, errors, outages = kept
     return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors)},
-                      extras=run_extras(run, errors, outages))
+                      extras=run_extras(run, errors, outages), units={"inside": "1", "band": "1"})
 
 
 def error_histories(run, errors) -> Histories:
