@@ -71,7 +71,7 @@ def get_system(name: str) -> System:
     Traceback (most recent call last):
     ...
     schuler.exceptions.InvalidParameter: system: 'allign' is not a system; did you mean 'align'?
-    choose from errors, vertical, calibrate, align, north, imu, navigate, mission
+    choose from errors, vertical, calibrate, align, north, imu, navigate, mission, aided
     """
     if name not in SYSTEM_MODULES:
         hint = difflib.get_close_matches(str(name), SYSTEM_MODULES, n=1)

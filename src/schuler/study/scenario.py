@@ -44,7 +44,7 @@ Examples
 Traceback (most recent call last):
 ...
 schuler.exceptions.ScenarioError: s.toml: system: 'compass' is not one of errors, vertical, calibrate, align, north,
-imu, navigate, mission
+imu, navigate, mission, aided
 """
 
 from __future__ import annotations
