@@ -48,6 +48,10 @@ def test_monte_carlo_positions_and_files(run_cli, tmp_path):
     assert cycle["t_s"].iloc[-1] == pytest.approx(10.0)
     members = pd.read_csv(tmp_path / "calibrate_monte_carlo.csv")
     assert len(members) == 200 and "azimuth_error_rad" in members
+    # the files a Monte Carlo run writes, exactly: the cycle's histories and figure, the members' errors
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
+        "calibrate_cycle.csv", "calibrate_cycle.png", "calibrate_cycle.svg", "calibrate_monte_carlo.csv",
+        "calibrate_monte_carlo.png", "calibrate_monte_carlo.svg"]
 
 
 @pytest.mark.parametrize("args, option", [
@@ -102,6 +106,9 @@ def test_reproduce(run_cli, tmp_path):
     assert not [row for row in data["rows"] if row["verdict"].startswith("differs")]
     assert data["inputs"] == {"monte_carlo": 300, "seed": 0} and data["units"]["computed"] == "the row's unit"
     assert (tmp_path / "calibrate_reproduction_monte_carlo.svg").stat().st_size > 1000
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
+        "calibrate_reproduction_monte_carlo.png", "calibrate_reproduction_monte_carlo.svg",
+        "calibrate_reproduction_summary.csv"]
     summary = pd.read_csv(tmp_path / "calibrate_reproduction_summary.csv")
     assert summary["rms_azimuth_error_rad"].iloc[1] == pytest.approx(math.radians(2.0 / 60), rel=1e-3)
     human = run_cli("calibrate", "reproduce", "--monte-carlo", "200")

@@ -301,3 +301,22 @@ def test_report_writes_its_figures(tmp_path):
         assert (tmp_path / figure.path).stat().st_size > 10_000
         assert (tmp_path / figure.path).with_suffix(".svg").exists()
     assert any("--drift-x" in command for command in section.commands)
+
+
+def test_run_result_reads_as_a_table_a_figure_html_and_json():
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    r = SYSTEM.run(drift_x=0.25 * DEG_H, monte_carlo=30)
+    frame = r.to_dataframe()
+    assert isinstance(frame, pd.DataFrame) and frame.index.name == "t_s"
+    assert list(frame.columns) == ["platform_angle_rad", "sensor_signal_V", "integrator_output_V_s"]
+    figure = r.plot()
+    assert isinstance(figure, plt.Figure) and set(r.figures()) == {"calibrate_cycle", "calibrate_monte_carlo"}
+    plt.close("all")
+    assert "<pre" in r._repr_html_() and "estimated drift X" in r._repr_html_()
+    data = r.to_dict()
+    assert data["drift_x_rad_s"] == pytest.approx(0.25 * DEG_H, rel=1e-9) and data["mode"] == "three-axis"
+    assert data["true_azimuth_rad"] == pytest.approx(math.radians(80.0)) and data["units"]["positions"] == "1"
+    stats = r.monte_carlo["azimuth_error_rad"]
+    assert stats.count == 30 and stats.std > 0

@@ -12,6 +12,6 @@ Modules: ``pulses`` (shapes, symmetry), ``stabilizer`` (one cycle, exact
 simulation and closed forms), ``procedure`` ((15)/(16), asin/atan2,
 multi-position), ``plant`` (3-D first-principles plant), ``error_budget`` (the
 documented budget), ``draws`` (the budget's errors drawn per member),
-``evaluation`` (parameters, outputs, ``evaluate``, ``run_case``), ``results``,
+``evaluation`` (parameters, outputs, ``evaluate``), ``results`` (result type, figures),
 ``reproduction``, ``plots``, ``api`` (``SYSTEM``).
 """

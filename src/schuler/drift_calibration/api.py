@@ -17,6 +17,7 @@ Examples
 from __future__ import annotations
 
 from functools import partial
+from pathlib import Path
 
 from schuler.alignment.commands import calibrate_compare_action
 from schuler.contract import System
@@ -25,17 +26,18 @@ from schuler.drift_calibration.evaluation import (
     PARAMETERS,
     evaluate,
     member_bytes,
-    run_case,
 )
 from schuler.drift_calibration.reproduction import (
     REPRODUCE_PARAMETERS,
     report,
     reproduce,
 )
-from schuler.drift_calibration.results import write_files
+from schuler.drift_calibration.results import CalibrationResult, data_files, figures
 from schuler.imu.instrument import apply_options, instrument_options
 from schuler.params import Case
 from schuler.references import PULSE_CALIBRATION
+from schuler.reproduction import Reproduction
+from schuler.results import Result, SystemResult
 
 SECONDS_PER_PHASE = 4e-5
 """Time of one position of one channel and cycle of a member's procedure, s (the default three-axis procedure,
@@ -54,6 +56,17 @@ def member_seconds(case: Case) -> float:
     return SECONDS_PER_PHASE * channels * int(case["positions"]) * int(case["cycles"])
 
 
+COMPARE = calibrate_compare_action(PARAMETERS, evaluate)
+"""``calibrate compare``: built by :mod:`schuler.alignment`, which writes its files."""
+
+
+def _files(result: Result, out_dir: Path) -> list[Path]:
+    """The system's data files; a comparison's files from its own writer (the generic writer calls no action's)."""
+    if COMPARE.write_files is not None and not isinstance(result, (SystemResult, Reproduction)):
+        return COMPARE.write_files(result, out_dir)
+    return data_files(result, out_dir)
+
+
 SYSTEM = System(
     name="calibrate",
     title="Gyro drift calibration by alternating-sign torque pulses, with autonomous azimuth",
@@ -61,12 +74,13 @@ SYSTEM = System(
     parameters=PARAMETERS,
     outputs=OUTPUTS,
     evaluate=evaluate,
-    run_case=run_case,
     reproduce=reproduce,
     reproduce_parameters=REPRODUCE_PARAMETERS,
-    write_files=write_files,
+    figures=figures,
+    data_files=_files,
+    result_type=CalibrationResult,
     report=report,
-    actions=(calibrate_compare_action(PARAMETERS, evaluate),),
+    actions=(COMPARE,),
     random_terms=True,
     member_bytes=member_bytes,
     member_seconds=member_seconds,

@@ -1,4 +1,4 @@
-"""What the drift calibration evaluates: its parameters, outputs, ``evaluate`` and ``run_case``.
+"""What the drift calibration evaluates: its parameters, outputs and ``evaluate`` (with one cycle's histories).
 
 Source: the alternating-pulse calibration article
 (:data:`schuler.references.PULSE_CALIBRATION`); equation numbers are its own.
@@ -38,8 +38,9 @@ from typing import Any
 
 import numpy as np
 
-from schuler.contract import Cases, Output
+from schuler.contract import Cases, Evaluation, Output
 from schuler.core.earth import EARTH_RATE
+from schuler.core.response import Histories
 from schuler.drift_calibration.draws import draw_errors
 from schuler.drift_calibration.procedure import (
     MODES,
@@ -48,7 +49,6 @@ from schuler.drift_calibration.procedure import (
     run_procedure,
 )
 from schuler.drift_calibration.pulses import SHAPES
-from schuler.drift_calibration.results import CalibrationResult, CycleHistory
 from schuler.drift_calibration.stabilizer import (
     NOISE_STEPS,
     Stabilizer,
@@ -232,13 +232,20 @@ def check_observable(latitude: np.ndarray, max_latitude: np.ndarray) -> None:
             DegradedAccuracyWarning, stacklevel=2)
 
 
-def evaluate(cases: Cases) -> dict[str, np.ndarray]:
+def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
+
+    With ``histories`` it is the run in full of the batch's first case: an
+    :class:`~schuler.contract.Evaluation` with the error-free cycle's histories
+    (``calibrate_cycle``) and, as extras, the mode, the procedure's shape and
+    the true drifts, Earth-rate component and azimuth.
 
     Parameters
     ----------
     cases : Cases
         A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
+    histories : bool
+        Whether to return the first case's cycle histories and true values too.
 
     Examples
     --------
@@ -259,7 +266,24 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
             part = np.arange(start, min(start + step, len(group)))
             for name, values in _evaluate_batch(group.take(part), first, stabilizer).items():
                 out[name][index[part]] = values
-    return out
+    return _in_full(cases.case(0), out) if histories else out
+
+
+def _in_full(case: Case, outputs: dict[str, np.ndarray]) -> Evaluation:
+    """The outputs with one error-free cycle's histories and the case's true values."""
+    stabilizer = stabilizer_of(case)
+    drift_y = case["drift_x"] if case["drift_y"] is None else case["drift_y"]
+    omega_x0 = float(apparent_drift(case["latitude"], case["azimuth"])[0])
+    cycle = simulate_cycle(stabilizer, np.array([case["drift_x"] + omega_x0]), keep_history=True)
+    cycle_history = Histories(cycle.time, {
+        "platform_angle_rad": cycle.platform_angle[0], "sensor_signal_V": cycle.sensor_signal[0],
+        "integrator_output_V_s": cycle.integrator_output[0]},
+        {"platform_angle_rad": "rad", "sensor_signal_V": "V", "integrator_output_V_s": "V s"})
+    extras: dict[str, Any] = {
+        "mode": case["mode"], "positions": int(case["positions"]), "cycles": int(case["cycles"]),
+        "true_drift_x_rad_s": case["drift_x"], "true_drift_y_rad_s": drift_y,
+        "true_earth_rate_component_rad_s": omega_x0, "true_azimuth_rad": case["azimuth"] % (2 * math.pi)}
+    return Evaluation(outputs, histories={"calibrate_cycle": cycle_history}, extras=extras)
 
 
 def _instrument_groups(cases: Cases):
@@ -303,37 +327,3 @@ def _evaluate_batch(cases: Cases, instrument: Case, stabilizer: Stabilizer) -> d
         "cycle_time_s": np.full(n, stabilizer.cycle_time),
         "procedure_time_s": np.full(n, procedure_time(stabilizer.tau, mode, positions, cycles)),
     }
-
-
-def run_case(case: Case, fidelity: str | None = None) -> CalibrationResult:
-    """One procedure in full: the outputs of :func:`evaluate`, the true values and one cycle's histories.
-
-    ``fidelity`` is accepted for the contract; the system has one way of evaluating.
-
-    Parameters
-    ----------
-    case : Case
-        A validated case (SI values).
-    fidelity : str, optional
-        One of the system's fidelities (default: the first).
-
-    Examples
-    --------
-    >>> r = run_case(PARAMETERS.case())
-    >>> round(float(np.degrees(r.azimuth_rad)), 6), round(float(np.degrees(r.drift_x_rad_s)) * 3600, 9)
-    (80.0, 0.1)
-    """
-    outputs: dict[str, Any] = {name: float(values[0]) for name, values in evaluate(Cases.from_case(case)).items()}
-    outputs["asin_saturated"] = bool(outputs["asin_saturated"])
-    stabilizer = stabilizer_of(case)
-    drift_y = case["drift_x"] if case["drift_y"] is None else case["drift_y"]
-    omega_x0 = float(apparent_drift(case["latitude"], case["azimuth"])[0])
-    cycle = simulate_cycle(stabilizer, np.array([case["drift_x"] + omega_x0]), keep_history=True)
-    return CalibrationResult(
-        mode=case["mode"], positions=int(case["positions"]), cycles=int(case["cycles"]),
-        true_drift_x_rad_s=case["drift_x"], true_drift_y_rad_s=drift_y, true_earth_rate_component_rad_s=omega_x0,
-        true_azimuth_rad=case["azimuth"] % (2 * math.pi),
-        **outputs,
-        cycle_history=CycleHistory(cycle.time, cycle.platform_angle[0], cycle.sensor_signal[0],
-                                   cycle.integrator_output[0]),
-    )

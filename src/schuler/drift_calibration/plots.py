@@ -15,8 +15,9 @@ def plot_cycle(history, title: str = "One measurement cycle"):
 
     Parameters
     ----------
-    history : CycleHistory
-        The cycle's time histories (:class:`~schuler.drift_calibration.results.CycleHistory`, SI).
+    history : Histories
+        The cycle's time histories (:class:`~schuler.core.response.Histories`: ``platform_angle_rad``,
+        ``sensor_signal_V``, ``integrator_output_V_s`` against time, s).
     title : str
         Figure title.
     """
@@ -24,11 +25,11 @@ def plot_cycle(history, title: str = "One measurement cycle"):
 
     time = history.time
     fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
-    axes[0].plot(time, to_unit(history.platform_angle, "arcsec"), label="platform angle alpha_X")
+    axes[0].plot(time, to_unit(history["platform_angle_rad"], "arcsec"), label="platform angle alpha_X")
     axes[0].set_ylabel("angle [arcsec]")
-    axes[1].plot(time, history.sensor_signal, color="tab:orange", label="command-sensor signal U")
+    axes[1].plot(time, history["sensor_signal_V"], color="tab:orange", label="command-sensor signal U")
     axes[1].set_ylabel("U [V]")
-    axes[2].plot(time, history.integrator_output, color="tab:green", label="integrator output")
+    axes[2].plot(time, history["integrator_output_V_s"], color="tab:green", label="integrator output")
     axes[2].set_ylabel("integrator [V s]")
     axes[2].set_xlabel("time [s]")
     for axis in axes:

@@ -20,18 +20,16 @@ are inputs tuned to match, and the rows say so. Constants: WGS-84 Earth rate
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from pathlib import Path
 
 import numpy as np
 
-from schuler.contract import FigureRef, ReportSection, monte_carlo
+from schuler.contract import Cases, FigureRef, ReportSection, monte_carlo
 from schuler.core.earth import EARTH_RATE
 from schuler.core.random import RandomStreams
 from schuler.drift_calibration import evaluation
 from schuler.drift_calibration.error_budget import TYPICAL, ErrorBudget
-from schuler.drift_calibration.results import write_files
 from schuler.params import Parameter, ParameterSet
 from schuler.references import PULSE_CALIBRATION
 from schuler.reproduction import Reproduction, Tolerance, compare
@@ -116,7 +114,7 @@ def reproduce(monte_carlo: int = 2000, seed: int = 0) -> Reproduction:
     scaled_budget = TYPICAL.scaled(scale)
     scaled = {mode: _monte_carlo(source_case(scaled_budget, drift_x=drift, mode=mode), monte_carlo, seed)
               for mode in ("three-axis", "single-axis")}
-    nominal = evaluation.run_case(source_case())
+    cycle_time = float(evaluation.evaluate(Cases.from_case(source_case()))["cycle_time_s"][0])
     three, single = scaled["three-axis"].statistics, scaled["single-axis"].statistics
     drift_text = f"{to_unit(drift, 'deg/h'):g} deg/h"
     rows = [
@@ -129,7 +127,7 @@ def reproduce(monte_carlo: int = 2000, seed: int = 0) -> Reproduction:
                 tolerance=Tolerance(0.02),
                 tuned=f"drifts of {drift_text} chosen to give it (the source states none; the relative error "
                       "scales as 1/drift)"),
-        compare("measurement cycle 2 tau (single-axis experiments)", nominal.cycle_time_s, "s",
+        compare("measurement cycle 2 tau (single-axis experiments)", cycle_time, "s",
                 printed="от 8 с до 15 с", value=sum(SOURCE_CYCLE_TIME) / 2, where=WHERE + ", experiments",
                 tolerance=Tolerance(0.0, (SOURCE_CYCLE_TIME[1] - SOURCE_CYCLE_TIME[0]) / 2),
                 tuned="pulse_duration 5 s chosen inside the source's range"),
@@ -223,13 +221,13 @@ def report(figures_dir: Path) -> ReportSection:
         The report's figure folder.
 
     """
+    from schuler.drift_calibration.api import SYSTEM
     from schuler.drift_calibration.plots import plot_trade_offs
     from schuler.io import save_figure_formats
 
     figures_dir = Path(figures_dir)
     case = evaluation.PARAMETERS.case()
-    run = dataclasses.replace(evaluation.run_case(case), monte_carlo=_monte_carlo(case, 1000, 0))
-    files = write_files(run, figures_dir)
+    files = SYSTEM.write(SYSTEM.result(case, monte_carlo=_monte_carlo(case, 1000, 0)), figures_dir)
     positions, by_positions = error_versus_positions(members=200)
     cycle_times, by_cycle = error_versus_cycle_time(members=200)
     files += save_figure_formats(plot_trade_offs(positions, by_positions, cycle_times, by_cycle),

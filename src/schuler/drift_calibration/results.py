@@ -1,71 +1,30 @@
-"""What ``schuler calibrate run`` returns and writes: :class:`CalibrationResult` and :func:`write_files`."""
+"""What ``schuler calibrate`` returns and draws: :class:`CalibrationResult`, :func:`figures`, :func:`data_files`."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar
-
-import numpy as np
+from typing import Any, ClassVar
 
 from schuler.reproduction import Reproduction
-from schuler.results import Result, RunResult
+from schuler.results import Result, SystemResult
 from schuler.units import to_unit
 
-
-@dataclass(frozen=True)
-class CycleHistory:
-    """One measurement cycle of the nominal case, for figures and files.
-
-    Attributes
-    ----------
-    time : ndarray
-        Time since the start of the cycle, s.
-    platform_angle : ndarray
-        Platform angle alpha_X relative to the base, rad.
-    sensor_signal : ndarray
-        Command-sensor signal U, V.
-    integrator_output : ndarray
-        Integrator output, V s (its final value is the reading Delta U of (11)).
-    """
-
-    time: np.ndarray
-    platform_angle: np.ndarray
-    sensor_signal: np.ndarray
-    integrator_output: np.ndarray
+MONTE_CARLO_ERRORS = ("drift_x_error_rad_s", "drift_y_error_rad_s", "azimuth_error_rad", "relative_drift_error")
+"""The outputs whose members a Monte Carlo's histograms and CSV show."""
 
 
-@dataclass
-class CalibrationResult(RunResult):
-    """One calibration procedure: estimated and true drifts and azimuth (every output of ``evaluate``).
+@dataclass(kw_only=True)
+class CalibrationResult(SystemResult):
+    """One calibration procedure, rendered as the calibration reads: estimates beside the truths.
 
     Rates in rad/s, angles in rad, times in s; ``render()`` shows deg/h, deg and
-    arcmin. The ``true_*`` fields are the case's values, the others what the
+    arcmin. The extras ``true_*`` are the case's values, the outputs what the
     procedure estimated; errors are estimated - true. In single-axis mode the
-    Y gyro is not measured (its estimate and error are NaN, null in JSON).
+    Y gyro is not measured (its estimate and error are NaN, null in JSON). The
+    histories ``calibrate_cycle`` are one error-free measurement cycle.
     """
-
-    mode: str
-    positions: int
-    cycles: int
-    true_drift_x_rad_s: float
-    true_drift_y_rad_s: float
-    true_earth_rate_component_rad_s: float
-    true_azimuth_rad: float
-    drift_x_rad_s: float
-    drift_y_rad_s: float
-    drift_x_error_rad_s: float
-    drift_y_error_rad_s: float
-    relative_drift_error: float
-    earth_rate_component_rad_s: float
-    azimuth_rad: float
-    azimuth_alternative_rad: float
-    azimuth_error_rad: float
-    asin_saturated: bool
-    cycle_time_s: float
-    procedure_time_s: float
-    cycle_history: CycleHistory | None = field(default=None, repr=False)
 
     units: ClassVar[dict[str, str]] = {"relative_drift_error": "1", "positions": "1", "cycles": "1"}
 
@@ -124,43 +83,53 @@ def _shown(value, unit: str, digits: int, fixed: bool = True) -> str:
     return f"{text} {unit}"
 
 
-def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """Figures (PNG and SVG) and CSV data of a run, its Monte Carlo, or the reproduction.
+def figures(result: Result) -> dict[str, Any]:
+    """The figures of a run (one cycle, its Monte Carlo's errors) or of the reproduction, by file stem.
+
+    Parameters
+    ----------
+    result : Result
+        What ``run``, ``reproduce`` or an action returned ({} for others).
+    """
+    from schuler.drift_calibration import plots
+
+    if isinstance(result, Reproduction):
+        return {"calibrate_reproduction_monte_carlo": plots.plot_histograms(result.data["samples"],
+                                                                            result.data["title"])}
+    if not isinstance(result, SystemResult):
+        return {}
+    drawn = {}
+    if "calibrate_cycle" in result.histories:
+        drawn["calibrate_cycle"] = plots.plot_cycle(result.histories["calibrate_cycle"])
+    if result.monte_carlo is not None:
+        title = f"Monte Carlo, {result.monte_carlo.members} members ({result.extras.get('mode', '')})"
+        drawn["calibrate_monte_carlo"] = plots.plot_histograms(_members(result), title)
+    return drawn
+
+
+def data_files(result: Result, out_dir: Path) -> list[Path]:
+    """The CSV files beside the histories: a Monte Carlo's members' errors, the reproduction's summary.
 
     Parameters
     ----------
     result : Result
         What ``run``, ``reproduce`` or an action returned.
     out_dir : Path
-        Folder for the figures (PNG, SVG) and data files (CSV); created if missing.
+        Folder for the CSV files (exists: the writer made it).
     """
     import pandas as pd
 
-    from schuler.drift_calibration import plots
-    from schuler.io import save_figure_formats, write_dataframe_csv
+    from schuler.io import write_dataframe_csv
 
     out_dir = Path(out_dir)
-    files: list[Path] = []
     if isinstance(result, Reproduction):
-        samples = result.data["samples"]
-        files += save_figure_formats(plots.plot_histograms(samples, result.data["title"]),
-                                     out_dir / "calibrate_reproduction_monte_carlo")
-        files.append(write_dataframe_csv(pd.DataFrame(result.data["summary"]),
-                                         out_dir / "calibrate_reproduction_summary.csv"))
-        return files
-    if not isinstance(result, CalibrationResult):
-        raise TypeError(f"calibrate writes no files for {type(result).__name__}")
-    history = result.cycle_history
-    if history is not None:
-        files += save_figure_formats(plots.plot_cycle(history), out_dir / "calibrate_cycle")
-        files.append(write_dataframe_csv(pd.DataFrame({
-            "t_s": history.time, "platform_angle_rad": history.platform_angle,
-            "sensor_signal_V": history.sensor_signal, "integrator_output_V_s": history.integrator_output,
-        }), out_dir / "calibrate_cycle.csv"))
-    if result.monte_carlo is not None:
-        samples = {name: result.monte_carlo.samples[name] for name in
-                   ("drift_x_error_rad_s", "drift_y_error_rad_s", "azimuth_error_rad", "relative_drift_error")}
-        title = f"Monte Carlo, {result.monte_carlo.members} members ({result.mode})"
-        files += save_figure_formats(plots.plot_histograms(samples, title), out_dir / "calibrate_monte_carlo")
-        files.append(write_dataframe_csv(pd.DataFrame(samples), out_dir / "calibrate_monte_carlo.csv"))
-    return files
+        return [write_dataframe_csv(pd.DataFrame(result.data["summary"]),
+                                    out_dir / "calibrate_reproduction_summary.csv")]
+    if isinstance(result, SystemResult) and result.monte_carlo is not None:
+        return [write_dataframe_csv(pd.DataFrame(_members(result)), out_dir / "calibrate_monte_carlo.csv")]
+    return []
+
+
+def _members(result: SystemResult) -> dict[str, Any]:
+    assert result.monte_carlo is not None
+    return {name: result.monte_carlo.samples[name] for name in MONTE_CARLO_ERRORS}
