@@ -222,11 +222,13 @@ class System:
         action : str, optional
             The action that made ``result`` (its own writer, where it has one).
         """
+        chosen = None if action is None else self.actions[[a.name for a in self.actions].index(action)]
+        if chosen is not None and chosen.write_files is not None:
+            # an action whose results another package builds (a comparison) writes its own files
+            return chosen.write_files(result, Path(out_dir))
         if not self.evaluates_histories:
-            chosen = None if action is None else self.actions[[a.name for a in self.actions].index(action)]
-            writer = (chosen.write_files if chosen is not None else None) or self.write_files
-            assert writer is not None, f"{self.name} declares neither figures nor write_files"
-            return writer(result, Path(out_dir))
+            assert self.write_files is not None, f"{self.name} declares neither figures nor write_files"
+            return self.write_files(result, Path(out_dir))
         return write_result(result, Path(out_dir), self.data_files)
 
     def case(self, **si_values) -> Case:
