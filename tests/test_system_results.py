@@ -24,7 +24,13 @@ from schuler.results import MonteCarloStatistics, SystemResult
 from test_contract import NAMES, light
 
 
-@pytest.mark.parametrize("name", NAMES)
+ON_RUN_CASE = {name for name in NAMES if not get_system(name).evaluates_histories}
+"""Systems not yet moved to the one evaluation (they keep ``run_case`` and ``write_files``): held to the test as
+strict expected failures, so each leaves this set the moment it moves (the set only shrinks)."""
+
+
+@pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.xfail(
+    name in ON_RUN_CASE, reason="still on run_case", strict=True)) for name in NAMES])
 def test_every_system_runs_through_evaluate_into_one_result_type_that_plots(name):
     system = get_system(name)
     assert system.evaluates_histories, f"{name} still has run_case"
