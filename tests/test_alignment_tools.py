@@ -20,6 +20,7 @@ from schuler.alignment.commands import align_compare
 from schuler.alignment.multi_static import MultiStaticPlan, calibrate_multi_static, identifiable_truth
 from schuler.alignment.north import AXES, NORTH_METHODS, find_north, north_sigma, schedule, turntable_rates
 from schuler.alignment.north_comparison import compare_north
+from schuler.alignment.plots import comparison_data_files, comparison_figures
 from schuler.alignment.six_position import SixPositionPlan, calibrate_six_position
 from schuler.exceptions import InvalidParameter
 from schuler.imu.simulate import ImuSimulator
@@ -286,3 +287,32 @@ def test_north_and_calibrate_compare_commands(run_cli, tmp_path):
     assert {"accel_non_orthogonality", "gyro_matrix"} <= set(calibration["multi_static"])
     written = json.dumps(calibration)
     assert "NaN" not in written
+
+
+def test_comparisons_plot_and_write_their_table(tmp_path):
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    from schuler.registry import get_system
+
+    align = get_system("align")
+    result = align.action("compare")(imu="navigation", duration=60.0, imu_rate=10.0)
+    plt.close(result.plot())
+    frame = result.to_dataframe()
+    assert set(frame.columns) == {f"{m}_{c}" for m in result.estimates for c in ("t_s", "heading_rad")}
+    names = {p.name for p in align.write(result, tmp_path, action="compare")}
+    assert names == {"align_compare_heading.png", "align_compare_heading.svg", "align_compare_heading.csv"}
+    written = pd.read_csv(tmp_path / "align_compare_heading.csv")
+    np.testing.assert_allclose(written["kalman_heading_rad"].dropna(), frame["kalman_heading_rad"].dropna())
+    estimate = result.estimates["kalman"]
+    assert "kalman" in str(estimate) and estimate.to_dict()["method"] == "kalman"
+    history = estimate.to_dataframe()
+    assert len(history) == estimate.time_s.size and "heading_sigma_rad" in history
+    north = compare_north("tactical", latitude_rad=math.radians(45.0), heading_rad=0.5, duration_s=60.0,
+                          sample_interval_s=0.5, members=3)
+    assert list(north.to_dataframe().columns) == list(north.versus_time)
+    figures = comparison_figures(north)
+    assert set(figures) == {"north_compare_accuracy"} and comparison_figures(estimate) == {}
+    names = {p.name for p in comparison_data_files(north, tmp_path / "north")}
+    assert names == {"north_compare_accuracy.csv"}
+    plt.close("all")

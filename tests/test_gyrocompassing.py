@@ -436,3 +436,47 @@ def test_simulated_band_time_lies_below_the_envelope_time_of_the_oscillation():
     simulated = swept["settling_time_simulated_s"]
     assert np.all(simulated <= envelope + 0.1) and np.all(simulated >= envelope - np.pi / omega - 0.1)
     assert np.all(simulated < 5 / h) and swept["settling_time_s"] == pytest.approx(5 / h)
+
+
+def test_run_reads_as_a_result_in_python(tmp_path):
+    import matplotlib.pyplot as plt
+    import pandas as pd
+    from matplotlib.figure import Figure
+
+    r = SYSTEM.run(latitude="50 deg", drift_east="0.01 deg/h", duration=1200.0)
+    frame = r.to_dataframe()
+    assert isinstance(frame, pd.DataFrame) and frame.index.name == "t_s"
+    assert list(frame.columns) == ["delta_rad", "beta_rad", "delta_rate_rad_s", "alpha_rad", "mu_rad", "nu_rad"]
+    assert frame["delta_rad"].iloc[-1] == r.azimuth_error_rad
+    figure = r.plot()
+    assert isinstance(figure, Figure)
+    plt.close(figure)
+    assert "Gyrocompassing" in r._repr_html_() and "arcmin" in str(r)
+    data = r.to_dict()
+    assert data["azimuth_error_rad"] == pytest.approx(r.azimuth_error_rad, rel=1e-14) and data["constraints_ok"] is True
+    assert (data["model"], data["regime"], data["constraint_violations"]) == ("full", "oscillatory", [])
+    mc = SYSTEM.run(latitude="50 deg", monte_carlo=200, seed=3, fidelity="closed")
+    stats = mc.monte_carlo["azimuth_error_rad"]
+    assert stats.count == 200 and stats.std == pytest.approx(mc.azimuth_error_sigma_rad, rel=0.2)
+    assert mc.histories == {} and set(mc.figures()) == {"align_monte_carlo"}
+    plt.close("all")
+
+
+def test_out_writes_the_files_of_each_result(tmp_path):
+    run = SYSTEM.run(duration=600.0, monte_carlo=20)
+    names = {p.name for p in SYSTEM.write(run, tmp_path / "run")}
+    assert names == {f"{stem}.{suffix}" for stem in ("align_time_history", "align_phase_trajectory",
+                                                     "align_monte_carlo") for suffix in ("png", "svg")} \
+        | {"align_time_history.csv"}
+    import pandas as pd
+
+    table = pd.read_csv(tmp_path / "run" / "align_time_history.csv")
+    assert list(table.columns) == ["t_s", "delta_rad", "beta_rad", "delta_rate_rad_s", "alpha_rad", "mu_rad",
+                                   "nu_rad"]
+    np.testing.assert_allclose(table["delta_rad"], run.histories["align_time_history"]["delta_rad"])
+    simplified = SYSTEM.run(duration=600.0, model="simplified")
+    assert list(simplified.to_dataframe().columns) == ["delta_rad", "beta_rad", "delta_rate_rad_s"]
+    closed = {p.name for p in SYSTEM.write(SYSTEM.run(fidelity="closed"), tmp_path / "closed")}
+    assert closed == set()
+    reproduced = {p.name for p in SYSTEM.write(SYSTEM.reproduce(), tmp_path / "reproduce")}
+    assert reproduced == {"align_reproduction_time_history.png", "align_reproduction_time_history.svg"}

@@ -25,11 +25,18 @@ simplified = align.run(latitude=math.radians(50), drift_east=drift, model="simpl
 
 fig, ax = plt.subplots(figsize=(8, 3.6), layout="constrained")
 for result, label in ((full, "full model (1.18)"), (simplified, "simplified (1.19)")):
-    ax.plot(result.run.time, np.degrees(result.run.delta) * 60, label=label)
+    history = result.to_dataframe()  # align_time_history, indexed by t_s
+    ax.plot(history.index, np.degrees(history["delta_rad"]) * 60, label=label)
 ax.axhline(math.degrees(full.azimuth_error_analytic_rad) * 60, color="k", ls=":", lw=0.8, label="steady state (1.21)")
 ax.axvline(full.settling_time_s, color="grey", ls="--", lw=0.8, label="settling time 5 / h")
 ax.set(xlabel="time, s", ylabel="azimuth error δ, arcmin", ylim=(-20, 65))
 ax.legend()
+plt.show()
+
+# %%
+# The system's own figures of a run, as ``--out`` writes them:
+print(full)
+full.plot("align_phase_trajectory")
 plt.show()
 
 # %%

@@ -97,6 +97,16 @@ class CalibrationComparison(Result):
              "six_position": "gyro_* rad/s (biases) or 1 (matrix entries); accel_* m/s^2 or 1; z 1",
              "multi_static": "as six_position; accel_non_orthogonality rad", "pulse": "rad/s, rad, s"}
 
+    def to_dataframe(self):
+        """One row per estimated coefficient: procedure, quantity, index, estimate, true, sigma, z (SI)."""
+        import pandas as pd
+
+        return pd.DataFrame([
+            {"procedure": procedure, "quantity": key, "index": i, "estimate": e, "true": t, "sigma": s, "z": z}
+            for procedure, block in (("six_position", self.six_position), ("multi_static", self.multi_static))
+            for key, entry in block.items() if isinstance(entry, dict)
+            for i, (e, t, s, z) in enumerate(zip(entry["estimate"], entry["true"], entry["sigma"], entry["z"]))])
+
     def render(self):
         from rich.console import Group
         from rich.table import Table

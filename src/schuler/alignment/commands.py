@@ -1,9 +1,12 @@
 """The suite's commands as contract Actions: ``align compare``, ``north compare``, ``calibrate compare``.
 
 Each is an :class:`~schuler.contract.Action` whose function takes validated SI
-values and returns a result of this package (written by
-:func:`~schuler.alignment.plots.write_files`). The systems that own the command
-names add them to their ``actions``; the north and calibrate ones hand over
+values and returns a result of this package, drawn by
+:func:`~schuler.alignment.plots.comparison_figures`; its table (``to_dataframe()``)
+is the CSV beside the figure (:func:`~schuler.alignment.plots.comparison_data_files`;
+:func:`~schuler.alignment.plots.write_files` writes both for a system that writes
+its own files). The systems that own the command names add them to their
+``actions``; the north and calibrate ones hand over
 their own evaluation (``parameters`` and ``evaluate`` of system 5 or 3) so that
 the ground gyrocompass and the pulse method stand beside the new methods
 without this package importing a seed system.
@@ -34,7 +37,7 @@ from schuler.alignment.comparison import (
 from schuler.alignment.data import StaticBatch
 from schuler.alignment.north import AXES, DEFAULT_CAROUSEL_PERIOD
 from schuler.alignment.north_comparison import NorthComparison, compare_north
-from schuler.alignment.plots import write_files
+from schuler.alignment.plots import comparison_figures, write_files
 from schuler.contract import Action, Cases
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
@@ -236,7 +239,8 @@ def north_compare_action(parameters: ParameterSet, evaluate: Callable) -> Action
                   "Simulated records of --imu GRADE; each method's azimuth with its fit 1-sigma, its analytic "
                   "accuracy and its Monte Carlo spread; accuracy against time and grade, the ground gyrocompass "
                   "(this system, read with the grade's angle noise) on the same figure with --out.",
-                  north_compare, NORTH_COMPARE_PARAMETERS, write_files=write_files)
+                  north_compare, NORTH_COMPARE_PARAMETERS, write_files=write_files,
+                  figures=comparison_figures)
 
 
 def calibrate_compare_action(parameters: ParameterSet, evaluate: Callable) -> Action:
@@ -276,7 +280,8 @@ def calibrate_compare_action(parameters: ParameterSet, evaluate: Callable) -> Ac
                   "One simulated IMU of --imu GRADE: six positions with a rate test and the automatic multi-static "
                   "method (Tedaldi et al. 2014), every estimate beside the truth and its predicted 1-sigma; "
                   "the pulse method's drift spread from this system's Monte Carlo.",
-                  calibrate_compare, CALIBRATE_COMPARE_PARAMETERS, write_files=write_files)
+                  calibrate_compare, CALIBRATE_COMPARE_PARAMETERS, write_files=write_files,
+                  figures=comparison_figures)
 
 
 ALIGN_COMPARE = Action(
@@ -285,5 +290,5 @@ ALIGN_COMPARE = Action(
     "Data from --record FILE (PSINS .imu, CSV, Parquet) or a record simulated from --imu GRADE. A table of roll, "
     "pitch, heading, 1-sigma, convergence time and accuracy limit per method; heading against time on one figure "
     "with --out.",
-    align_compare, ALIGN_COMPARE_PARAMETERS, write_files=write_files)
+    align_compare, ALIGN_COMPARE_PARAMETERS, figures=comparison_figures)
 """The ``align compare`` command."""

@@ -189,7 +189,8 @@ class AlignmentComparison(Result):
     ``gyrocompass_design`` names the loop's design; ``time_constant_s``, ``damping``, ``c_gamma`` and ``c_a`` are
     the KPI design's; ``gyrocompass_stages`` lists the staged design's stages (name, span, level loop's natural
     period, azimuth time constant at the stage's start, and whether it grows with the time spent in the stage),
-    empty for the KPI design.
+    empty for the KPI design. ``estimates[NAME]`` is the method's
+    :class:`~schuler.alignment.data.MethodEstimate` (its histories; not in ``to_dict``).
     """
 
     source: str
@@ -211,7 +212,7 @@ class AlignmentComparison(Result):
     notes: list[str] = field(default_factory=list)
     gyrocompass_design: str = "staged"
     gyrocompass_stages: list[dict[str, Any]] = field(default_factory=list)
-    histories: dict[str, MethodEstimate] = field(default_factory=dict, repr=False)
+    estimates: dict[str, MethodEstimate] = field(default_factory=dict, repr=False)
 
     units = {"latitude_rad": "rad", "c_gamma": "1/s", "c_a": "1/s", "damping": "1",
              "gyrocompass_stages": "s (start_s, end_s, level_period_s, azimuth_time_constant_s: null when the "
@@ -219,6 +220,16 @@ class AlignmentComparison(Result):
              "body_rotation_rad": "rad, the body's net turn over the window (north, east, down)",
              "coarse_disturbance_rad": "rad, the heading shift that turn gives coarse alignment",
              "agreement": "heading difference from kalman (rad) and its ratio to the combined noise limit (1)"}
+
+    def to_dataframe(self):
+        """Each method's heading against time, ``{method}_t_s`` and ``{method}_heading_rad`` (first record; s, rad)."""
+        import pandas as pd
+
+        columns = {}
+        for name, estimate in self.estimates.items():
+            columns[f"{name}_t_s"] = pd.Series(estimate.time_s)
+            columns[f"{name}_heading_rad"] = pd.Series(estimate.heading_history_rad[0])
+        return pd.DataFrame(columns)
 
     def render(self):
         from rich.console import Group
@@ -348,7 +359,7 @@ def compare_alignment(batch: StaticBatch, model: ErrorModel, settings: Alignment
         body_rotation_rad=(float(rotation[0]), float(rotation[1]), float(rotation[2])),
         coarse_disturbance_rad=disturbance, notes=notes, gyrocompass_design=settings.gyrocompass_design,
         gyrocompass_stages=stages,
-        histories=estimates)
+        estimates=estimates)
 
 
 def simulated_batch(model: ErrorModel, *, latitude_rad: float, heading_rad: float, duration_s: float,

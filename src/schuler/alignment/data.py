@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -29,6 +30,7 @@ from schuler.alignment.attitude import wrap_angle
 from schuler.core.earth import normal_gravity
 from schuler.exceptions import InvalidParameter
 from schuler.imu.record import ImuRecord
+from schuler.results import Result
 
 BYTES_PER_SAMPLE = 6 * 8
 """Bytes of one six-axis sample of one record in a batch (float64)."""
@@ -228,8 +230,8 @@ def window_indices(samples: int, dt: float, start_s: float, duration_s: float | 
 
 
 @dataclass
-class MethodEstimate:
-    """One method's attitude for every record of a batch.
+class MethodEstimate(Result):
+    """One method's attitude for every record of a batch (arrays of length 1 for a single record).
 
     Attributes
     ----------
@@ -257,6 +259,40 @@ class MethodEstimate:
     pitch_history_rad: np.ndarray
     heading_history_rad: np.ndarray
     sigma_history_rad: np.ndarray | None = None
+
+    units: ClassVar[dict[str, str]] = {"time_s": "s"}
+
+    def to_dataframe(self):
+        """The histories, one row per record and time: ``record``, ``t_s``, roll, pitch, heading (and 1-sigma), rad."""
+        import pandas as pd
+
+        records, n_time = np.shape(self.heading_history_rad)
+        frame = pd.DataFrame({"record": np.repeat(np.arange(records), n_time), "t_s": np.tile(self.time_s, records),
+                              "roll_rad": np.ravel(self.roll_history_rad),
+                              "pitch_rad": np.ravel(self.pitch_history_rad),
+                              "heading_rad": np.ravel(self.heading_history_rad)})
+        if self.sigma_history_rad is not None:
+            sigma = np.reshape(self.sigma_history_rad, (-1, 3))
+            for column, name in enumerate(("roll", "pitch", "heading")):
+                frame[f"{name}_sigma_rad"] = sigma[:, column]
+        return frame
+
+    def render(self):
+        """The final attitude of each record in deg and its 1-sigma in arcmin."""
+        from rich.table import Table
+
+        table = Table(title=f"{self.method}: final attitude ({np.size(self.time_s)} times, "
+                            f"{float(np.max(self.time_s, initial=0.0)):g} s)")
+        table.add_column("record", justify="right")
+        for name in ("roll (deg)", "pitch (deg)", "heading (deg)", "1-sigma r, p, h (arcmin)"):
+            table.add_column(name, justify="right")
+        for record in range(np.size(self.heading_rad)):
+            angles = [f"{math.degrees(float(np.ravel(a)[record])):.4f}"
+                      for a in (self.roll_rad, self.pitch_rad, self.heading_rad)]
+            sigma = "-" if self.sigma_rad is None else ", ".join(
+                f"{math.degrees(float(v)) * 60:.3g}" for v in np.reshape(self.sigma_rad, (-1, 3))[record])
+            table.add_row(str(record), *angles, sigma)
+        return table
 
 
 def convergence_time(time_s, history, final, band) -> np.ndarray:

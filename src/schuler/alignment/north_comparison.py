@@ -154,6 +154,12 @@ class NorthComparison(Result):
              "versus_time": "s (duration_s), rad (1-sigma)", "versus_grade": "rad",
              "ground_gyrocompass": "rad (readout_noise_rad, sigma_rad)"}
 
+    def to_dataframe(self):
+        """Each method's 1-sigma (rad) against the observation time ``duration_s`` (s)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.versus_time)
+
     def render(self):
         from rich.console import Group
         from rich.table import Table

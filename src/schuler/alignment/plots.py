@@ -53,7 +53,7 @@ def heading_figure(result: AlignmentComparison):
     fig, ax = plt.subplots(figsize=(WIDTH_IN, 4.2), dpi=DPI)
     truth = result.true_attitude_rad
     reference = truth[2] if truth is not None else result.methods["kalman"]["heading_rad"]
-    for index, (name, estimate) in enumerate(result.histories.items()):
+    for index, (name, estimate) in enumerate(result.estimates.items()):
         values = wrap_angle(estimate.heading_history_rad[0] - reference) * ARCMIN
         ax.plot(estimate.time_s, values, lw=1.2, color=f"C{index}", label=LABELS[name])
         if estimate.sigma_history_rad is not None:
@@ -156,8 +156,50 @@ def calibration_figure(result: CalibrationComparison):
     return fig
 
 
+def comparison_figures(result) -> dict:
+    """The figure of an alignment, north-finding or calibration comparison, by file stem ({}: none of them).
+
+    Parameters
+    ----------
+    result : Result
+        An AlignmentComparison, NorthComparison or CalibrationComparison (anything else has no figure here).
+    """
+    if isinstance(result, AlignmentComparison):
+        return {"align_compare_heading": heading_figure(result)}
+    if isinstance(result, NorthComparison):
+        return {"north_compare_accuracy": north_figure(result)}
+    if isinstance(result, CalibrationComparison):
+        return {"calibrate_compare_errors": calibration_figure(result)}
+    return {}
+
+
+def comparison_data_files(result, out_dir) -> list[Path]:
+    """The CSV beside a comparison's figure: its table (:meth:`to_dataframe`) under the figure's stem.
+
+    Parameters
+    ----------
+    result : Result
+        An AlignmentComparison, NorthComparison or CalibrationComparison (anything else writes nothing).
+    out_dir : str or Path
+        Folder the file is written into.
+
+    Returns
+    -------
+    list of Path
+        The file written (empty for other results).
+    """
+    stems = {AlignmentComparison: "align_compare_heading", NorthComparison: "north_compare_accuracy",
+             CalibrationComparison: "calibrate_compare_errors"}
+    stem = stems.get(type(result))
+    if stem is None:
+        return []
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    return [write_dataframe_csv(result.to_dataframe(), out_dir / f"{stem}.csv")]
+
+
 def write_files(result, out_dir) -> list[Path]:
-    """Figures (PNG and SVG) and CSV data of an alignment, north-finding or calibration comparison.
+    """Figure (PNG and SVG) and CSV of a comparison, for a system that writes through its own ``write_files``.
 
     Parameters
     ----------
@@ -170,33 +212,8 @@ def write_files(result, out_dir) -> list[Path]:
     -------
     list of Path
         The files written.
-
-    Raises
-    ------
-    TypeError
-        ``result`` is none of the three comparisons.
     """
-    import pandas as pd
-
-    out_dir = Path(out_dir)
-    if isinstance(result, AlignmentComparison):
-        files = save_figure_formats(heading_figure(result), out_dir / "align_compare_heading")
-        columns = {}
-        for name, estimate in result.histories.items():
-            columns[f"{name}_t_s"] = pd.Series(estimate.time_s)
-            columns[f"{name}_heading_rad"] = pd.Series(estimate.heading_history_rad[0])
-        files.append(write_dataframe_csv(pd.DataFrame(columns), out_dir / "align_compare_heading.csv"))
-        return files
-    if isinstance(result, NorthComparison):
-        files = save_figure_formats(north_figure(result), out_dir / "north_compare_accuracy")
-        files.append(write_dataframe_csv(pd.DataFrame(result.versus_time), out_dir / "north_compare_accuracy.csv"))
-        return files
-    if isinstance(result, CalibrationComparison):
-        files = save_figure_formats(calibration_figure(result), out_dir / "calibrate_compare_errors")
-        rows = [{"procedure": procedure, "quantity": key, "index": i, "estimate": e, "true": t, "sigma": s, "z": z}
-                for procedure, block in (("six_position", result.six_position), ("multi_static", result.multi_static))
-                for key, entry in block.items() if isinstance(entry, dict)
-                for i, (e, t, s, z) in enumerate(zip(entry["estimate"], entry["true"], entry["sigma"], entry["z"]))]
-        files.append(write_dataframe_csv(pd.DataFrame(rows), out_dir / "calibrate_compare_errors.csv"))
-        return files
-    raise TypeError(f"the alignment suite writes no files for {type(result).__name__}")
+    files = []
+    for stem, figure in comparison_figures(result).items():
+        files += save_figure_formats(figure, Path(out_dir) / stem)
+    return files + comparison_data_files(result, out_dir)

@@ -9,9 +9,9 @@ level and azimuth channels.
 - :mod:`~schuler.gyrocompassing.analytic`: steady state (1.21)/(1.25), transient (1.22)/(1.24), settling time, design;
 - :mod:`~schuler.gyrocompassing.case`: cases, validation, gains, closed forms of many cases at once;
 - :mod:`~schuler.gyrocompassing.simulation`: runs with the task-1 constraint checks, batched simulation;
-- :mod:`~schuler.gyrocompassing.evaluation`: the system's parameters, outputs, ``evaluate`` and ``run_case``
+- :mod:`~schuler.gyrocompassing.evaluation`: the system's parameters, outputs and ``evaluate`` (a run in full)
   (Monte Carlo members draw the residual drifts and accelerometer biases);
-- :mod:`~schuler.gyrocompassing.results`: the result type and its figures and data files;
+- :mod:`~schuler.gyrocompassing.results`: how a run renders, its figures and data files;
 - :mod:`~schuler.gyrocompassing.reproduction`: the source's design example and errata, the report section;
 - :mod:`~schuler.gyrocompassing.api`: ``SYSTEM`` for the CLI (``schuler align``), scenarios, sweeps and report.
 """

@@ -2,9 +2,9 @@
 
 Source: Meleshko, KPI lab manual (:data:`schuler.references.KPI_LAB_MANUAL`).
 The pieces: :mod:`~schuler.gyrocompassing.evaluation` (parameters, outputs,
-``evaluate``, ``run_case``), :mod:`~schuler.gyrocompassing.reproduction`
-(``reproduce``, ``report``), :mod:`~schuler.gyrocompassing.results` (the result
-type and ``write_files``).
+``evaluate``), :mod:`~schuler.gyrocompassing.reproduction`
+(``reproduce``, ``report``), :mod:`~schuler.gyrocompassing.results` (how a
+result renders, its figures and data files).
 
 Examples
 --------
@@ -21,9 +21,9 @@ from functools import partial
 from schuler.alignment.commands import ALIGN_COMPARE
 from schuler.contract import System
 from schuler.gyrocompassing.case import DEFAULT_DURATION
-from schuler.gyrocompassing.evaluation import FIDELITIES, OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case
+from schuler.gyrocompassing.evaluation import FIDELITIES, OUTPUTS, PARAMETERS, evaluate, member_bytes
 from schuler.gyrocompassing.reproduction import report, reproduce
-from schuler.gyrocompassing.results import write_files
+from schuler.gyrocompassing.results import AlignmentRun, data_files, figures
 from schuler.imu.instrument import apply_options, instrument_options
 from schuler.params import Case
 from schuler.references import KPI_LAB_MANUAL
@@ -53,9 +53,10 @@ SYSTEM = System(
     parameters=PARAMETERS,
     outputs=OUTPUTS,
     evaluate=evaluate,
-    run_case=run_case,
     reproduce=reproduce,
-    write_files=write_files,
+    figures=figures,
+    data_files=data_files,
+    result_type=AlignmentRun,
     report=report,
     fidelities=FIDELITIES,
     actions=(ALIGN_COMPARE,),

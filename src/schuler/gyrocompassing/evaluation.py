@@ -1,9 +1,8 @@
-"""What the gyrocompassing system evaluates: its parameters, outputs, ``evaluate`` and ``run_case``.
+"""What the gyrocompassing system evaluates: its parameters, outputs and ``evaluate``.
 
 Parameters are declared once in :data:`PARAMETERS`; :func:`evaluate` is the
-vectorised evaluation of many cases (sweeps, Monte Carlo), :func:`run_case` one
-case in full (its outputs equal :func:`evaluate`'s, plus the time histories of
-the chosen model and of (1.19) beside it for the figures).
+vectorised evaluation of many cases (sweeps, Monte Carlo) and, with
+``histories=True``, of one case in full (the chosen model's time histories).
 
 Fidelities: ``simulated`` (default) takes the azimuth and level errors, the
 settling time in the 1 % band and the constraint check from the exact
@@ -21,8 +20,9 @@ import warnings
 
 import numpy as np
 
-from schuler.contract import Cases, Output
+from schuler.contract import Cases, Evaluation, Output
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.response import Histories
 from schuler.gyrocompassing import analytic, models
 from schuler.gyrocompassing.case import (
     DEFAULT_DAMPING,
@@ -31,11 +31,9 @@ from schuler.gyrocompassing.case import (
     DEFAULT_TIME_CONSTANT,
     MAX_DURATION,
     AlignmentCase,
-    DegradedAccuracyWarning,
     analytic_results,
     automatic_duration,
 )
-from schuler.gyrocompassing.results import AlignmentResult
 from schuler.gyrocompassing.simulation import evaluate_cases
 from schuler.gyrocompassing.simulation import run_case as simulate_case
 from schuler.memory import require
@@ -158,8 +156,28 @@ def alignment_case(cases: Cases) -> AlignmentCase:
                          DEFAULT_MAX_LATITUDE, earth_rate=EARTH_RATE, gravity=STANDARD_GRAVITY)
 
 
-def evaluate(cases: Cases) -> dict[str, np.ndarray]:
+def single_case(case) -> AlignmentCase:
+    """The :class:`AlignmentCase` of one validated case of the system (no arrays).
+
+    Parameters
+    ----------
+    case : mapping
+        A validated case of the system's parameters (SI values).
+    """
+    return _first(alignment_case(Cases.from_case(case)))
+
+
+def _first(aligned: AlignmentCase) -> AlignmentCase:
+    """The first case of a batch (with the random terms it drew)."""
+    return AlignmentCase(**{f: (v[0] if isinstance(v, np.ndarray) else v) for f, v in vars(aligned).items()})
+
+
+def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
+
+    With ``histories`` also the first case's time histories (``align_time_history``: delta, beta, delta', and
+    the level angles of the full models, rad and rad/s) and its ``model``, ``regime`` and ``constraint_violations``
+    (``constraints_ok`` a flag there).
 
     Cases are grouped by model, duration and output step (each group is one
     batched simulation on the engine), so swept durations and steps hold per case.
@@ -168,7 +186,8 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     ----------
     cases : Cases
         A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
-
+    histories : bool
+        Whether to give the first case in full (an :class:`~schuler.contract.Evaluation`).
     """
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
@@ -182,7 +201,7 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
         part = _evaluate_group(group, fidelity)
         for name, values in part.items():
             out[name][index] = values
-    return out
+    return _histories(cases, out, fidelity) if histories else out
 
 
 def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
@@ -228,52 +247,30 @@ def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
     return out
 
 
-def run_case(case: Case, fidelity: str | None = None) -> AlignmentResult:
-    """One case in full: the outputs of :func:`evaluate` and the histories of the model and of (1.19).
-
-    Parameters
-    ----------
-    case : Case
-        A validated case (SI values).
-    fidelity : str, optional
-        One of the system's fidelities (default: the first).
-
-    Examples
-    --------
-    >>> r = run_case(PARAMETERS.case(drift_east=np.radians(0.01) / 3600, model="simplified"))
-    >>> round(float(np.degrees(r.azimuth_error_rad) * 60), 3), r.constraints_ok
-    (3.556, True)
-    """
-    fidelity = fidelity or FIDELITIES[0]
-    cases = Cases.from_case(case, fidelity=fidelity)
-    outputs = {name: float(values[0]) for name, values in evaluate(cases).items()}
-    aligned = alignment_case(cases)
-    single = AlignmentCase(**{f: (v[0] if isinstance(v, np.ndarray) else v)
-                                    for f, v in vars(aligned).items()})
-    model = case["model"]
-    histories = simplified = None
-    if fidelity == "simulated":
-        require(member_bytes(case) * 3, "this run's histories", "--duration or --output-step")
-        with warnings.catch_warnings():
-            # evaluate has warned about the latitude already; the histories are the same case
-            warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")
-            histories = simulate_case(single, model, duration=outputs["simulated_duration_s"],
-                                      time_step=case["output_step"])
-            simplified = histories
-            if model != "simplified":
-                # (1.19) beside the model for the comparison figures; the model's own run has warned already
-                warnings.simplefilter("ignore", DegradedAccuracyWarning)
-                simplified = simulate_case(single, "simplified", duration=outputs["simulated_duration_s"],
-                                            time_step=case["output_step"])
-    violations = [] if histories is None else list(histories.violations)
-    return AlignmentResult(
-        model=model, fidelity=fidelity,
-        regime=_regime(outputs["c_gamma"], outputs["c_a"], case["latitude"]),
-        constraint_violations=violations, run=histories, simplified_run=simplified,
-        constraints_ok=None if math.isnan(outputs["constraints_ok"]) else bool(outputs["constraints_ok"]),
-        monte_carlo=None,  # System.run adds it
-        **{name: value for name, value in outputs.items() if name != "constraints_ok"},
-    )
+def _histories(cases: Cases, outputs: dict[str, np.ndarray], fidelity: str) -> Evaluation:
+    """The first case in full: its outputs, the model's time histories and the structured results beside them."""
+    case = cases.case(0)
+    scalars = {name: float(values[0]) for name, values in outputs.items()}
+    if not math.isnan(scalars["constraints_ok"]):
+        # the run's flag reads as a flag (True, shown yes/no) where a batch carries it as 1.0 / 0.0
+        outputs = {**outputs, "constraints_ok": outputs["constraints_ok"].astype(bool)}
+    extras: dict = {"model": case["model"], "regime": _regime(scalars["c_gamma"], scalars["c_a"], case["latitude"]),
+                    "constraint_violations": []}
+    if fidelity != "simulated":
+        return Evaluation(outputs, extras=extras)
+    require(member_bytes(case) * 3, "this run's histories", "--duration or --output-step")
+    with warnings.catch_warnings():
+        # evaluate has warned about the latitude already; the histories are the same case
+        warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")
+        run = simulate_case(_first(alignment_case(cases)), case["model"], duration=scalars["simulated_duration_s"],
+                            time_step=case["output_step"])
+    extras["constraint_violations"] = list(run.violations)
+    channels = {"delta_rad": run.delta, "beta_rad": run.beta, "delta_rate_rad_s": run.delta_rate}
+    # the level angles of the full models (None on the simplified one)
+    level = {"alpha_rad": run.alpha, "mu_rad": run.mu, "nu_rad": run.nu}
+    channels.update({name: values for name, values in level.items() if values is not None})
+    units = {name: "rad/s" if name.endswith("_rad_s") else "rad" for name in channels}
+    return Evaluation(outputs, histories={"align_time_history": Histories(run.time, channels, units)}, extras=extras)
 
 
 def _regime(c_gamma: float, c_a: float, latitude: float) -> str:
@@ -296,4 +293,4 @@ def member_bytes(case: Case) -> int:
     return int(6 * 8 * (duration / case["output_step"] + 2))
 
 
-__all__ = ["FIDELITIES", "OUTPUTS", "PARAMETERS", "alignment_case", "evaluate", "member_bytes", "run_case"]
+__all__ = ["FIDELITIES", "OUTPUTS", "PARAMETERS", "alignment_case", "evaluate", "member_bytes", "single_case"]

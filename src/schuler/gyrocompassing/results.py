@@ -1,54 +1,26 @@
-"""What ``schuler align run`` returns and writes: :class:`AlignmentResult` and :func:`write_files`."""
+"""How an ``align`` run reads and draws: :class:`AlignmentRun` (its rendering), :func:`case_runs`, :func:`figures`."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from pathlib import Path
-from typing import ClassVar
+import warnings
+from typing import Any
 
+from schuler.gyrocompassing.case import DegradedAccuracyWarning
+from schuler.gyrocompassing.evaluation import single_case
 from schuler.gyrocompassing.simulation import CaseRun
+from schuler.gyrocompassing.simulation import run_case as simulate_case
 from schuler.reproduction import Reproduction
-from schuler.results import Result, RunResult
+from schuler.results import Result, SystemResult
 from schuler.units import to_unit
 
 
-@dataclass
-class AlignmentResult(RunResult):
-    """One gyrocompassing case: accuracy, time, constraint check (every output of the system's ``evaluate``).
+class AlignmentRun(SystemResult):
+    """One gyrocompassing case as ``align run`` gives it; ``render()`` shows arcmin and arcsec.
 
-    Angles in rad, times in s, gains in 1/s; ``render()`` shows arcmin and arcsec.
-    Outputs computed only by the simulation are None with ``fidelity="closed"``.
-    ``run`` and ``simplified_run`` hold the histories of the model and of (1.19)
-    (not in ``to_dict``).
+    Outputs computed only by the simulation are NaN with ``fidelity="closed"``;
+    ``histories["align_time_history"]`` holds the model's time histories.
     """
-
-    model: str
-    fidelity: str
-    azimuth_error_rad: float
-    azimuth_error_analytic_rad: float
-    full_minus_simplified_rad: float
-    level_error_beta_rad: float
-    level_error_beta_analytic_rad: float
-    azimuth_error_sigma_rad: float
-    azimuth_error_sigma_simplified_rad: float
-    settling_time_s: float
-    settling_time_simulated_s: float
-    regime: str
-    c_gamma: float
-    c_a: float
-    design_time_constant_s: float
-    design_damping: float
-    max_abs_delta_rad: float
-    max_abs_beta_rad: float
-    max_abs_delta_rate_rad_s: float
-    constraints_ok: bool | None
-    constraint_violations: list
-    simulated_duration_s: float
-    run: CaseRun | None = field(default=None, repr=False)
-    simplified_run: CaseRun | None = field(default=None, repr=False)
-
-    units: ClassVar[dict[str, str]] = {"c_gamma": "1/s", "c_a": "1/s", "design_damping": "1"}
 
     def render(self):
         from rich.console import Group
@@ -62,31 +34,33 @@ class AlignmentResult(RunResult):
                 return "-"
             return "not settled" if math.isinf(value) else f"{value:.5g} s"
 
-        table = Table(title=f"Gyrocompassing, {self.model} model ({self.fidelity})", show_header=True)
+        out = self.outputs
+        table = Table(title=f"Gyrocompassing, {self.extras['model']} model ({self.fidelity})", show_header=True)
         table.add_column("quantity")
         table.add_column("value", justify="right")
-        constraint = ("not checked (closed form)" if self.constraints_ok is None
-                      else "ok" if self.constraints_ok else "; ".join(self.constraint_violations))
+        ok = out["constraints_ok"]
+        constraint = ("not checked (closed form)" if ok is None or ok != ok
+                      else "ok" if ok else "; ".join(self.extras["constraint_violations"]))
         rows = [
             (f"azimuth error ({'simulated' if self.fidelity == 'simulated' else 'closed-form'} steady state)",
-             angle(self.azimuth_error_rad)),
-            ("azimuth error, analytic (1.21)", angle(self.azimuth_error_analytic_rad)),
-            ("full model minus (1.21)", angle(self.full_minus_simplified_rad, "arcsec", 3)),
-            ("level error beta", angle(self.level_error_beta_rad)),
-            ("level error beta, analytic (1.25)", angle(self.level_error_beta_analytic_rad)),
-            ("settling time, analytic", f"{seconds(self.settling_time_s)} ({self.regime})"),
-            ("settling time, simulated 1 % band", seconds(self.settling_time_simulated_s)),
-            ("c_Gamma, c_a", f"{self.c_gamma:.4g} 1/s, {self.c_a:.4g} 1/s"),
-            ("T, zeta", f"{self.design_time_constant_s:.4g} s, {self.design_damping:.3g}"),
+             angle(out["azimuth_error_rad"])),
+            ("azimuth error, analytic (1.21)", angle(out["azimuth_error_analytic_rad"])),
+            ("full model minus (1.21)", angle(out["full_minus_simplified_rad"], "arcsec", 3)),
+            ("level error beta", angle(out["level_error_beta_rad"])),
+            ("level error beta, analytic (1.25)", angle(out["level_error_beta_analytic_rad"])),
+            ("settling time, analytic", f"{seconds(out['settling_time_s'])} ({self.extras['regime']})"),
+            ("settling time, simulated 1 % band", seconds(out["settling_time_simulated_s"])),
+            ("c_Gamma, c_a", f"{out['c_gamma']:.4g} 1/s, {out['c_a']:.4g} 1/s"),
+            ("T, zeta", f"{out['design_time_constant_s']:.4g} s, {out['design_damping']:.3g}"),
             ("constraints (0.4 rad, 0.01 rad, 0.2 rad/s)", constraint),
         ]
         if self.monte_carlo is not None:
-            stats = self.monte_carlo.statistics["azimuth_error_rad"]
+            stats = self.monte_carlo["azimuth_error_rad"]
             rows += [
                 (f"Monte Carlo ({self.monte_carlo.members} members): mean, std",
-                 f"{angle(stats['mean'])}, {angle(stats['std'])}"),
+                 f"{angle(stats.mean)}, {angle(stats.std)}"),
                 ("analytic 1-sigma: model, (1.21)",
-                 f"{angle(self.azimuth_error_sigma_rad)}, {angle(self.azimuth_error_sigma_simplified_rad)}"),
+                 f"{angle(out['azimuth_error_sigma_rad'])}, {angle(out['azimuth_error_sigma_simplified_rad'])}"),
             ]
         for name, value in rows:
             table.add_row(name, value)
@@ -99,44 +73,70 @@ def _clean(value: float, digits: int) -> str:
     return text[1:] if text.startswith("-") and float(text) == 0 else text
 
 
-def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """Figures (PNG and SVG) and CSV of a run, a Monte Carlo or the reproduction.
+def case_runs(result: SystemResult) -> tuple[CaseRun, CaseRun] | None:
+    """The run's model and (1.19) simulated in full, for figures that need more than the CSV (None: closed form).
+
+    Parameters
+    ----------
+    result : SystemResult
+        What ``align run`` returned; its case (``parameters``) is simulated again over its ``simulated_duration_s``.
+    """
+    if result.fidelity != "simulated":
+        return None
+    single, model = single_case(result.parameters), result.extras["model"]
+    duration, step = result.outputs["simulated_duration_s"], result.parameters["output_step"]
+    with warnings.catch_warnings():
+        # the run has warned already: these are the same case
+        warnings.simplefilter("ignore", DegradedAccuracyWarning)
+        run = simulate_case(single, model, duration=duration, time_step=step)
+        simplified = run if model == "simplified" else simulate_case(single, "simplified", duration=duration,
+                                                                     time_step=step)
+    return run, simplified
+
+
+def figures(result: Result) -> dict[str, Any]:
+    """The figures of a run (time history, phase trajectory, Monte Carlo histogram) or of the reproduction.
 
     Parameters
     ----------
     result : Result
-        What ``run``, ``reproduce`` or an action returned.
-    out_dir : Path
-        Folder for the figures (PNG, SVG) and data files (CSV); created if missing.
+        What ``run``, ``reproduce`` or ``align compare`` returned.
     """
-    import pandas as pd
-
+    from schuler.alignment.plots import comparison_figures
     from schuler.gyrocompassing import plots
-    from schuler.io import write_dataframe_csv
 
-    out_dir = Path(out_dir)
     if isinstance(result, Reproduction):
-        return plots.write_figures({"align_reproduction_time_history": plots.time_history(result.data)}, out_dir)
-    if not isinstance(result, AlignmentResult):
-        raise TypeError(f"align writes no files for {type(result).__name__}")
-    figures = {}
-    files: list[Path] = []
-    run = result.run
-    if run is not None:
-        runs = {f"{result.model} model": run}
-        if result.model != "simplified" and result.simplified_run is not None:
-            runs["simplified model (1.19)"] = result.simplified_run
-        figures["align_time_history"] = plots.time_history(runs)
-        figures["align_phase_trajectory"] = plots.phase_trajectory(runs)
-        columns = {"t_s": run.time, "delta_rad": run.delta, "beta_rad": run.beta, "delta_rate_rad_s": run.delta_rate}
-        # the level angles of the full models (None on the simplified one)
-        level = {"alpha_rad": run.alpha, "mu_rad": run.mu, "nu_rad": run.nu}
-        columns.update({name: values for name, values in level.items() if values is not None})
-        files.append(write_dataframe_csv(pd.DataFrame(columns), out_dir / "align_time_history.csv"))
+        return {"align_reproduction_time_history": plots.time_history(result.data)}
+    if not isinstance(result, SystemResult):
+        return comparison_figures(result)
+    drawn = {}
+    simulated = case_runs(result)
+    if simulated is not None:
+        run, simplified = simulated
+        model = result.extras["model"]
+        runs = {f"{model} model": run}
+        if model != "simplified":
+            runs["simplified model (1.19)"] = simplified
+        drawn["align_time_history"] = plots.time_history(runs)
+        drawn["align_phase_trajectory"] = plots.phase_trajectory(runs)
     if result.monte_carlo is not None:
         samples = to_unit(result.monte_carlo.samples["azimuth_error_rad"], "arcmin")
-        stats = result.monte_carlo.statistics["azimuth_error_rad"]
-        figures["align_monte_carlo"] = plots.monte_carlo_histogram(
-            samples, float(to_unit(result.azimuth_error_sigma_rad, "arcmin")),
-            float(to_unit(stats["mean"], "arcmin")), result.model)
-    return plots.write_figures(figures, out_dir) + files
+        drawn["align_monte_carlo"] = plots.monte_carlo_histogram(
+            samples, float(to_unit(result.outputs["azimuth_error_sigma_rad"], "arcmin")),
+            float(to_unit(result.monte_carlo["azimuth_error_rad"].mean, "arcmin")), result.extras["model"])
+    return drawn
+
+
+def data_files(result: Result, out_dir) -> list:
+    """The CSV of an ``align compare`` (a run's and the reproduction's files are its histories and figures).
+
+    Parameters
+    ----------
+    result : Result
+        What ``run``, ``reproduce`` or ``align compare`` returned.
+    out_dir : Path
+        Folder to write into.
+    """
+    from schuler.alignment.plots import comparison_data_files
+
+    return comparison_data_files(result, out_dir)

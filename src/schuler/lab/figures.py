@@ -373,11 +373,15 @@ class Interactive:
 
 
 def _alignment_figures(result) -> list[dict]:
-    if result.run is None:
+    from schuler.gyrocompassing.results import case_runs
+
+    simulated = case_runs(result)
+    if simulated is None:
         return [empty("no histories: the closed form computes none")] * 2
-    runs = {f"{result.model} model": result.run}
-    if result.model != "simplified" and result.simplified_run is not None:
-        runs["simplified (1.19)"] = result.simplified_run
+    run, simplified = simulated
+    runs = {f"{result.model} model": run}
+    if result.model != "simplified":
+        runs["simplified (1.19)"] = simplified
     return [time_history(runs), phase_trajectory(runs)]
 
 
@@ -409,7 +413,7 @@ def interactive_figures(system: System, result) -> list[dict] | None:
     system : System
         The system that computed ``result``.
     result : object
-        What the system's ``run`` returned (for ``align``: an ``AlignmentResult``).
+        What the system's ``run`` returned (for ``align``: an ``AlignmentRun``).
 
     Returns
     -------

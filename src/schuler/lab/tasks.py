@@ -27,6 +27,7 @@ from dash.exceptions import PreventUpdate
 
 from schuler.contract import System
 from schuler.exceptions import SchulerError
+from schuler.gyrocompassing.results import case_runs
 from schuler.gyrocompassing.simulation import MAX_BETA, MAX_DELTA, MAX_DELTA_RATE
 from schuler.lab import figures, manual, views
 from schuler.lab.controls import controls, error_owner, parse_typed, typed_values
@@ -247,7 +248,7 @@ def constraint_panel(result) -> html.Table:
 
     Parameters
     ----------
-    result : AlignmentResult
+    result : AlignmentRun
         The ``align`` run's result; its ``max_abs_delta_rad``, ``max_abs_beta_rad`` (rad) and
         ``max_abs_delta_rate_rad_s`` (rad/s) are compared with the limits of :data:`CONSTRAINTS`.
 
@@ -331,10 +332,13 @@ def compute(system: System, page: str, typed: dict[str, str], sweep_typed: dict[
     view = TaskView()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result: Any = system.run(**values)  # the align system's AlignmentResult (histories in run)
-        runs = {f"{result.model} model": result.run}
+        result: Any = system.run(**values)
+        simulated = case_runs(result)
+        assert simulated is not None  # the task pages run the default fidelity, simulated
+        run, simplified = simulated
+        runs = {f"{result.model} model": run}
         if result.model != "simplified":
-            runs["simplified (1.19)"] = result.simplified_run
+            runs["simplified (1.19)"] = simplified
         view.tables.append(views.headline(system, {o.name: getattr(result, o.name) for o in system.outputs}))
         if number in (1, 2):
             view.tables.insert(0, constraint_panel(result))
@@ -347,12 +351,12 @@ def compute(system: System, page: str, typed: dict[str, str], sweep_typed: dict[
                 table.iloc[:, 0].to_numpy(), table.columns[0], columns, CONSTRAINTS,
                 title=f"Accuracy and time against {name} (task {number})"), table))
         if number in (1, 2):
-            view.figures.append((f"task{number}_time_history", figures.time_history(runs), history_table(result.run)))
+            view.figures.append((f"task{number}_time_history", figures.time_history(runs), history_table(run)))
         elif number == 3:
-            view.figures.append(("task3_level_angles", figures.level_angles(result.run), history_table(result.run)))
-            view.figures.append(("task3_time_history", figures.time_history(runs), history_table(result.run)))
+            view.figures.append(("task3_level_angles", figures.level_angles(run), history_table(run)))
+            view.figures.append(("task3_time_history", figures.time_history(runs), history_table(run)))
         else:
-            view.figures.append(("task5_phase_trajectory", figures.phase_trajectory(runs), history_table(result.run)))
+            view.figures.append(("task5_phase_trajectory", figures.phase_trajectory(runs), history_table(run)))
     view.notes += [f"warning: {w.message}" for w in caught]
     return view
 
