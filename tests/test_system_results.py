@@ -6,10 +6,6 @@ from __future__ import annotations
 import json
 import math
 
-import matplotlib
-
-matplotlib.use("Agg")
-
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
@@ -22,7 +18,6 @@ from schuler.contract import Cases
 from schuler.core.random import RandomStreams
 from schuler.results import MonteCarloStatistics, SystemResult
 from test_contract import NAMES, light
-
 
 ON_RUN_CASE = {name for name in NAMES if not get_system(name).evaluates_histories}
 """Systems not yet moved to the one evaluation (they keep ``run_case`` and ``write_files``): held to the test as
