@@ -119,9 +119,9 @@ def test_estimates_are_within_a_factor_of_ten_of_the_measured_time():
 def test_a_system_without_an_estimate_is_refused_on_its_measured_pace(monkeypatch):
     align = get_system("align")
 
-    def slow(cases):
+    def slow(cases, histories=False):
         time.sleep(0.02)
-        return align.evaluate(cases)
+        return align.evaluate(cases, histories=histories)
 
     undeclared = dataclasses.replace(align, member_seconds=None, member_bytes=lambda case: 2**40, evaluate=slow)
     monkeypatch.setenv("SCHULER_TIME_BUDGET", "2 s")

@@ -221,13 +221,15 @@ def report(figures_dir: Path) -> ReportSection:
         The report's figure folder.
 
     """
-    from schuler.drift_calibration.api import SYSTEM
     from schuler.drift_calibration.plots import plot_trade_offs
     from schuler.io import save_figure_formats
+    from schuler.registry import get_system
+
+    system = get_system("calibrate")  # through the registry: api imports this module
 
     figures_dir = Path(figures_dir)
     case = evaluation.PARAMETERS.case()
-    files = SYSTEM.write(SYSTEM.result(case, monte_carlo=_monte_carlo(case, 1000, 0)), figures_dir)
+    files = system.write(system.result(case, monte_carlo=_monte_carlo(case, 1000, 0)), figures_dir)
     positions, by_positions = error_versus_positions(members=200)
     cycle_times, by_cycle = error_versus_cycle_time(members=200)
     files += save_figure_formats(plot_trade_offs(positions, by_positions, cycle_times, by_cycle),
