@@ -158,7 +158,7 @@ def test_the_report_has_a_section_per_landed_system(tmp_path_factory):
         pytest.skip("no system is installed yet")
     index = full_report(tmp_path_factory)
     text = index.read_text(encoding="utf-8")
-    check_page(index, ["errors", "vertical", "calibrate", "align", "north", "imu", "navigate", "mission"])
+    check_page(index, ["errors", "vertical", "calibrate", "align", "north", "imu", "navigate", "mission", "aided"])
     for name in SYSTEM_MODULES:
         section = text.split(f'id="system-{name}"')[1].split("</section>")[0]
         if name in landed:

@@ -37,7 +37,7 @@ def error_envelopes(histories, outages):
         axis.plot(minutes, histories[error] * scale, color="tab:red", lw=0.8, label="error")
         axis.set_ylabel(label)
         axis.grid(True, alpha=0.3)
-    axes[0].legend(loc="upper right", fontsize=8)
+    axes[0].legend(loc="upper right", fontsize=9)
     axes[0].set_title("Aided INS: errors and the filter's +-3-sigma (GNSS outages shaded)")
     axes[-1].set_xlabel("time [min]")
     fig.tight_layout()
@@ -61,7 +61,7 @@ def outage_drift(outages):
     axis.set_xticks(x, [f"{o['start_s'] / 60:.0f} min, {o['duration_s']:.0f} s" for o in outages])
     axis.set_ylabel("horizontal [m]")
     axis.set_title("Drift through each GNSS outage")
-    axis.legend(fontsize=8)
+    axis.legend(fontsize=9)
     axis.grid(True, axis="y", alpha=0.3)
     fig.tight_layout()
     return fig
