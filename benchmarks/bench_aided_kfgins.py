@@ -21,7 +21,15 @@ heading RMS (KF-GINS's result read with :func:`schuler.aided.kfgins.read_navigat
 the comparison is skipped (say so and exit 0). Printed beside the timings: the load average (two shared cores
 move wall-clock times by up to 3x).
 
-Run: ``SCHULER_KFGINS=/path/to/KF-GINS python benchmarks/bench_aided_kfgins.py [--duration S]``.
+Run: ``SCHULER_KFGINS=/path/to/KF-GINS python benchmarks/bench_aided_kfgins.py [--duration S] [--seed K]``.
+
+Measured (seed 1, load average 14 on two cores; KF-GINS built Release, -O3, with Debian's Eigen 3.4, yaml-cpp
+0.7 and abseil 20220623): horizontal RMS 0.505 m (KF-GINS 0.492 m), outages 1.14, 4.32, 3.98 m (1.25, 4.04,
+4.03 m), heading RMS 0.0466 deg (0.0466 deg); KF-GINS 5.0 s CPU, schuler 2.6 s CPU for the whole (1.4 s the
+filter). Over seeds 1-6 schuler's horizontal RMS is 0.98-1.03 times KF-GINS's and each outage's largest error
+0.91-1.07 times. The difference is schuler's Gauss-Markov estimates relaxing towards zero between updates (as the
+mean of the modelled process does); KF-GINS keeps its fed-back biases and scale factors constant: without that
+decay and with a 0.1-s covariance step schuler gives KF-GINS's figures within 0.1 %.
 """
 
 from __future__ import annotations
