@@ -7,6 +7,7 @@ before ``imu`` moved to ``evaluate(cases, histories=True)``: the move keeps them
 from __future__ import annotations
 
 import csv
+import math
 import os
 from pathlib import Path
 
@@ -91,3 +92,131 @@ def test_reproduce_out_files_are_kept(run_cli, tmp_path, monkeypatch):
         "imu_reproduction_tactical.csv", *(f"imu_reproduction_tactical_{s}.{e}" for s in ("gyro", "accel")
                                            for e in ("png", "svg"))}
     assert _columns(tmp_path / "imu_reproduction_tactical.csv") == CURVE_COLUMNS
+
+
+def _close(python, cli, path=""):
+    """Python's JSON equals the command's to 1e-12 (numbers), exactly otherwise."""
+    if isinstance(cli, dict):
+        assert set(python) >= set(cli), path
+        for key, value in cli.items():
+            _close(python[key], value, f"{path}.{key}")
+    elif isinstance(cli, list):
+        assert len(python) == len(cli), path
+        for index, (a, b) in enumerate(zip(python, cli)):
+            _close(a, b, f"{path}[{index}]")
+    elif isinstance(cli, float) and not isinstance(python, bool):
+        assert python == pytest.approx(cli, rel=1e-12, abs=0.0), path
+    else:
+        assert python == cli, path
+
+
+@pytest.fixture(scope="module")
+def degree_csv(tmp_path_factory, industrial_csv):
+    """The industrial record with its own column names, gyros in deg/s and accelerometers in g."""
+    import numpy as np
+    import pandas as pd
+
+    frame = pd.read_csv(industrial_csv)
+    out = pd.DataFrame({"t": frame["t_s"]})
+    for axis in "xyz":
+        out[f"w{axis}"] = np.degrees(frame[f"gyro_{axis}_rad_s"])
+    for axis in "xyz":
+        out[f"a{axis}"] = frame[f"accel_{axis}_m_s2"] / 9.80665
+    path = tmp_path_factory.mktemp("imu") / "degrees.csv"
+    out.to_csv(path, index=False, float_format="%.17g")
+    return path
+
+
+COLUMNS = "time=t,gyro_x=wx,gyro_y=wy,gyro_z=wz,accel_x=ax,accel_y=ay,accel_z=az"
+
+
+def test_allan_deviation_and_identify_from_python_equal_the_command(industrial_csv, run_cli):
+    import schuler.imu
+
+    cli = run_cli("imu", "allan", industrial_csv, "--json").json()
+    result = schuler.imu.allan_deviation(industrial_csv)
+    data = result.to_dict()
+    _close(data, {key: cli[key] for key in data if key != "units"})
+    # the identified terms are the command's, per channel and term (SI)
+    terms = schuler.imu.identify(str(industrial_csv))
+    identified = terms.to_dict()["terms"]
+    for channel in CHANNELS:
+        _close(identified[channel], {key: value for key, value in cli["noise"][channel].items()
+                                     if key in (*TERMS, "sigma", "upper_bound", "resolved", "chi2_per_point")})
+    # the record in memory gives the same analysis (one chunk instead of a stream)
+    from_record = schuler.imu.allan_deviation(schuler.imu.read_record(industrial_csv))
+    assert from_record.noise["gyro_x"].curve.adev == pytest.approx(cli["noise"]["gyro_x"]["adev"], rel=1e-9)
+    # industrial grade (Xsens MTi 1): N = 0.007 deg/s/sqrt(Hz) in rad/sqrt(s), 5 min identify it within 3 %
+    assert terms.terms["gyro_x"]["N"] == pytest.approx(math.radians(0.007), rel=0.03)
+    assert result.grade == cli["grade"] == "industrial"
+
+
+def test_the_results_plot_and_tabulate_by_tau(industrial_csv):
+    import matplotlib.pyplot as plt
+
+    import schuler.imu
+
+    result = schuler.imu.allan_deviation(industrial_csv, channels=["gyro_x", "accel_z"])
+    frame = result.to_dataframe()
+    assert frame.index.name == "tau_s" and list(frame.columns) == [
+        "gyro_x_adev_rad_s", "gyro_x_adev_lower_rad_s", "gyro_x_adev_upper_rad_s", "gyro_x_edf",
+        "accel_z_adev_m_s2", "accel_z_adev_lower_m_s2", "accel_z_adev_upper_m_s2", "accel_z_edf"]
+    assert frame.attrs["units"]["tau_s"] == "s" and frame.attrs["units"]["accel_z_adev_m_s2"] == "m/s^2"
+    full = schuler.imu.allan_deviation(industrial_csv)
+    # one channel's curve does not depend on the others analysed beside it
+    assert frame["gyro_x_adev_rad_s"].to_numpy() == pytest.approx(full.noise["gyro_x"].curve.adev, rel=1e-12)
+    assert result.grade == "industrial" and set(result.figures()) == {"imu_allan_gyro", "imu_allan_accel"}
+    plt.close("all")
+    assert result.plot() is not None and "gyro_x" in result._repr_html_()
+    plt.close("all")
+    terms = schuler.imu.identify(industrial_csv, channels="accel_y")
+    table = terms.to_dataframe()
+    assert table.loc[("accel_y", "N"), "unit"] == "m/s^1.5" and len(table) == 5
+    assert terms.grade is None and terms.plot() is not None  # no gyro analysed: no grade
+    plt.close("all")
+
+
+def test_python_options_are_values_not_command_text(degree_csv, industrial_csv, run_cli):
+    import pint
+
+    import schuler.imu
+
+    cli = run_cli("imu", "allan", degree_csv, "--columns", COLUMNS, "--units", "gyro=deg/s,accel=g", "--json").json()
+    columns = dict(pair.split("=") for pair in COLUMNS.split(","))
+    units = pint.UnitRegistry()
+    by_text = schuler.imu.allan_deviation(degree_csv, columns=columns, units={"gyro": "deg/s", "accel": "g"})
+    by_pint = schuler.imu.identify(degree_csv, columns=columns, units={"gyro": units.deg / units.s, "accel": "g"})
+    for channel in CHANNELS:
+        _close(by_text.to_dict()["noise"][channel], cli["noise"][channel], channel)
+        _close(by_pint.terms[channel]["N"], cli["noise"][channel]["N"], channel)
+    # the same record in SI: the same terms within the rounding of the degree file (17 digits)
+    si = schuler.imu.identify(industrial_csv)
+    assert by_pint.terms["gyro_y"]["N"] == pytest.approx(si.terms["gyro_y"]["N"], rel=1e-9)
+
+
+def test_python_functions_refuse_what_does_not_apply(industrial_csv):
+    import schuler.imu
+    from schuler.exceptions import InvalidParameter
+
+    with pytest.raises(InvalidParameter, match="channels: 'gyro_w' is not a channel; did you mean 'gyro_x'"):
+        schuler.imu.allan_deviation(industrial_csv, channels=["gyro_w"])
+    with pytest.raises(InvalidParameter, match="per_octave"):
+        schuler.imu.allan_deviation(industrial_csv, per_octave=0)
+    record = schuler.imu.read_record(industrial_csv)
+    with pytest.raises(InvalidParameter, match="units: applies to a file, not to a record in memory"):
+        schuler.imu.identify(record, units={"gyro": "deg/s"})
+    with pytest.raises(InvalidParameter, match="units: unknown channel 'gyr'; channels are time, gyro, accel"):
+        schuler.imu.read_record(industrial_csv, units={"gyr": "deg/s"})
+
+
+@pytest.mark.skipif(not PSINS.is_file(), reason="the PSINS lasergyro.imu recording is not here")
+def test_the_psins_recording_through_allan_deviation():
+    import schuler.imu
+
+    result = schuler.imu.allan_deviation(PSINS)
+    # 184,718 samples of 10 ms (the file's README); the gyro floor places it in the navigation grade
+    assert result.samples == 184_718 and result.sample_interval_s == 0.01 and result.grade == "navigation"
+    frame = result.to_dataframe()
+    # the long-tau gyro Allan deviation falls below 2 deg/h within the record (as tests/test_imu_psins.py)
+    assert (frame.filter(like="gyro").filter(like="adev_rad_s").iloc[-1] < math.radians(2.0) / 3600).all()
+    assert result.figures().keys() == {"imu_allan_gyro", "imu_allan_accel"}
