@@ -198,8 +198,8 @@ def test_python_functions_refuse_what_does_not_apply(industrial_csv):
     import schuler.imu
     from schuler.exceptions import InvalidParameter
 
-    with pytest.raises(InvalidParameter, match="channels: 'gyro_w' is not a channel; did you mean 'gyro_x'"):
-        schuler.imu.allan_deviation(industrial_csv, channels=["gyro_w"])
+    with pytest.raises(InvalidParameter, match="channels: 'gyrox' is not a channel; did you mean 'gyro_x'"):
+        schuler.imu.allan_deviation(industrial_csv, channels=["gyrox"])
     with pytest.raises(InvalidParameter, match="per_octave"):
         schuler.imu.allan_deviation(industrial_csv, per_octave=0)
     record = schuler.imu.read_record(industrial_csv)

@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from schuler.imu.allan import allan_deviation
-from schuler.imu.identify import identify_terms
+from schuler.imu.noise_terms import identify_terms
 from schuler.imu.simulate import simulate_record
 from schuler.imu.spec import preset
 

@@ -29,7 +29,7 @@ through :mod:`schuler.units`.
 - :mod:`~schuler.imu.spec`: TOML spec files and the grade presets with their sources;
 - :mod:`~schuler.imu.simulate`: N members x T samples, windowed, seeded, independent of the cut;
 - :mod:`~schuler.imu.allan`: streaming overlapping Allan deviation with confidence intervals;
-- :mod:`~schuler.imu.identify`: IEEE 952 terms by weighted least squares, uncertainties, resolvability;
+- :mod:`~schuler.imu.noise_terms`: IEEE 952 terms by weighted least squares, uncertainties, resolvability;
 - :mod:`~schuler.imu.characterise`: six-channel analysis, grade, round trip, the PSINS reproduction;
 - :mod:`~schuler.imu.system_inputs`: error model -> parameters of align, calibrate, north, errors;
 - :mod:`~schuler.imu.analysis`: the everyday functions above;

@@ -106,7 +106,7 @@ def identify(record: ImuRecord | str | Path, *, channels: Iterable[str] | None =
     """The IEEE 952 terms N, B, K, Q, R of a record's channels, with uncertainties and resolvability.
 
     The terms are fitted by weighted least squares to the Allan curves of
-    :func:`allan_deviation` (:func:`~schuler.imu.identify.identify_terms`).
+    :func:`allan_deviation` (:func:`~schuler.imu.noise_terms.identify_terms`).
 
     Parameters
     ----------

@@ -22,7 +22,7 @@ from schuler.exceptions import InvalidParameter
 from schuler.imu.allan import DEFAULT_MAX_FRACTION, AllanAccumulator, AllanCurve, allan_lags
 from schuler.imu.error_model import ErrorModel, SensorErrors
 from schuler.imu.files import open_record, read_record
-from schuler.imu.identify import TERMS, identify_terms, no_terms
+from schuler.imu.noise_terms import TERMS, identify_terms, no_terms
 from schuler.imu.readers import RecordSource
 from schuler.imu.record import ImuRecord, record_info
 from schuler.imu.results import (
@@ -40,7 +40,7 @@ from schuler.imu.spec import GRADES, preset
 TOLERANCE_FACTORS = {"Q": 3.0, "N": 3.0, "B": 3.0, "K": 3.0, "R": 3.0}
 """Round-trip tolerance of each term in units of its standard uncertainty (3 sigma).
 
-The sigma (:mod:`~schuler.imu.identify`, inflated for the correlation of
+The sigma (:mod:`~schuler.imu.noise_terms`, inflated for the correlation of
 overlapping estimates) is what makes N and Q tight (~0.1-1 %: many short-tau
 points with huge edf) and B and K loose (10-50 %: the few long-tau points with
 edf of a few)."""

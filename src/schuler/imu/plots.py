@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from schuler.imu.error_model import ErrorModel
-from schuler.imu.identify import SLOPES, model_allan_deviation, term_allan_deviations
+from schuler.imu.noise_terms import SLOPES, model_allan_deviation, term_allan_deviations
 from schuler.imu.results import DISPLAY_UNITS, AllanResult, IdentifiedTerms, sensor_of, shown_unit
 from schuler.imu.spec import case_model
 from schuler.io import save_figure_formats, write_dataframe_csv
@@ -183,7 +183,7 @@ def monte_carlo_figure(summary, true_terms: dict):
     summary : MonteCarloSummary
         The Monte Carlo of ``schuler imu run``: its ``samples`` of ``noise_<channel>_<term>`` (SI) per member.
     true_terms : dict of str to dict of str to float
-        Channel -> term -> true value, SI (:attr:`~schuler.imu.run_results.ImuRunResult.true_terms`); the ratio
+        Channel -> term -> true value, SI (a run's ``true_terms``); the ratio
         identified / true is a plain number, so only matching units matter.
 
     Returns

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from schuler.core.response import Histories
 from schuler.imu.allan import AllanCurve
-from schuler.imu.identify import TERMS, NoiseTerms
+from schuler.imu.noise_terms import TERMS, NoiseTerms
 from schuler.imu.record import ImuInfo
 from schuler.imu.spec import GRADES
 from schuler.results import Footnotes, Result, json_safe
@@ -214,22 +214,6 @@ class AllanResult(Result):
     def to_dataframe(self):
         """The curves indexed by ``tau_s`` (s): adev and its 68 % bounds (rad/s, m/s^2) and edf per channel."""
         return self.histories["imu_allan"].to_dataframe()
-
-    def values(self, channel: str) -> dict[str, float]:
-        """Identified N, B, K, Q, R of a channel, SI.
-
-        Parameters
-        ----------
-        channel : str
-            A channel name, ``gyro_x`` .. ``accel_z``.
-
-        Returns
-        -------
-        dict of str to float
-            Term -> identified value in the units of :data:`TERM_UNITS` (unresolved terms too: check
-            ``noise[channel].terms.resolved``).
-        """
-        return dict(self.noise[channel].terms.values)
 
     def terms(self) -> IdentifiedTerms:
         """The identified terms of each channel with their uncertainties (:class:`IdentifiedTerms`)."""
