@@ -302,7 +302,7 @@ def round_trip(model: ErrorModel | str, *, duration_s: float, sample_interval_s:
     duration_s, sample_interval_s : float
         Record length and dt, s.
     seed, member : int
-        Address of the record's random numbers.
+        Address of the record's random numbers: seed and member number.
     latitude_rad, heading_rad : float
         Site latitude and heading of the body x axis, rad.
 

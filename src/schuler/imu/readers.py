@@ -356,7 +356,7 @@ def open_csv(path, *, columns: dict[str, str] | None = None, units: dict[str, st
         Refuse accelerometer rates whose mean magnitude is 0.5..1.5 while declared
         in m/s^2 (the file is almost surely in g).
     latitude_rad, longitude_rad, height_m : float, optional
-        The site, which a CSV file does not carry.
+        The site, which a CSV file does not carry: latitude and longitude in rad, height in m.
 
     Returns
     -------
