@@ -17,7 +17,7 @@ from schuler.imu.error_model import (
     gauss_markov_allan_variance,
     gauss_markov_for_bias_instability,
 )
-from schuler.imu.identify import identify_terms
+from schuler.imu.noise_terms import identify_terms
 from schuler.imu.simulate import simulate_members, simulate_record
 from schuler.imu.spec import preset
 
@@ -91,7 +91,7 @@ def test_round_trips_over_seeds_durations_and_rates(seed, duration_s, dt):
 
 @pytest.mark.slow
 def test_reported_sigma_covers_the_scatter_on_fresh_seeds():
-    # the inflation of identify.SIGMA_INFLATION was measured on other seeds; here the rms z-score
+    # the inflation of noise_terms.SIGMA_INFLATION was measured on other seeds; here the rms z-score
     # of N and Q over 8 records x 3 axes must stay between 0.6 and 1.6 (chi-square with ~24 dof: 2.5-97.5 %)
     model = ROUND_TRIP_MODEL.gyro
     scores = {"Q": [], "N": []}

@@ -78,7 +78,7 @@ def test_a_spec_file_is_simulated_and_identified(tmp_path):
     spec.write_text('name = "test part"\n[gyro]\nrandom_walk = "0.3 deg/sqrt(h)"\n'
                     '[accel]\nrandom_walk = "100 ug/sqrt(Hz)"\n', encoding="utf-8")
     result = SYSTEM.run(spec=str(spec), **SHORT)
-    assert result.model.name == "test part"
+    assert result.model == "test part"
     assert result.outputs["noise_gyro_y_N"] == pytest.approx(math.radians(0.3) / 60, rel=0.015)
     assert result.outputs["noise_accel_z_N"] == pytest.approx(100e-6 * 9.80665, rel=0.015)
     assert math.isnan(result.outputs["noise_gyro_y_B"])  # no bias instability in the spec

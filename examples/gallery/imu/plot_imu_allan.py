@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from schuler.imu.allan import allan_deviation
-from schuler.imu.identify import identify_terms
+from schuler.imu.noise_terms import identify_terms
 from schuler.imu.simulate import simulate_record
 from schuler.imu.spec import preset
 
@@ -46,6 +46,8 @@ print(f"B: identified {terms.values['B'] / DEG_H:.2f} ± {terms.sigma['B'] / DEG
       f"spec {model.gyro.bias_instability[0] / DEG_H:.2f} deg/h")
 
 # %%
-# The whole record's six channels, the grade and a round trip (simulate ->
-# identify returns what went in) are :func:`schuler.imu.characterise.analyse_record`
-# and :func:`schuler.imu.characterise.round_trip`.
+# The whole record's six channels, their terms and the grade are
+# :func:`schuler.imu.allan_deviation` (a record or a file; ``plot()`` draws the
+# figures of ``schuler imu allan``) and :func:`schuler.imu.identify`; a round
+# trip (simulate -> identify returns what went in) is
+# :func:`schuler.imu.characterise.round_trip`.

@@ -6,8 +6,7 @@ typed result; :data:`ACTIONS` declares them for the command line.
 * ``info FILE``: what a file holds (:class:`~schuler.imu.record.ImuInfo`), streamed
   chunk by chunk, so any size is read in bounded memory; every line is checked.
 * ``allan FILE``: Allan curves and IEEE 952 terms of the six channels
-  (:class:`~schuler.imu.results.AllanResult`), streamed; the memory it holds
-  (the longest lag's angles per channel) is estimated and refused beyond the budget first.
+  (:func:`~schuler.imu.analysis.allan_deviation`, the same from Python), streamed.
 * ``simulate -o FILE``: a record of a grade or spec file at rest; ``.parquet``
   is written window by window (memory bounded), ``.csv`` in memory after an
   estimate; either appears atomically.
@@ -27,24 +26,17 @@ from pathlib import Path
 
 from schuler.contract import Action, Argument
 from schuler.exceptions import InvalidParameter
-from schuler.imu.characterise import analyse_source
-from schuler.imu.evaluation import PARAMETERS, case_model, sample_interval
-from schuler.imu.files import file_info, open_record, write_record
-from schuler.imu.readers import CHANNELS, CHUNK_ROWS
+from schuler.imu.analysis import PER_OCTAVE, allan_deviation
+from schuler.imu.evaluation import PARAMETERS, sample_interval
+from schuler.imu.files import file_info, write_record
 from schuler.imu.record import KINDS, ImuInfo
 from schuler.imu.results import AllanResult
 from schuler.imu.run_results import SimulationResult
 from schuler.imu.simulate import simulate_record, write_simulation
+from schuler.imu.spec import case_model
 from schuler.memory import require
 from schuler.params import Parameter, ParameterSet
 from schuler.units import quoted
-
-ALLAN_BYTES_PER_SAMPLE = 32
-"""Memory an Allan analysis holds per sample of the file: six channels' angles over twice the longest lag
-(1/8 of the samples), and their copy while a chunk is added, bytes."""
-
-CHUNK_BYTES = CHUNK_ROWS * 7 * 8 * 4
-"""Memory one chunk of a file holds while read and converted, bytes."""
 
 CSV_BYTES_PER_SAMPLE = 600
 """Memory a simulated record written as CSV holds per sample: the simulation, the table and its text, bytes."""
@@ -72,9 +64,7 @@ CSV_OPTIONS = (
 )
 
 INFO_PARAMETERS = ParameterSet(CSV_OPTIONS, owner="imu info")
-ALLAN_PARAMETERS = ParameterSet((*CSV_OPTIONS, Parameter(
-    "per_octave", "", 2, "Averaging times per octave of tau.", minimum=1, maximum=16, kind="integer")),
-    owner="imu allan")
+ALLAN_PARAMETERS = ParameterSet((*CSV_OPTIONS, PER_OCTAVE), owner="imu allan")
 SIMULATE_PARAMETERS = PARAMETERS + ParameterSet((Parameter(
     "seed", "", 0, "Seed of the record's random numbers.", minimum=0, kind="integer"),))
 
@@ -117,8 +107,8 @@ def csv_options(file: Path, kind=None, axes=None, columns=None, units=None, lati
     Returns
     -------
     dict
-        ``open_csv`` keywords: ``kind``, ``axes``, ``columns`` and ``units`` (dicts per channel, ``gyro`` and
-        ``accel`` expanded to their axes) and ``latitude_rad``, only those the user set.
+        ``open_csv`` keywords: ``kind``, ``axes``, ``columns`` and ``units`` (dicts by channel) and
+        ``latitude_rad``, only those the user set.
     """
     given = [name for name, value in (("kind", kind), ("axes", axes), ("columns", columns), ("units", units),
                                       ("latitude", latitude)) if value not in (None, "")]
@@ -134,16 +124,7 @@ def csv_options(file: Path, kind=None, axes=None, columns=None, units=None, lati
     if columns:
         options["columns"] = _pairs(columns, "columns")
     if units:
-        written = _pairs(units, "units")
-        expanded = {}
-        for key, unit in written.items():
-            targets = [f"{key}_{axis}" for axis in "xyz"] if key in ("gyro", "accel") else [key]
-            unknown = [t for t in targets if t not in ("time", *CHANNELS)]
-            if unknown:
-                raise InvalidParameter("units", f"unknown channel {key!r}; channels are time, gyro, accel, "
-                                       + ", ".join(CHANNELS))
-            expanded.update({target: unit for target in targets})
-        options["units"] = expanded
+        options["units"] = _pairs(units, "units")
     if latitude is not None:
         options["latitude_rad"] = latitude
     return options
@@ -169,7 +150,7 @@ def info(file: Path, **options) -> ImuInfo:
 
 
 def allan(file: Path, per_octave: int = 2, **options) -> AllanResult:
-    """Allan deviation with confidence intervals and IEEE 952 terms of the six channels of a file, streamed.
+    """``schuler imu allan FILE``: :func:`~schuler.imu.analysis.allan_deviation` of a file, its options parsed.
 
     Parameters
     ----------
@@ -185,10 +166,7 @@ def allan(file: Path, per_octave: int = 2, **options) -> AllanResult:
     AllanResult
         Curves, terms and grade of the six channels.
     """
-    source = open_record(file, **csv_options(file, **options))
-    require(source.estimated_samples * ALLAN_BYTES_PER_SAMPLE + CHUNK_BYTES, "this Allan analysis",
-            "the file (analyse a part of it)")
-    return analyse_source(source, per_octave=per_octave)
+    return allan_deviation(file, per_octave=per_octave, **csv_options(file, **options))
 
 
 def simulate(output: Path, grade=None, spec=None, duration=3600.0, imu_rate=100.0, output_step=None,

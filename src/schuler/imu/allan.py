@@ -273,7 +273,7 @@ def allan_deviation(rates, sample_interval_s: float, lags=None, chunk: int = 1 <
     sample_interval_s : float
         tau0, s.
     lags : array_like of int, optional
-        Default :func:`allan_lags` (two per octave, up to n / 8).
+        Lags m, number of samples (default :func:`allan_lags`: two per octave, up to n / 8).
     chunk : int
         Samples per streamed chunk (the result does not depend on it beyond rounding).
     """

@@ -3,15 +3,16 @@
 Sources: the grade presets' data sheets (:mod:`~schuler.imu.spec`), IEEE Std
 952-1997 Annex C for the Allan-variance terms, the PSINS toolbox's
 ``lasergyro.imu`` for the real recording. The pieces:
-:mod:`~schuler.imu.evaluation` (parameters, outputs, ``evaluate``,
-``run_case``), :mod:`~schuler.imu.reproduction` (``reproduce``, ``report``),
-:mod:`~schuler.imu.run_results` (the result types and ``write_files``),
+:mod:`~schuler.imu.evaluation` (parameters, outputs, ``evaluate``),
+:mod:`~schuler.imu.reproduction` (``reproduce``, ``report``),
+:mod:`~schuler.imu.run_results` (how a run renders),
+:mod:`~schuler.imu.plots` (``figures``, ``data_files``),
 :mod:`~schuler.imu.actions` (``info``, ``allan``, ``simulate``).
 
 Examples
 --------
 >>> r = SYSTEM.run(grade="consumer", duration=600.0)
->>> r.to_dict()["noise"]["gyro_x"]["N"] > 0, r.round_trip.all_within
+>>> r.to_dict()["noise"]["gyro_x"]["N"] > 0, r.all_within
 (True, True)
 """
 
@@ -19,9 +20,10 @@ from __future__ import annotations
 
 from schuler.contract import System
 from schuler.imu.actions import ACTIONS
-from schuler.imu.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case, sample_interval
+from schuler.imu.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes, sample_interval
+from schuler.imu.plots import data_files, figures
 from schuler.imu.reproduction import REPRODUCE_PARAMETERS, report, reproduce
-from schuler.imu.run_results import write_files
+from schuler.imu.run_results import ImuRun
 from schuler.params import Case
 
 SECONDS_PER_SAMPLE = 1.4e-6
@@ -49,10 +51,11 @@ SYSTEM = System(
     parameters=PARAMETERS,
     outputs=OUTPUTS,
     evaluate=evaluate,
-    run_case=run_case,
     reproduce=reproduce,
     reproduce_parameters=REPRODUCE_PARAMETERS,
-    write_files=write_files,
+    figures=figures,
+    data_files=data_files,
+    result_type=ImuRun,
     report=report,
     actions=ACTIONS,
     random_terms=True,

@@ -22,7 +22,7 @@ from schuler.exceptions import InvalidParameter
 from schuler.imu.allan import DEFAULT_MAX_FRACTION, AllanAccumulator, AllanCurve, allan_lags
 from schuler.imu.error_model import ErrorModel, SensorErrors
 from schuler.imu.files import open_record, read_record
-from schuler.imu.identify import TERMS, identify_terms, no_terms
+from schuler.imu.noise_terms import TERMS, identify_terms, no_terms
 from schuler.imu.readers import RecordSource
 from schuler.imu.record import ImuRecord, record_info
 from schuler.imu.results import (
@@ -40,7 +40,7 @@ from schuler.imu.spec import GRADES, preset
 TOLERANCE_FACTORS = {"Q": 3.0, "N": 3.0, "B": 3.0, "K": 3.0, "R": 3.0}
 """Round-trip tolerance of each term in units of its standard uncertainty (3 sigma).
 
-The sigma (:mod:`~schuler.imu.identify`, inflated for the correlation of
+The sigma (:mod:`~schuler.imu.noise_terms`, inflated for the correlation of
 overlapping estimates) is what makes N and Q tight (~0.1-1 %: many short-tau
 points with huge edf) and B and K loose (10-50 %: the few long-tau points with
 edf of a few)."""
@@ -76,9 +76,13 @@ def classify_grade(noise: dict) -> tuple[str | None, dict[str, float]]:
     -------
     grade, margins : str or None, dict
         ``margins[grade]`` is the largest ratio model / upper bound (<= 1.05: consistent);
-        the grade is None when no preset is consistent (a sensor noisier than consumer MEMS).
+        the grade is None when no preset is consistent (a sensor noisier than consumer MEMS), and None with no
+        margins when ``noise`` holds no gyro channel.
     """
     from scipy.stats import chi2
+
+    if not any(sensor_of(name) == "gyro" for name in noise):
+        return None, {}
 
     margins: dict[str, float] = {}
     for grade in GRADES:
@@ -97,7 +101,8 @@ def classify_grade(noise: dict) -> tuple[str | None, dict[str, float]]:
 
 
 def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, kind: str = "rate",
-                   source: str = "", per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION) -> AllanResult:
+                   source: str = "", per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION,
+                   channels: tuple[str, ...] = CHANNELS) -> AllanResult:
     """Allan analysis of streamed ``(time_s, gyro, accel)`` chunks (rates or increments, see ``kind``).
 
     ``expected_samples`` sets the lags (an estimate is fine: lags beyond
@@ -121,29 +126,35 @@ def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, k
         Averaging times per octave of tau, number of.
     max_fraction : float
         Longest lag as a fraction of the samples seen, ratio (default 1/8).
+    channels : tuple of str
+        The channels to analyse, of :data:`~schuler.imu.results.CHANNELS` (default all six; the grade is
+        judged on the gyro channels among them).
 
     Returns
     -------
     AllanResult
-        Curves with confidence intervals, identified terms of the six channels and the grade they match.
+        Curves with confidence intervals, identified terms of the channels and the grade they match.
     """
     dt = float(sample_interval_s)
     lags = allan_lags(max(4, int(expected_samples)), per_octave=per_octave, max_fraction=max_fraction)
-    accumulator = AllanAccumulator(dt, lags, channels=6)
+    # all six columns as they come (a copy's layout would move the offsets' rounding)
+    columns = slice(None) if channels == CHANNELS else [CHANNELS.index(name) for name in channels]
+    accumulator = AllanAccumulator(dt, lags, channels=len(channels))
     for _, gyro, accel in chunks:
-        block = np.concatenate([gyro, accel], axis=1)
+        block = np.concatenate([gyro, accel], axis=1)[:, columns]
         accumulator.update(block / dt if kind == "increment" else block)
     if accumulator.samples < 16:
         raise InvalidParameter("samples", f"an Allan analysis needs at least 16 samples, got {accumulator.samples}")
     curves = accumulator.curves(max_lag=int(accumulator.samples * max_fraction))
     noise = {name: ChannelNoise(curve=curve, terms=identify_terms(curve) if np.any(curve.adev > 0) else no_terms())
-             for name, curve in zip(CHANNELS, curves)}
+             for name, curve in zip(channels, curves)}
     grade, margins = classify_grade(noise)
     return AllanResult(source=source, samples=accumulator.samples, sample_interval_s=dt,
                        duration_s=accumulator.samples * dt, noise=noise, grade=grade, grade_margin=margins)
 
 
-def analyse_record(record: ImuRecord, per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION) -> AllanResult:
+def analyse_record(record: ImuRecord, per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION,
+                   channels: tuple[str, ...] = CHANNELS) -> AllanResult:
     """Allan curves with confidence intervals and IEEE 952 terms of the six channels of a record.
 
     Parameters
@@ -154,11 +165,13 @@ def analyse_record(record: ImuRecord, per_octave: int = 2, max_fraction: float =
         Averaging times per octave of tau, number of.
     max_fraction : float
         Longest lag as a fraction of the record's samples, ratio (default 1/8).
+    channels : tuple of str
+        The channels to analyse (default all six, :data:`~schuler.imu.results.CHANNELS`).
 
     Returns
     -------
     AllanResult
-        Curves, terms and grade of the six channels.
+        Curves, terms and grade of the channels.
 
     Examples
     --------
@@ -170,11 +183,11 @@ def analyse_record(record: ImuRecord, per_octave: int = 2, max_fraction: float =
     """
     chunks = [(record.time_s, record.gyro_rate_rad_s, record.accel_m_s2)]
     return analyse_chunks(chunks, sample_interval_s=record.sample_interval_s, expected_samples=record.samples,
-                          source=record.source, per_octave=per_octave, max_fraction=max_fraction)
+                          source=record.source, per_octave=per_octave, max_fraction=max_fraction, channels=channels)
 
 
-def analyse_source(source: RecordSource, per_octave: int = 2,
-                   max_fraction: float = DEFAULT_MAX_FRACTION) -> AllanResult:
+def analyse_source(source: RecordSource, per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION,
+                   channels: tuple[str, ...] = CHANNELS) -> AllanResult:
     """Allan analysis of an opened file, chunk by chunk (memory bounded by the longest lag, not the file).
 
     Parameters
@@ -185,11 +198,13 @@ def analyse_source(source: RecordSource, per_octave: int = 2,
         Averaging times per octave of tau, number of.
     max_fraction : float
         Longest lag as a fraction of the samples read, ratio (default 1/8).
+    channels : tuple of str
+        The channels to analyse (default all six, :data:`~schuler.imu.results.CHANNELS`).
 
     Returns
     -------
     AllanResult
-        Curves, terms and grade of the six channels; ``source`` is the file's name.
+        Curves, terms and grade of the channels; ``source`` is the file's name.
     """
     chunks = source.chunks()
     first = next(chunks, None)
@@ -202,7 +217,7 @@ def analyse_source(source: RecordSource, per_octave: int = 2,
 
     return analyse_chunks(all_chunks(), sample_interval_s=source.interval_s(),
                           expected_samples=source.estimated_samples, kind=source.kind, source=source.path.name,
-                          per_octave=per_octave, max_fraction=max_fraction)
+                          per_octave=per_octave, max_fraction=max_fraction, channels=channels)
 
 
 def analyse_file(path, per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION, **options) -> AllanResult:
@@ -287,7 +302,7 @@ def round_trip(model: ErrorModel | str, *, duration_s: float, sample_interval_s:
     duration_s, sample_interval_s : float
         Record length and dt, s.
     seed, member : int
-        Address of the record's random numbers.
+        Address of the record's random numbers: seed and member number.
     latitude_rad, heading_rad : float
         Site latitude and heading of the body x axis, rad.
 

@@ -1,4 +1,4 @@
-"""What ``schuler imu run`` evaluates: its parameters, outputs, ``evaluate`` and ``run_case``.
+"""What ``schuler imu run`` evaluates: its parameters, outputs and ``evaluate``.
 
 A case is an IMU (a grade preset or a TOML spec file, :mod:`~schuler.imu.spec`)
 recording at rest and level at a site for ``duration`` at ``imu_rate``. Its
@@ -23,6 +23,12 @@ the identified terms over N independent records (seed S, members 0 .. N-1):
 the scatter of the estimator, from which the tolerances are judged. A case's
 numbers never depend on chunking or executor.
 
+A run in full (``histories=True``) keeps the first case's Allan curves as
+histories over the averaging time (``imu_allan``, indexed by ``tau_s``: the
+columns of ``imu_allan.csv``) and, as extras, the record (model, seed, member,
+samples, site), the round trip's checks, the true and identified terms and the
+grade the gyro curves belong to: ``schuler imu run --json``'s keys.
+
 Memory: one record is simulated and analysed at a time, about
 :data:`BYTES_PER_SAMPLE` bytes per sample (measured with tracemalloc on a
 one-hour 100 Hz industrial record: 223 bytes), refused beyond the budget
@@ -35,15 +41,25 @@ import math
 
 import numpy as np
 
-from schuler.contract import Cases, Output
+from schuler.contract import Cases, Evaluation, Output
 from schuler.exceptions import InvalidParameter
 from schuler.imu.characterise import round_trip, true_terms
 from schuler.imu.error_model import ErrorModel
-from schuler.imu.results import CHANNELS, DISPLAY_UNITS, TERM_UNITS, RoundTripResult, sensor_of
-from schuler.imu.run_results import ImuRunResult
-from schuler.imu.spec import GRADES, load_spec_file, preset
+from schuler.imu.results import (
+    CHANNELS,
+    CHECK_UNITS,
+    DISPLAY_UNITS,
+    GRADE_MARGIN_UNITS,
+    NOISE_UNITS,
+    TERM_UNITS,
+    RoundTripResult,
+    curves_histories,
+    sensor_of,
+)
+from schuler.imu.spec import GRADES, case_model
 from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
+from schuler.results import json_safe
 
 NOMINAL_SEED = 0
 """Seed of the nominal case's record (``cases.random`` is None)."""
@@ -108,24 +124,6 @@ OUTPUTS = (
 )
 
 
-def case_model(grade: str | None, spec: str | None) -> ErrorModel:
-    """The error model of a case: the spec file when given, else the grade preset.
-
-    Parameters
-    ----------
-    grade : str or None
-        Grade preset, one of :data:`~schuler.imu.spec.GRADES` (None: the default, tactical).
-    spec : str or None
-        Path of a TOML spec file (figures in spec-sheet units); when set it wins over ``grade``.
-
-    Returns
-    -------
-    ErrorModel
-        The IMU's error terms, SI.
-    """
-    return load_spec_file(spec) if spec else preset(grade or PARAMETERS["grade"].default)
-
-
 def sample_interval(imu_rate: float, output_step: float | None) -> float:
     """dt, s: ``output_step`` when set, else 1 / ``imu_rate``.
 
@@ -168,7 +166,7 @@ def record_samples(duration: float, dt: float) -> int:
 
 
 def _round_trip(case: Case, seed: int, member: int, models: dict) -> tuple[ErrorModel, RoundTripResult]:
-    key = (case["grade"], case["spec"])
+    key = (case["grade"], case["spec"])  # one model per grade or spec file in a batch
     if key not in models:
         models[key] = case_model(*key)
     model = models[key]
@@ -202,7 +200,12 @@ def outputs_of(trip: RoundTripResult) -> dict[str, float]:
     return out
 
 
-def evaluate(cases: Cases) -> dict[str, np.ndarray]:
+EXTRA_UNITS = {**NOISE_UNITS, **CHECK_UNITS, **GRADE_MARGIN_UNITS, "samples": "1", "seed": "1", "member": "1",
+               "fraction_within_tolerance": "1"}
+"""Units of a run's extras whose key does not name one (the terms by letter, the checks, the grade margins)."""
+
+
+def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:
     """Every output of :data:`OUTPUTS` for a batch of cases: one simulated record per case (see the module notes).
 
     Parameters
@@ -210,52 +213,52 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     cases : Cases
         A batch of validated cases (SI values); the record's random numbers from ``cases.random`` (seed
         :data:`NOMINAL_SEED` when None) at ``cases.members``.
+    histories : bool
+        Whether to give the first case in full: its Allan curves (``imu_allan``) and the record's analysis as
+        extras (an :class:`~schuler.contract.Evaluation`).
 
     Returns
     -------
-    dict of str to ndarray
+    dict of str to ndarray, or Evaluation
         Output name -> values of shape (number of cases,), SI.
+
+    Examples
+    --------
+    >>> run = evaluate(Cases.from_case(PARAMETERS.case(grade="consumer", duration=600.0)), histories=True)
+    >>> round(float(run["noise_gyro_x_N"][0] / run.extras["true_terms"]["gyro_x"]["N"]), 2)
+    1.0
     """
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     seed = NOMINAL_SEED if cases.random is None else cases.random.seed
     models: dict = {}
+    first = None
     for i in range(n):
-        _, trip = _round_trip(cases.case(i), seed, int(cases.members[i]), models)
+        model, trip = _round_trip(cases.case(i), seed, int(cases.members[i]), models)
+        first = first or (model, trip)
         for name, value in outputs_of(trip).items():
             out[name][i] = value
-    return out
+    if not histories:
+        return out
+    assert first is not None, "a batch holds at least one case"
+    return _in_full(cases.case(0), *first, out)
 
 
-def run_case(case: Case, fidelity: str | None = None) -> ImuRunResult:
-    """One case in full: the round trip of the nominal record (seed 0, member 0) with its Allan curves.
-
-    Parameters
-    ----------
-    case : Case
-        Every parameter of :data:`PARAMETERS`, SI.
-    fidelity : str or None
-        The contract's evaluation fidelity; this system has a single way of evaluating, so it is not used.
-
-    Returns
-    -------
-    ImuRunResult
-        The model, the round trip with its curves, the outputs (SI) and the true terms per channel.
-
-    Examples
-    --------
-    >>> r = run_case(PARAMETERS.case(grade="consumer", duration=600.0))
-    >>> round(float(r.outputs["noise_gyro_x_N"] / r.true_terms["gyro_x"]["N"]), 2)
-    1.0
-    """
-    model, trip = _round_trip(case, NOMINAL_SEED, 0, {})
+def _in_full(case: Case, model: ErrorModel, trip: RoundTripResult, outputs: dict[str, np.ndarray]) -> Evaluation:
+    """The first case in full: its Allan curves over tau and the record's analysis (JSON-safe extras)."""
+    analysis = trip.analysis
     truth = {}
     for channel in CHANNELS:
         errors = model.gyro if sensor_of(channel) == "gyro" else model.accel
         terms = true_terms(errors, "xyz".index(channel[-1]))
         truth[channel] = {term: float(terms[term]) for term in OUTPUT_TERMS}
-    return ImuRunResult(model=model, round_trip=trip, outputs=outputs_of(trip), true_terms=truth,
-                        latitude_rad=case["latitude"], azimuth_rad=case["azimuth"])
+    extras = {"model": model.name, "model_source": model.source, "seed": trip.seed, "member": trip.member,
+              "samples": analysis.samples, "duration_s": trip.duration_s, "sample_interval_s": trip.sample_interval_s,
+              "latitude_rad": case["latitude"], "azimuth_rad": case["azimuth"], "all_within": trip.all_within,
+              "grade": analysis.grade, "grade_margin": json_safe(analysis.grade_margin), "true_terms": truth,
+              "checks": json_safe(trip.checks), "noise": analysis.to_dict()["noise"]}
+    return Evaluation(outputs, histories={"imu_allan": curves_histories(analysis.noise)}, extras=extras,
+                      units=EXTRA_UNITS)
 
 
 def member_bytes(case: Case) -> int:
@@ -275,5 +278,4 @@ def member_bytes(case: Case) -> int:
     return int(BYTES_PER_SAMPLE * max(1.0, case["duration"] / dt))
 
 
-__all__ = ["NOMINAL_SEED", "OUTPUTS", "PARAMETERS", "case_model", "evaluate", "member_bytes", "outputs_of",
-           "run_case"]
+__all__ = ["NOMINAL_SEED", "OUTPUTS", "PARAMETERS", "evaluate", "member_bytes", "outputs_of"]

@@ -34,7 +34,8 @@ def open_record(path, **options) -> RecordSource:
         The file: ``.imu`` (PSINS), ``.parquet`` (native) or anything else (CSV).
     **options
         Keywords of :func:`~schuler.imu.readers.open_csv` (column mapping, units, kind, axes, site in rad and m);
-        refused for ``.imu`` and ``.parquet``.
+        in ``units``, ``gyro`` and ``accel`` stand for their three axes (``{"gyro": "deg/s"}``); refused for
+        ``.imu`` and ``.parquet``.
 
     Returns
     -------
@@ -55,6 +56,10 @@ def open_record(path, **options) -> RecordSource:
         return open_psins(path)
     if suffix == ".parquet":
         return open_parquet(path)
+    if options.get("units"):
+        # "gyro" and "accel" stand for their three axes
+        options["units"] = {name: unit for key, unit in options["units"].items()
+                            for name in ([f"{key}_{axis}" for axis in "xyz"] if key in ("gyro", "accel") else [key])}
     return open_csv(path, **options)
 
 

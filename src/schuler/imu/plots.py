@@ -1,20 +1,29 @@
 """Figures of the IMU layer: log-log Allan deviation with confidence bands, the fit, slope lines and values.
 
 Each function builds one matplotlib figure from SI results and shows gyros in
-deg/h and accelerometers in ug; :func:`write_figures` saves figures (PNG and
-SVG) through :mod:`schuler.io`.
+deg/h and accelerometers in ug. An analysis is drawn from an
+:class:`~schuler.imu.results.AllanResult` or from its ``noise`` JSON (a run
+keeps that), so a result redraws from what it holds. :func:`figures` is the
+system's hook (every result of ``schuler imu``), :func:`data_files` its CSV
+beside the generic writer's; :func:`write_figures` saves figures (PNG and SVG)
+through :mod:`schuler.io`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from schuler.imu.error_model import ErrorModel
-from schuler.imu.identify import SLOPES, term_allan_deviations
-from schuler.imu.results import DISPLAY_UNITS, AllanResult, sensor_of, shown_unit
-from schuler.io import save_figure_formats
+from schuler.imu.noise_terms import SLOPES, model_allan_deviation, term_allan_deviations
+from schuler.imu.results import DISPLAY_UNITS, AllanResult, IdentifiedTerms, sensor_of, shown_unit
+from schuler.imu.spec import case_model
+from schuler.io import save_figure_formats, write_dataframe_csv
+from schuler.reproduction import Reproduction
+from schuler.results import Result, SystemResult
 from schuler.units import to_unit
 
 _ADEV_UNITS = {"gyro": "deg/h", "accel": "ug"}
@@ -30,51 +39,87 @@ def _figure(columns: int):
     return fig, axes[0]
 
 
-def allan_figure(result: AllanResult, sensor: str = "gyro", true_model: ErrorModel | None = None):
+def _noise(analysis: AllanResult | Mapping) -> Mapping[str, Mapping[str, Any]]:
+    """Channel -> its ``noise.<channel>`` data (curve arrays, terms, ``resolved``) of an analysis or its JSON."""
+    if isinstance(analysis, AllanResult):
+        return {name: channel.to_dict() for name, channel in analysis.noise.items()}
+    return analysis
+
+
+def _curve(channel: Mapping[str, Any], key: str) -> np.ndarray:
+    return np.asarray(channel[key], dtype=float)  # a JSON null (not finite) becomes NaN
+
+
+def _exact(model: ErrorModel, name: str, tau) -> np.ndarray:
+    errors = model.gyro if sensor_of(name) == "gyro" else model.accel
+    return np.sqrt(errors.allan_variance(tau, "xyz".index(name[-1])))
+
+
+def _title(analysis: AllanResult | Mapping, sensor: str, title: str | None) -> str:
+    if title is not None:
+        return title
+    grade = analysis.grade if isinstance(analysis, AllanResult) else None
+    source = analysis.source if isinstance(analysis, AllanResult) else "record"
+    return f"{source}: {sensor} Allan deviation" + (f" (grade: {grade})" if grade else "")
+
+
+def allan_figure(analysis: AllanResult | Mapping, sensor: str = "gyro", true_model: ErrorModel | None = None,
+                 title: str | None = None):
     """Allan deviation of the three axes of one sensor: data with 68 % band, fit, term slope lines.
 
     Parameters
     ----------
-    result : AllanResult
+    analysis : AllanResult or mapping
+        The analysis, or its ``noise`` JSON (channel -> ``tau_s`` in s, ``adev`` and its bounds in rad/s or m/s^2,
+        the terms in the units of :data:`~schuler.imu.results.TERM_UNITS`, ``resolved``).
     sensor : {"gyro", "accel"}
+        Which triad to draw (gyros shown in deg/h, accelerometers in ug).
     true_model : ErrorModel, optional
         Draw the model's exact curve too (round trips).
+    title : str, optional
+        Title of the figure (not set: the record's name, the sensor and the grade).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per axis.
     """
     unit = _ADEV_UNITS[sensor]
-    names = [name for name in result.noise if sensor_of(name) == sensor]
+    noise = _noise(analysis)
+    names = [name for name in noise if sensor_of(name) == sensor]
     fig, axes = _figure(len(names))
     for axis, name in zip(axes, names):
-        channel = result.noise[name]
-        curve, terms = channel.curve, channel.terms
-        tau = curve.tau_s
-        axis.fill_between(tau, to_unit(curve.adev_lower, unit), to_unit(curve.adev_upper, unit), alpha=0.25,
-                          color="C0", label="68 % confidence")
-        axis.loglog(tau, to_unit(curve.adev, unit), "o", ms=3.5, color="C0", label="overlapping ADEV")
-        axis.loglog(tau, to_unit(terms.model_adev(tau), unit), "-", color="k", lw=1.2, label="IEEE 952 fit")
-        lines = term_allan_deviations(terms.values, tau)
+        channel = noise[name]
+        tau = _curve(channel, "tau_s")
+        values = {term: float(channel[term]) for term in SLOPES}
+        axis.fill_between(tau, to_unit(_curve(channel, "adev_lower"), unit), to_unit(_curve(channel, "adev_upper"),
+                          unit), alpha=0.25, color="C0", label="68 % confidence")
+        axis.loglog(tau, to_unit(_curve(channel, "adev"), unit), "o", ms=3.5, color="C0", label="overlapping ADEV")
+        axis.loglog(tau, to_unit(model_allan_deviation(values, tau), unit), "-", color="k", lw=1.2,
+                    label="IEEE 952 fit")
+        lines = term_allan_deviations(values, tau)
         for index, term in enumerate(("Q", "N", "B", "K", "R")):
-            if not terms.resolved[term]:
+            if not channel["resolved"][term]:
                 continue
             display = DISPLAY_UNITS[sensor][term]
             axis.loglog(tau, to_unit(lines[term], unit), "--", lw=0.9, color=f"C{index + 1}",
-                        label=f"{term} = {to_unit(terms.values[term], display):.3g} {shown_unit(display)} "
+                        label=f"{term} = {to_unit(values[term], display):.3g} {shown_unit(display)} "
                               f"(slope {SLOPES[term]:+g})")
         if true_model is not None:
-            errors = true_model.gyro if sensor == "gyro" else true_model.accel
-            exact = np.sqrt(errors.allan_variance(tau, "xyz".index(name[-1])))
-            axis.loglog(tau, to_unit(exact, unit), ":", color="C3", lw=1.5, label="true model")
+            axis.loglog(tau, to_unit(_exact(true_model, name, tau), unit), ":", color="C3", lw=1.5,
+                        label="true model")
         axis.set_title(name)
         axis.set_xlabel("averaging time tau [s]")
         axis.grid(True, which="both", alpha=0.3)
         axis.legend(loc="best", fontsize=6.5)
     axes[0].set_ylabel(f"Allan deviation [{shown_unit(unit)}]")
-    fig.suptitle(f"{result.source}: {sensor} Allan deviation" + (f" (grade: {result.grade})" if result.grade else ""))
+    fig.suptitle(_title(analysis, sensor, title))
     # fixed margins: tight_layout measures every log tick label and took most of the figure's time
     fig.subplots_adjust(left=0.06, right=0.99, bottom=0.11, top=0.88, wspace=0.06)
     return fig
 
 
-def channel_curves(result: AllanResult, sensor: str = "gyro", true_model: ErrorModel | None = None,
+def channel_curves(analysis: AllanResult | Mapping, sensor: str = "gyro", true_model: ErrorModel | None = None,
                    title: str | None = None):
     """Compact figure for the report (6.5 in wide, default font sizes): three axes' curves and fits on one plot.
 
@@ -83,8 +128,8 @@ def channel_curves(result: AllanResult, sensor: str = "gyro", true_model: ErrorM
 
     Parameters
     ----------
-    result : AllanResult
-        The analysis whose curves (SI) are drawn; gyros shown in deg/h, accelerometers in ug.
+    analysis : AllanResult or mapping
+        The analysis, or its ``noise`` JSON (curves SI); gyros shown in deg/h, accelerometers in ug.
     sensor : {"gyro", "accel"}
         Which triad's three axes to draw.
     true_model : ErrorModel, optional
@@ -104,18 +149,19 @@ def channel_curves(result: AllanResult, sensor: str = "gyro", true_model: ErrorM
 
     unit = _ADEV_UNITS[sensor]
     fig, axis = plt.subplots(figsize=(6.5, 4.4))
-    names = [name for name in result.noise if sensor_of(name) == sensor]
+    noise = _noise(analysis)
+    names = [name for name in noise if sensor_of(name) == sensor]
     for index, name in enumerate(names):
-        channel = result.noise[name]
-        curve, color = channel.curve, f"C{index}"
-        adev = to_unit(curve.adev, unit)
-        bars = np.vstack([adev - to_unit(curve.adev_lower, unit), to_unit(curve.adev_upper, unit) - adev])
-        axis.errorbar(curve.tau_s, adev, yerr=bars, fmt="o", ms=3.5, color=color, elinewidth=0.8, label=name)
-        axis.loglog(curve.tau_s, to_unit(channel.terms.model_adev(curve.tau_s), unit), "-", color=color, lw=1.0)
+        channel, color = noise[name], f"C{index}"
+        tau = _curve(channel, "tau_s")
+        adev = to_unit(_curve(channel, "adev"), unit)
+        bars = np.vstack([adev - to_unit(_curve(channel, "adev_lower"), unit),
+                          to_unit(_curve(channel, "adev_upper"), unit) - adev])
+        axis.errorbar(tau, adev, yerr=bars, fmt="o", ms=3.5, color=color, elinewidth=0.8, label=name)
+        fit = model_allan_deviation({term: float(channel[term]) for term in SLOPES}, tau)
+        axis.loglog(tau, to_unit(fit, unit), "-", color=color, lw=1.0)
         if true_model is not None:
-            errors = true_model.gyro if sensor == "gyro" else true_model.accel
-            exact = np.sqrt(errors.allan_variance(curve.tau_s, "xyz".index(name[-1])))
-            axis.loglog(curve.tau_s, to_unit(exact, unit), ":", color="k", lw=1.2,
+            axis.loglog(tau, to_unit(_exact(true_model, name, tau), unit), ":", color="k", lw=1.2,
                         label="true model" if index == 0 else None)
     axis.plot([], [], "-", color="0.4", label="IEEE 952 fit")
     axis.set_xscale("log")
@@ -137,7 +183,7 @@ def monte_carlo_figure(summary, true_terms: dict):
     summary : MonteCarloSummary
         The Monte Carlo of ``schuler imu run``: its ``samples`` of ``noise_<channel>_<term>`` (SI) per member.
     true_terms : dict of str to dict of str to float
-        Channel -> term -> true value, SI (:attr:`~schuler.imu.run_results.ImuRunResult.true_terms`); the ratio
+        Channel -> term -> true value, SI (a run's ``true_terms``); the ratio
         identified / true is a plain number, so only matching units matter.
 
     Returns
@@ -191,3 +237,68 @@ def write_figures(figures: dict, outdir, formats=("png", "svg")) -> list[Path]:
     for stem, fig in figures.items():
         paths += save_figure_formats(fig, Path(outdir) / stem, formats)
     return paths
+
+
+def figures(result: Result) -> dict[str, Any]:
+    """The figures of any ``schuler imu`` result, file stem -> Figure ({} for ``info`` and ``simulate``).
+
+    A run: ``imu_allan_gyro`` and ``imu_allan_accel`` with the true model's
+    curves (the model of its ``grade`` or ``spec``), and ``imu_monte_carlo``
+    with a Monte Carlo; an Allan analysis (or its identified terms): its
+    Allan figures (one per sensor analysed); the reproduction: two per
+    analysed record.
+
+    Parameters
+    ----------
+    result : Result
+        What ``run``, ``reproduce``, an action, :func:`~schuler.imu.analysis.allan_deviation` or
+        :func:`~schuler.imu.analysis.identify` returned.
+    """
+    if isinstance(result, IdentifiedTerms):
+        result = result.analysis
+    if isinstance(result, AllanResult):
+        return _analysis_figures(result, "imu_allan")
+    if isinstance(result, Reproduction):
+        drawn: dict[str, Any] = {}
+        for stem, analysis in (result.data or {}).items():
+            drawn.update(_analysis_figures(analysis, stem))
+        return drawn
+    if not isinstance(result, SystemResult):
+        return {}
+    extras, parameters = result.extras, result.parameters
+    model = case_model(parameters["grade"], parameters["spec"])
+    grade = f" (grade: {extras['grade']})" if extras["grade"] else ""
+    drawn = {f"imu_allan_{sensor}": allan_figure(
+        extras["noise"], sensor, model, f"simulated {extras['model']}, seed {extras['seed']}, member "
+                                        f"{extras['member']}: {sensor} Allan deviation{grade}")
+        for sensor in ("gyro", "accel")}
+    if result.monte_carlo is not None:
+        drawn["imu_monte_carlo"] = monte_carlo_figure(result.monte_carlo, extras["true_terms"])
+    return drawn
+
+
+def _analysis_figures(analysis: AllanResult, stem: str) -> dict[str, Any]:
+    sensors = {sensor_of(name) for name in analysis.noise}
+    return {f"{stem}_{sensor}": allan_figure(analysis, sensor) for sensor in ("gyro", "accel") if sensor in sensors}
+
+
+def data_files(result: Result, out_dir: Path) -> list[Path]:
+    """The reproduction's curves as CSV, ``<stem>.csv`` per analysed record (a run's and an analysis' curves are
+    their histories, which the generic writer writes as ``imu_allan.csv``).
+
+    Parameters
+    ----------
+    result : Result
+        What an ``imu`` command returned.
+    out_dir : Path
+        Folder to write into (created if missing).
+
+    Returns
+    -------
+    list of Path
+        The files written: columns ``tau_s`` (s), adev and bounds per channel (rad/s, m/s^2), edf.
+    """
+    if not isinstance(result, Reproduction):
+        return []
+    return [write_dataframe_csv(analysis.to_dataframe().reset_index(), Path(out_dir) / f"{stem}.csv")
+            for stem, analysis in (result.data or {}).items()]

@@ -345,7 +345,7 @@ def open_csv(path, *, columns: dict[str, str] | None = None, units: dict[str, st
         Channel (``time``, ``gyro_x`` .. ``accel_z``) -> the file's column name.
         Default: the project's header :data:`CSV_HEADER`.
     units : dict, optional
-        Channel -> unit as written ("deg/s", "g", "deg", "m/s", "ms"). Defaults:
+        Channel -> unit as text ("deg/s", "g", "deg", "m/s", "ms") or a pint unit. Defaults:
         s, rad/s and m/s^2 for rates, rad and m/s for increments.
     kind : {"rate", "increment"}
         What the sensor columns hold.
@@ -356,7 +356,7 @@ def open_csv(path, *, columns: dict[str, str] | None = None, units: dict[str, st
         Refuse accelerometer rates whose mean magnitude is 0.5..1.5 while declared
         in m/s^2 (the file is almost surely in g).
     latitude_rad, longitude_rad, height_m : float, optional
-        The site, which a CSV file does not carry.
+        The site, which a CSV file does not carry: latitude and longitude in rad, height in m.
 
     Returns
     -------
@@ -443,7 +443,7 @@ def _csv_mapping(path: Path, names: list[str], columns: dict | None, header_line
 def _csv_scales(units: dict[str, str], kind: str) -> dict[str, float]:
     unknown = set(units) - {"time", *CHANNELS}
     if unknown:
-        raise InvalidParameter("units", f"unknown channel {sorted(unknown)[0]!r}; channels are time, "
+        raise InvalidParameter("units", f"unknown channel {sorted(unknown)[0]!r}; channels are time, gyro, accel, "
                                + ", ".join(CHANNELS))
     expected = {"time": "s", **{c: ("rad/s" if kind == "rate" else "rad") for c in CHANNELS[:3]},
                 **{c: ("m/s^2" if kind == "rate" else "m/s") for c in CHANNELS[3:]}}

@@ -11,11 +11,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from schuler.core.response import Histories
 from schuler.imu.allan import AllanCurve
-from schuler.imu.identify import TERMS, NoiseTerms
+from schuler.imu.noise_terms import TERMS, NoiseTerms
 from schuler.imu.record import ImuInfo
 from schuler.imu.spec import GRADES
 from schuler.results import Footnotes, Result, json_safe
+
+SHOWN_TERMS = ("N", "B", "K", "Q", "R")
+"""The IEEE 952 terms in the order of tables and outputs."""
 
 CHANNELS = ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
 
@@ -97,23 +101,93 @@ class ChannelNoise:
                 "adev_upper": self.curve.adev_upper, "edf": self.curve.edf}
 
 
-def _term_text(channel: str, term: str, value: float, resolved: bool, upper: float) -> str:
+def _number(value) -> float:
+    """A term's number from a result or from its JSON (None there: not finite)."""
+    return math.nan if value is None else float(value)
+
+
+def _term_text(channel: str, term: str, value, resolved: bool, upper) -> str:
     from schuler.units import to_unit
 
     unit = DISPLAY_UNITS[sensor_of(channel)][term]
     if resolved:
-        return f"{to_unit(value, unit):.3g}"
+        return f"{to_unit(_number(value), unit):.3g}"
+    upper = _number(upper)
     return f"< {to_unit(upper, unit):.2g}" if math.isfinite(upper) and upper > 0 else "-"
+
+
+def terms_table(noise: dict, title: str, grade: str | None = None):
+    """The terms of each channel in display units, unresolved ones as an upper bound (a rich Table).
+
+    Parameters
+    ----------
+    noise : dict
+        Channel -> its ``noise.<channel>`` JSON (:meth:`ChannelNoise.to_dict`): N, B, K, Q, R in the units of
+        :data:`TERM_UNITS`, ``resolved``, ``upper_bound`` and ``chi2_per_point``.
+    title : str
+        Title of the table.
+    grade : str, optional
+        The grade the gyro curves belong to (shown in the caption).
+    """
+    from rich.table import Table
+
+    table = Table(title=title)
+    table.add_column("channel")
+    for term in SHOWN_TERMS:
+        table.add_column(term, justify="right")
+    table.add_column("fit chi2/point", justify="right")
+    for sensor in ("gyro", "accel"):
+        units = DISPLAY_UNITS[sensor]
+        names = [name for name in noise if sensor_of(name) == sensor]
+        if names:
+            table.add_row(f"[dim]{sensor} unit[/dim]", *(f"[dim]{shown_unit(units[t])}[/dim]" for t in SHOWN_TERMS),
+                          "")
+        for name in names:
+            channel = noise[name]
+            table.add_row(name, *(_term_text(name, term, channel[term], channel["resolved"][term],
+                                             channel["upper_bound"][term]) for term in SHOWN_TERMS),
+                          f"{_number(channel['chi2_per_point']):.3g}")
+    if grade:
+        table.caption = (f"grade: {grade} (the closest preset below the gyro curves); '< x': not resolved in this "
+                         "record, about 2-sigma upper bound")
+    return table
+
+
+def curves_histories(noise: dict[str, ChannelNoise]) -> Histories:
+    """The Allan curves as histories over the averaging time ``tau_s``: what ``imu_allan.csv`` holds.
+
+    Parameters
+    ----------
+    noise : dict of str to ChannelNoise
+        The analysed channels; every curve shares the first channel's averaging times (s).
+
+    Returns
+    -------
+    Histories
+        Indexed by ``tau_s`` (s): ``<channel>_adev_rad_s`` / ``_m_s2`` with their lower and upper 68 % bounds
+        (rad/s or m/s^2) and ``<channel>_edf`` (plain number) per channel.
+    """
+    channels, units = {}, {}
+    for name, channel in noise.items():
+        curve = channel.curve
+        unit, suffix = ("rad/s", "rad_s") if sensor_of(name) == "gyro" else ("m/s^2", "m_s2")
+        for key, values in ((f"{name}_adev_{suffix}", curve.adev), (f"{name}_adev_lower_{suffix}", curve.adev_lower),
+                            (f"{name}_adev_upper_{suffix}", curve.adev_upper), (f"{name}_edf", curve.edf)):
+            channels[key], units[key] = values, "1" if key.endswith("_edf") else unit
+    return Histories(next(iter(noise.values())).curve.tau_s, channels, units, time_name="tau_s")
 
 
 @dataclass
 class AllanResult(Result):
-    """Allan deviation and IEEE 952 terms of the six channels of a record.
+    """Allan deviation and IEEE 952 terms of the channels of a record (all six unless fewer were asked for).
 
     ``noise`` maps channel -> :class:`ChannelNoise`; ``grade`` is the preset
     whose gyro Allan deviation stays below the record's and comes closest
     (:func:`~schuler.imu.characterise.classify_grade`), ``grade_margin`` the
     largest ratio of each preset's curve to the record's upper bound.
+    :meth:`to_dataframe` gives the curves indexed by the averaging time
+    ``tau_s`` (the columns of ``imu_allan.csv``), :meth:`terms` the identified
+    terms, ``plot()`` the Allan figures.
     """
 
     source: str
@@ -132,45 +206,66 @@ class AllanResult(Result):
                 "noise": {name: json_safe(channel.to_dict()) for name, channel in self.noise.items()},
                 "units": dict(self.units)}
 
-    def values(self, channel: str) -> dict[str, float]:
-        """Identified N, B, K, Q, R of a channel, SI.
+    @property
+    def histories(self) -> dict[str, Histories]:
+        """The curves as ``{"imu_allan": Histories}`` over ``tau_s``, as a run holds them (the CSV ``--out`` writes)."""
+        return {"imu_allan": curves_histories(self.noise)}
 
-        Parameters
-        ----------
-        channel : str
-            A channel name, ``gyro_x`` .. ``accel_z``.
+    def to_dataframe(self):
+        """The curves indexed by ``tau_s`` (s): adev and its 68 % bounds (rad/s, m/s^2) and edf per channel."""
+        return self.histories["imu_allan"].to_dataframe()
 
-        Returns
-        -------
-        dict of str to float
-            Term -> identified value in the units of :data:`TERM_UNITS` (unresolved terms too: check
-            ``noise[channel].terms.resolved``).
-        """
-        return dict(self.noise[channel].terms.values)
+    def terms(self) -> IdentifiedTerms:
+        """The identified terms of each channel with their uncertainties (:class:`IdentifiedTerms`)."""
+        return IdentifiedTerms(source=self.source, samples=self.samples, sample_interval_s=self.sample_interval_s,
+                               duration_s=self.duration_s, grade=self.grade, terms={
+                                   name: {**{t: channel.terms.values[t] for t in SHOWN_TERMS},
+                                          **{key: dict(getattr(channel.terms, key))
+                                             for key in ("sigma", "upper_bound", "resolved")},
+                                          "chi2_per_point": channel.terms.chi2_per_point}
+                                   for name, channel in self.noise.items()}, analysis=self)
 
     def render(self):
         """Terms per channel in display units; unresolved terms as an upper bound."""
-        from rich.table import Table
+        return terms_table({name: channel.to_dict() for name, channel in self.noise.items()},
+                           f"Allan analysis of {self.source}: {self.samples:,} samples, "
+                           f"{self.duration_s / 60:.4g} min at {1 / self.sample_interval_s:.6g} Hz", self.grade)
 
-        table = Table(title=f"Allan analysis of {self.source}: {self.samples:,} samples, "
-                            f"{self.duration_s / 60:.4g} min at {1 / self.sample_interval_s:.6g} Hz")
-        table.add_column("channel")
-        for term in ("N", "B", "K", "Q", "R"):
-            table.add_column(term, justify="right")
-        table.add_column("fit chi2/point", justify="right")
-        for sensor in ("gyro", "accel"):
-            units = DISPLAY_UNITS[sensor]
-            table.add_row(f"[dim]{sensor} unit[/dim]", *(f"[dim]{shown_unit(units[t])}[/dim]" for t in "NBKQR"), "")
-            for name, channel in self.noise.items():
-                if sensor_of(name) != sensor:
-                    continue
-                t = channel.terms
-                table.add_row(name, *(_term_text(name, term, t.values[term], t.resolved[term], t.upper_bound[term])
-                                      for term in "NBKQR"), f"{t.chi2_per_point:.3g}")
-        if self.grade:
-            table.caption = (f"grade: {self.grade} (the closest preset below the gyro curves); '< x': not "
-                             "resolved in this record, about 2-sigma upper bound")
-        return table
+
+@dataclass
+class IdentifiedTerms(Result):
+    """The IEEE 952 terms identified on a record's Allan curves (:func:`schuler.imu.identify`).
+
+    ``terms[channel]`` holds N, B, K, Q, R in the SI units of :data:`TERM_UNITS`
+    (rad/s^0.5 ... for gyros, m/s^1.5 ... for accelerometers) and, per term,
+    ``sigma`` (standard uncertainty, same unit), ``upper_bound`` (about 2 sigma,
+    same unit) and ``resolved``, and the fit's ``chi2_per_point``; ``plot()``
+    draws the Allan curves they were fitted to.
+    """
+
+    source: str
+    samples: int
+    sample_interval_s: float
+    duration_s: float
+    grade: str | None
+    terms: dict[str, dict]
+    analysis: AllanResult = field(repr=False)
+
+    units = {**{term: NOISE_UNITS[term] for term in SHOWN_TERMS}, "sigma": "the term's unit",
+             "upper_bound": "the term's unit", "chi2_per_point": "1", "samples": "1"}
+
+    def to_dataframe(self):
+        """One row per (channel, term): value, sigma, upper_bound (SI, the row's ``unit``) and resolved."""
+        import pandas as pd
+
+        rows = [{"channel": name, "term": term, "value": values[term], "sigma": values["sigma"][term],
+                 "upper_bound": values["upper_bound"][term], "resolved": values["resolved"][term],
+                 "unit": TERM_UNITS[sensor_of(name)][term]} for name, values in self.terms.items()
+                for term in SHOWN_TERMS]
+        return pd.DataFrame(rows).set_index(["channel", "term"])
+
+    def render(self):
+        return terms_table(self.terms, f"IEEE 952 terms of {self.source}", self.grade)
 
 
 @dataclass
@@ -219,22 +314,36 @@ class RoundTripResult(Result):
                 "units": {**NOISE_UNITS, **CHECK_UNITS, "seed": "1", "member": "1"}}
 
     def render(self):
-        from rich.table import Table
+        return checks_table(json_safe(self.checks), f"Round trip: {self.model}, {self.duration_s / 3600:.3g} h at "
+                                                    f"{1 / self.sample_interval_s:.6g} Hz, seed {self.seed}")
 
-        from schuler.units import to_unit
 
-        table = Table(title=f"Round trip: {self.model}, {self.duration_s / 3600:.3g} h at "
-                            f"{1 / self.sample_interval_s:.6g} Hz, seed {self.seed}")
-        for column in ("channel", "term", "true", "identified", "error", "tolerance", "unit", "ok"):
-            table.add_column(column, justify="left" if column in ("channel", "term", "unit") else "right")
-        for check in self.checks:
-            unit = DISPLAY_UNITS[sensor_of(check.channel)][check.term]
-            error = (check.identified - check.true) / check.true if check.true else math.nan
-            table.add_row(check.channel, check.term, f"{to_unit(check.true, unit):.4g}",
-                          f"{to_unit(check.identified, unit):.4g}", f"{100 * error:+.2f} %",
-                          f"{100 * check.tolerance / check.true:.2f} %" if check.true else "-",
-                          shown_unit(unit), "yes" if check.within else "NO")
-        return table
+def checks_table(checks: list[dict], title: str):
+    """A round trip's checks, true beside identified in display units with the error and tolerance (a rich Table).
+
+    Parameters
+    ----------
+    checks : list of dict
+        The ``checks`` JSON (:class:`TermCheck` fields: ``true``, ``identified``, ``tolerance`` in the SI unit of
+        the term, :data:`TERM_UNITS`).
+    title : str
+        Title of the table.
+    """
+    from rich.table import Table
+
+    from schuler.units import to_unit
+
+    table = Table(title=title)
+    for column in ("channel", "term", "true", "identified", "error", "tolerance", "unit", "ok"):
+        table.add_column(column, justify="left" if column in ("channel", "term", "unit") else "right")
+    for check in checks:
+        unit = DISPLAY_UNITS[sensor_of(check["channel"])][check["term"]]
+        true, identified = _number(check["true"]), _number(check["identified"])
+        error = (identified - true) / true if true else math.nan
+        table.add_row(check["channel"], check["term"], f"{to_unit(true, unit):.4g}", f"{to_unit(identified, unit):.4g}",
+                      f"{100 * error:+.2f} %", f"{100 * _number(check['tolerance']) / true:.2f} %" if true else "-",
+                      shown_unit(unit), "yes" if check["within"] else "NO")
+    return table
 
 
 @dataclass

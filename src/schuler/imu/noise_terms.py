@@ -93,6 +93,19 @@ def term_allan_deviations(values: dict[str, float], tau) -> dict[str, np.ndarray
     return {term: np.sqrt(basis[:, i]) * values[term] for i, term in enumerate(TERMS)}
 
 
+def model_allan_deviation(values: dict[str, float], tau) -> np.ndarray:
+    """The Allan deviation of the terms together at ``tau`` (eq. C.30), in the channel's rate unit.
+
+    Parameters
+    ----------
+    values : dict of str to float
+        The terms Q, N, B, K, R in SI (rad, rad/sqrt(s), rad/s ... for a gyro).
+    tau : float or ndarray
+        Averaging times, s.
+    """
+    return np.sqrt(term_basis(tau) @ np.array([values[t] ** 2 for t in TERMS]))
+
+
 @dataclass
 class NoiseTerms:
     """IEEE 952 coefficients of one channel, SI, with standard uncertainties.
@@ -132,7 +145,7 @@ class NoiseTerms:
         tau : float or ndarray
             Averaging times, s.
         """
-        return np.sqrt(term_basis(tau) @ np.array([self.values[t] ** 2 for t in TERMS]))
+        return model_allan_deviation(self.values, tau)
 
 
 def no_terms() -> NoiseTerms:
