@@ -89,7 +89,7 @@ def bench_pyins(path, imu, seconds: float) -> float | None:
     except ImportError:
         print("pyins: not installed (pip install python-ins==1.0.1, the 'bench' extra): comparison skipped")
         return None
-    from schuler.navigate.attitude import euler_from_quaternion
+    from schuler.core.attitude import euler_from_quaternion
 
     n = int(seconds * RATE)
     t = np.arange(n + 1) / RATE

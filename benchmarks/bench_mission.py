@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from schuler.core.attitude import dcm_from_quaternion
 from schuler.core.random import RandomStreams
 from schuler.mission.coefficients import step_coefficients
 from schuler.mission.covariance import covariance_budget
@@ -31,7 +32,6 @@ from schuler.mission.evaluation import PARAMETERS
 from schuler.mission.monte_carlo import BlockWhiteNoise, run_members
 from schuler.mission.setup import CONSTANT_SOURCES, mission_setup
 from schuler.mission.stages import initial_state_map, sensor_inputs
-from schuler.navigate.attitude import rotation_matrix
 from schuler.navigate.errors import WhiteNoise
 from schuler.navigate.mechanization import navigate
 from schuler.navigation_errors.three_d import propagate_along
@@ -60,7 +60,7 @@ def source_by_source(setup):
     """The constant sources' final horizontal variance, one propagate_along call per source."""
     trajectory = setup.trajectory()
     c = step_coefficients(trajectory, setup.latitude, setup.height, setup.duration, setup.output_step)
-    start = rotation_matrix(trajectory.kinematics(np.array([0.0]))[1])[0]
+    start = dcm_from_quaternion(trajectory.kinematics(np.array([0.0]))[1])[0]
     x0 = initial_state_map(setup, start, 7) * setup.constant_sigmas[:, None]
     sigmas = setup.constant_sigmas
     inputs = sensor_inputs(c.body_to_ned, c.body_rate, c.body_specific_force) * sigmas[None, :, None]

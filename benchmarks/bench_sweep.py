@@ -34,12 +34,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from schuler.gyrocompassing.case import DegradedAccuracyWarning
+from schuler.gyrocompassing.case import GyrocompassingAccuracyWarning
 from schuler.study.scenario import parse_scenario
 from schuler.study.sweep import run_sweep
 
 # the grid reaches 80 deg latitude on purpose: the accuracy warning is expected there
-warnings.simplefilter("ignore", DegradedAccuracyWarning)
+warnings.simplefilter("ignore", GyrocompassingAccuracyWarning)
 
 SCENARIO = """\
 system = "align"

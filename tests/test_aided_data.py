@@ -30,11 +30,11 @@ from schuler.aided.kfgins import (
     write_navigation,
 )
 from schuler.aided.kfgins_configuration import example_configuration, read_configuration
+from schuler.core.attitude import dcm_from_quaternion, euler_from_quaternion
 from schuler.core.earth import STANDARD_GRAVITY, earth_rate_ned, radii_of_curvature, transport_rate_ned
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
 from schuler.imu.record import ImuRecord
-from schuler.navigate.attitude import euler_from_quaternion, rotation_matrix
 from schuler.navigate.drive import drive
 from schuler.navigate.trajectory import Stationary
 from schuler.navigate.truth import ideal_imu
@@ -365,7 +365,7 @@ def test_body_rate_is_the_ideal_gyro_less_the_earth_and_transport_rates(imu200):
     # measured 1.5e-7 rad/s off on rates up to 0.375 rad/s (the mean over 5 ms differs from the middle value by
     # dt^2 omega'' / 24, and omega_in^b is taken at the interval's end)
     j = np.arange(27_400, 29_200, 50)
-    C = rotation_matrix(imu200.quaternion[j])
+    C = dcm_from_quaternion(imu200.quaternion[j])
     rates = earth_rate_ned(imu200.latitude_rad[j]) + transport_rate_ned(
         imu200.latitude_rad[j], imu200.height_m[j], imu200.velocity_ned_m_s[j, 0], imu200.velocity_ned_m_s[j, 1])
     expected = imu200.angular_rate_rad_s[j] - np.einsum("nji,nj->ni", C, rates)
@@ -398,7 +398,7 @@ def test_antenna_velocity_is_the_derivative_of_its_position():
     velocity = truths[1].at_lever_arm(arm)[1]
     derivative = (_ned_metres(*positions[2].T, positions[1].T) - _ned_metres(*positions[0].T, positions[1].T)) / (2 * h)
     np.testing.assert_allclose(derivative, velocity, rtol=0, atol=1e-5)
-    C = rotation_matrix(truths[1].quaternion)
+    C = dcm_from_quaternion(truths[1].quaternion)
     forward = np.einsum("nji,nj->ni", C, velocity)[:, 0]
     np.testing.assert_allclose(forward, 8.0 - truths[1].body_rate_rad_s[:, 2] * arm[1], rtol=0, atol=1e-6)
     assert np.all(truths[1].body_rate_rad_s[:, 2] > 0.05)  # a right turn

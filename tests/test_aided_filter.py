@@ -15,16 +15,16 @@ from schuler.aided import analysis, kalman, measurements
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import ErrorProcess, FilterModel, NavigationPoint, system_matrix, transition
 from schuler.aided.gnss import GnssRecord
-from schuler.core.earth import radii_of_curvature
-from schuler.core.propagation import discretise_noise
-from schuler.core.rotation import skew
-from schuler.navigate.attitude import (
+from schuler.core.attitude import (
+    dcm_from_quaternion,
     euler_from_quaternion,
     quaternion_from_euler,
     quaternion_from_rotation_vector,
     quaternion_multiply,
-    rotation_matrix,
+    skew,
 )
+from schuler.core.earth import radii_of_curvature
+from schuler.core.propagation import discretise_noise
 from schuler.navigate.trajectory import WaypointProfile
 from schuler.navigate.truth import ideal_imu
 
@@ -114,7 +114,7 @@ def errors_against(run, imu):
 def solution_at(heading=D(30.0), pitch=D(5.0), roll=D(-3.0), rate=(0.01, -0.02, 0.3)) -> measurements.Solution:
     q = quaternion_from_euler(np.array([roll]), np.array([pitch]), np.array([heading]))
     return measurements.Solution(np.array([D(30.5)]), np.array([D(114.5)]), np.array([20.0]),
-                                 np.array([[8.0, 5.0, 0.1]]), rotation_matrix(q), np.array([rate]))
+                                 np.array([[8.0, 5.0, 0.1]]), dcm_from_quaternion(q), np.array([rate]))
 
 
 def test_gnss_position_residual_and_lever_arm_sign():
@@ -180,7 +180,7 @@ def test_van_loan_noise_of_a_gauss_markov_state_is_its_closed_form():
 def test_accelerometer_bias_grows_velocity_error_along_the_body_axis():
     """delta_v' = +C b_a: a forward bias of a vehicle heading east grows the east velocity error."""
     model = tactical_model()
-    C = rotation_matrix(quaternion_from_euler(np.array([0.0]), np.array([0.0]), np.array([D(90.0)])))
+    C = dcm_from_quaternion(quaternion_from_euler(np.array([0.0]), np.array([0.0]), np.array([D(90.0)])))
     point = NavigationPoint(np.array([D(30.0)]), np.array([0.0]), np.zeros((1, 3)), C,
                             np.array([[0.0, 0.0, -G0]]), np.zeros((1, 3)))
     Phi, _ = transition(model, point, 1.0)
@@ -223,7 +223,7 @@ def test_transition_matches_the_nonlinear_ins(short_drive):
     f_mean = sub[:, 3:].sum(axis=0) / 20.0
     w_mean = sub[:, :3].sum(axis=0) / 20.0
     point = NavigationPoint(np.array([lat]), np.array([h]), v_true[None],
-                            rotation_matrix(q_true[None]), f_mean[None], w_mean[None])
+                            dcm_from_quaternion(q_true[None]), f_mean[None], w_mean[None])
     Phi, _ = transition(model, point, 20.0)
     dx = np.zeros(21)
     dx[0:3], dx[3:6], dx[6:9] = dr, dv, psi

@@ -1,4 +1,4 @@
-"""Self-alignment at rest: each method against exact attitudes, the static limits, and system 4's steady state.
+"""Self-alignment at rest: each method against exact attitudes, the static limits, and schuler align's steady state.
 
 Noise-free records are built from the true inputs (:func:`schuler.imu.simulate.static_truth`, or a
 tilted body's C^T omega and C^T f), so every method must return the attitude to rounding; constant
@@ -14,7 +14,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from schuler.alignment.attitude import dcm_from_euler, earth_rate_ned, euler_from_dcm, triad, wrap_angle
 from schuler.alignment.coarse import align_coarse
 from schuler.alignment.data import StaticBatch, convergence_time
 from schuler.alignment.gyrocompass import align_gyrocompass, loop_gains, settling_time
@@ -29,6 +28,8 @@ from schuler.alignment.limits import (
     kpi_equivalent_inputs,
     static_errors,
 )
+from schuler.core.attitude import dcm_from_euler, euler_from_dcm, triad, wrap_angle
+from schuler.core.earth import earth_rate_ned
 from schuler.exceptions import InvalidParameter, NotObservable
 from schuler.gyrocompassing.analytic import full_steady_state, gains_from_design, steady_state
 from schuler.imu.error_model import ErrorModel, SensorErrors
@@ -209,7 +210,7 @@ def test_static_heading_limit_is_the_gyro_term_of_1_21():
         static = static_errors(latitude, 0.0, gyro_ned, np.zeros(3))[2]
         loop = c_gamma * gyro_ned[2] / (c_a * 7.292115e-5 * math.cos(latitude))
         assert float(delta_y) == pytest.approx(static + loop, rel=1e-12, abs=1e-18)
-        if down == 0.0:   # system 4's tested example: 0.01 deg/h east at 50 deg gives 3.556 arcmin (KPI manual)
+        if down == 0.0:   # schuler align's tested example: 0.01 deg/h east at 50 deg gives 3.556 arcmin (KPI manual)
             assert abs(float(delta_y)) == pytest.approx(abs(east) / 0.01 * math.radians(3.556 / 60), rel=1e-3)
 
 

@@ -14,10 +14,10 @@ import math
 import numpy as np
 import pytest
 
-from schuler.alignment.attitude import wrap_angle
 from schuler.alignment.comparison import AlignmentSettings, method_limits, run_methods, simulated_batch
 from schuler.alignment.north import find_north, north_sigma
 from schuler.alignment.north_comparison import simulate_turntable
+from schuler.core.attitude import wrap_angle
 from schuler.imu.error_model import ErrorModel, SensorErrors
 from schuler.imu.spec import preset
 

@@ -12,7 +12,6 @@ import math
 import numpy as np
 import pytest
 
-from schuler.alignment.attitude import dcm_from_euler, earth_rate_ned, wrap_angle
 from schuler.alignment.commands import align_compare
 from schuler.alignment.comparison import AlignmentSettings, method_limits, simulated_batch, staged_design
 from schuler.alignment.data import StaticBatch
@@ -27,6 +26,8 @@ from schuler.alignment.staged_gyrocompass import (
     staged_limit,
 )
 from schuler.alignment.sway import Sway, sway_batch
+from schuler.core.attitude import dcm_from_euler, wrap_angle
+from schuler.core.earth import earth_rate_ned
 from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel, SensorErrors
 from schuler.imu.spec import preset

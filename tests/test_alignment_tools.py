@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 from schuler.alignment._multi_static_fits import mean_covariance
-from schuler.alignment.attitude import earth_rate_ned, wrap_angle
 from schuler.alignment.calibration_comparison import calibration_model, compare_calibration
 from schuler.alignment.commands import align_compare
 from schuler.alignment.multi_static import MultiStaticPlan, calibrate_multi_static, identifiable_truth
@@ -22,6 +21,8 @@ from schuler.alignment.north import AXES, NORTH_METHODS, find_north, north_sigma
 from schuler.alignment.north_comparison import compare_north
 from schuler.alignment.plots import comparison_data_files, comparison_figures
 from schuler.alignment.six_position import SixPositionPlan, calibrate_six_position
+from schuler.core.attitude import wrap_angle
+from schuler.core.earth import earth_rate_ned
 from schuler.exceptions import InvalidParameter
 from schuler.imu.simulate import ImuSimulator
 from schuler.imu.spec import preset
@@ -58,7 +59,7 @@ def test_north_sigma_closed_forms():
 
 
 def test_north_comparison_puts_system_5_on_the_same_time_axis():
-    """compare_north with a stand-in for system 5: its curve sits beside the three methods, per duration.
+    """compare_north with a stand-in for schuler north: its curve sits beside the three methods, per duration.
 
     (The Monte Carlo spreads against the closed forms are tests/test_alignment_monte_carlo.py's, at 1,000
     members; the grade's flicker makes the simulator slow, so few members here.)
@@ -269,7 +270,7 @@ def test_align_compare_json_and_figure(run_cli, tmp_path):
 
 
 def test_north_and_calibrate_compare_commands(run_cli, tmp_path):
-    """``north compare`` has system 5 on its curve; ``calibrate compare`` has system 3's pulse method beside."""
+    """``north compare`` has schuler north on its curve; ``calibrate compare`` has the pulse method beside."""
     out = run_cli("north", "compare", "--duration", "60", "--imu-rate", "2", "--monte-carlo", "3", "--json",
                   "--out", tmp_path)
     assert out.code == 0, out.stderr

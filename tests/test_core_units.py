@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from schuler.core import earth
 from schuler.exceptions import InvalidParameter
-from schuler.params import Parameter, parse_parameters
+from schuler.params import Parameter, ParameterSet
 from schuler.units import format_quantity, parse_quantity, to_unit
 
 
@@ -122,11 +122,12 @@ def test_parameter_range_and_messages():
     assert LATITUDE.help_text() == "Latitude. Range [-90, 90] deg. [default: 50 deg]"
 
 
-def test_parse_parameters_defaults_and_unknown_names():
-    values = parse_parameters([LATITUDE, TAU, MODE, COUNT], {"tau": "8 s", "mode": "Single-Axis"})
-    assert values == {"latitude": pytest.approx(math.radians(50)), "tau": 8.0, "mode": "single-axis", "monte_carlo": 0}
-    with pytest.raises(InvalidParameter, match="unknown parameter"):
-        parse_parameters([LATITUDE], {"latitud": 5})
+def test_parameter_set_parses_defaults_and_refuses_unknown_names():
+    values = ParameterSet([LATITUDE, TAU, MODE, COUNT], owner="demo").parse({"tau": "8 s", "mode": "Single-Axis"})
+    assert dict(values) == {"latitude": pytest.approx(math.radians(50)), "tau": 8.0, "mode": "single-axis",
+                            "monte_carlo": 0}
+    with pytest.raises(InvalidParameter, match="did you mean 'latitude'"):
+        ParameterSet([LATITUDE], owner="demo").parse({"latitud": 5})
 
 
 @pytest.mark.parametrize("text", ["()", "f()", "1 +", "deg deg (", "[1, 2]"])

@@ -37,15 +37,20 @@ import schuler_api  # noqa: E402
 UNIT = re.compile(
     r"""(?ix)
     (?<![\w/^])
-    (rad|mrad|urad|rad/s|rad/s\^?2|rad/s²|rad/sqrt\(s\)|m|m/s|m/s\^?2|m/s²|m\^?2|s|s\^?2|ms|hz|kg|n|v|a|
-     deg|degrees?|deg/h|deg/s|arcmin|arcsec|ft|ft/s|mi|km|ppm|ug|mg|g|h|min|1/s|1/s\^?2|bytes?|gib|mib|%|percent|
+    (rad|mrad|urad|rad/s|rad/s\^?2|rad/s²|rad/sqrt\(s\)|m/s|m/s\^?2|m/s²|m\^?2|s\^?2|ms|hz|kg|
+     deg|degrees?|deg/h|deg/s|arcmin|arcsec|ft|ft/s|mi|km|ppm|ug|mg|min|1/s|1/s\^?2|bytes?|gib|mib|%|percent|
      radians?|metres?|meters?|seconds?|hours?|minutes?|si|dpi|px|pixels?|kg\s?m\^?2|n\s?m(\s?s)?|v\s?s|v/rad|v/deg|n\s?m/a)
     (?![\w])
+    | (?:^|\|\s*|,\s*|\bin\s+|\d\s?)(?-i:m|s|N|g|h)(?=[\s,.;:]|$) | \((?-i:m|s|N|V|A|g|h)\)
     | plain\ numbers? | dimensionless | unitless | \bunits?\b | \bratios?\b | \bfactor\b | \bcounts?\b
     | number\ of | \bindex\b | \bindices\b | \bseed\b | \bmembers?\b | \bsamples\b | \bpasses\b | \bsteps\b
     """
 )
-"""Evidence that an entry states its unit (or is a count or a plain ratio)."""
+"""Evidence that an entry states its unit (or is a count or a plain ratio).
+
+A one-letter unit (m, s, N, g, h; V and A only in parentheses) counts only where a unit stands:
+opening the description, after a comma, "in" or a number, or in parentheses ("s.", "float, s", "in m",
+"9.8 m", "T (s)"), so that the article "a" or the "n" of "shape (n,)" is no unit."""
 
 NUMERIC = re.compile(r"(?i)\b(float|int|integer|array|array_like|ndarray|number|scalar|complex|real)\b")
 
@@ -72,7 +77,7 @@ def unit_problems(function) -> list[str]:
         documented.update(names)
         numeric = bool(NUMERIC.search(entry.type)) or not (entry.type.strip() or entry.name.startswith("*"))
         choice = "{" in entry.type
-        if numeric and not choice and not UNIT.search(entry.type + " " + " ".join(entry.desc)):
+        if numeric and not choice and not UNIT.search(entry.type + " | " + " ".join(entry.desc)):
             problems.append(f"{entry.name}: no unit")
     problems += [f"{name}: not documented" for name in parameters if name not in documented]
     return problems
@@ -141,6 +146,22 @@ def test_the_unit_check_catches_what_it_should():
         """
 
     assert unit_problems(doctest_in_parameters) == ["a doctest read as a parameter: put it under an Examples header"]
+
+    def letters_that_are_no_units(state, weight, step):
+        """A function.
+
+        Parameters
+        ----------
+        state : ndarray, shape (n,)
+            A state.
+        weight : float
+            Weight of a member's sample in the mean, m.
+        step : float
+            Time step, s.
+        """
+
+    # the article "a" and the "n" of a shape are no units; "m" after a comma and "s" after one are
+    assert unit_problems(letters_that_are_no_units) == ["state: no unit"]
 
 
 def test_the_api_reference_covers_every_package():

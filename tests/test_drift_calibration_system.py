@@ -24,7 +24,7 @@ from schuler.drift_calibration.error_budget import TYPICAL
 from schuler.drift_calibration.evaluation import (
     BUDGET_TERMS,
     PARAMETERS,
-    DegradedAccuracyWarning,
+    AzimuthAccuracyWarning,
 )
 from schuler.drift_calibration.reproduction import reproduce
 from schuler.exceptions import InvalidParameter, NotObservable
@@ -139,7 +139,7 @@ def test_nominal_procedure_recovers_drifts_and_azimuth(latitude, azimuth, drift_
     # invariant: without errors (15)/(16) or the least-squares fit give back the drifts and atan2 (or the
     # asin branch nearer the truth) the azimuth, for any site and drifts below the horizontal Earth rate's size
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DegradedAccuracyWarning)
+        warnings.simplefilter("ignore", AzimuthAccuracyWarning)
         r = SYSTEM.run(latitude=math.radians(latitude), azimuth=math.radians(azimuth), drift_x=drift_x * DEG_H,
                        drift_y=drift_y * DEG_H, mode=mode, positions=positions)
     scale = EARTH_RATE * math.cos(math.radians(latitude))
@@ -233,7 +233,7 @@ def test_beyond_the_latitude_limit_the_azimuth_is_not_observable():
         SYSTEM.run(latitude=math.radians(89.99))
     with pytest.raises(NotObservable, match="max-latitude"):
         SYSTEM.evaluate_values({"latitude": np.radians([10.0, 86.0])})
-    with pytest.warns(DegradedAccuracyWarning, match="latitude 87 deg: azimuth accuracy degrades"):
+    with pytest.warns(AzimuthAccuracyWarning, match="latitude 87 deg: azimuth accuracy degrades"):
         allowed = SYSTEM.run(latitude=math.radians(87.0), max_latitude=math.radians(88.0))
     assert abs(allowed.azimuth_error_rad) < 1e-9  # the error-free procedure still works there
     with warnings.catch_warnings():
@@ -246,7 +246,7 @@ def test_azimuth_error_grows_as_one_over_cos_latitude():
     # the azimuth errors scale by cos 40 / cos 80 = 4.41, to the small-angle linearisation (1e-3)
     noise = budget(sensor_noise_density=TYPICAL.sensor_noise_density)
     low = mc(300, seed=4, **noise, latitude=math.radians(40.0))["azimuth_error_rad"]["rms"]
-    with pytest.warns(DegradedAccuracyWarning):
+    with pytest.warns(AzimuthAccuracyWarning):
         high = mc(300, seed=4, **noise, latitude=math.radians(80.0))["azimuth_error_rad"]["rms"]
     assert high / low == pytest.approx(math.cos(math.radians(40.0)) / math.cos(math.radians(80.0)), rel=1e-3)
 

@@ -15,7 +15,7 @@ from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter, NotObservable
 from schuler.gyrocompassing import analytic, models
 from schuler.gyrocompassing.api import SYSTEM
-from schuler.gyrocompassing.case import MAX_DURATION, AlignmentCase, DegradedAccuracyWarning, analytic_results
+from schuler.gyrocompassing.case import MAX_DURATION, AlignmentCase, GyrocompassingAccuracyWarning, analytic_results
 from schuler.gyrocompassing.reproduction import reproduce
 from schuler.gyrocompassing.simulation import evaluate_cases, run_case, simulate_cases
 
@@ -315,7 +315,7 @@ def test_near_the_pole():
     # one horizontal Earth rate for every system (issue 12): NotObservable at the pole, naming the latitude
     with pytest.raises(NotObservable, match="latitude: 90 deg.*not observable"):
         analytic.steady_state(math.pi / 2, 0.05, 20.0)
-    with pytest.warns(DegradedAccuracyWarning, match="degrades"):
+    with pytest.warns(GyrocompassingAccuracyWarning, match="degrades"):
         run_ = run_case(AlignmentCase(latitude=math.radians(89.5), max_latitude=math.radians(89.9),
                                                   drift_east=0.01 * DEG_PER_H))
     values = [run_.simulated.azimuth_error[0], run_.analytic["azimuth_error_analytic_rad"], run_.analytic["c_a"]]
@@ -330,7 +330,7 @@ def test_near_the_pole():
 
 def test_slow_user_gains_end_in_bounded_run_with_warning():
     # c_a so small the loop needs days: the run stops at 48 h and says so, never runs on
-    with pytest.warns(DegradedAccuracyWarning, match="exceeds the run"):
+    with pytest.warns(GyrocompassingAccuracyWarning, match="exceeds the run"):
         run_ = run_case(AlignmentCase(c_a=1e-3), time_step=60.0)
     assert run_.duration == MAX_DURATION
     assert math.isinf(run_.simulated.settling_time[0])

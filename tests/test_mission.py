@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from schuler.core.attitude import dcm_from_quaternion
 from schuler.core.earth import EARTH_RATE
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
@@ -15,7 +16,6 @@ from schuler.mission.evaluation import PARAMETERS
 from schuler.mission.monte_carlo import final_horizontal_errors, initial_errors, member_draws, run_members
 from schuler.mission.reproduction import reproduce
 from schuler.mission.setup import CONSTANT_SOURCES, mission_setup
-from schuler.navigate.attitude import rotation_matrix
 from schuler.navigate.mechanization import navigate
 from schuler.units import from_unit
 
@@ -99,7 +99,7 @@ def test_the_monte_carlo_starts_from_the_attitude_error_the_covariance_assumes()
     trajectory = setup.trajectory()
     q0 = trajectory.kinematics(np.array([0.0]))[1][0]
     members = np.arange(6)
-    _, x0 = member_draws(setup, members, RandomStreams(3), 7, rotation_matrix(q0))
+    _, x0 = member_draws(setup, members, RandomStreams(3), 7, dcm_from_quaternion(q0))
     result = navigate(trajectory, 60.0, imu_rate=1.0, output_step=60.0,
                       initial_errors=initial_errors(x0, setup, q0), member_ids=members)
     phi0 = result.attitude_error_rad[:, 0]

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
+from schuler.core.attitude import euler_from_quaternion
 from schuler.exceptions import InvalidParameter
-from schuler.navigate.attitude import euler_from_quaternion
 from schuler.navigate.drive import GroundVehicleProfile, drive
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.trajectory import WaypointProfile

@@ -138,7 +138,8 @@ def test_simulated_and_closed_fidelities_agree_to_rounding(source):
 
 
 def test_evaluate_warns_once_for_the_worst_group_that_lost_its_accuracy():
-    # the drift source on a 1-km Earth: 0.87 of the error at 1e9 s, 4.6e-3 at 1e8 s; the default Earth agrees
+    # the drift source on a 1-km Earth: 0.5-0.9 of the error at 1e9 s (by the libraries' rounding), 4.6e-3 at 1e8 s;
+    # the default Earth agrees; the one warning names the worst group
     from schuler.navigation_errors.evaluation import SIMULATION_TOLERANCE
     from schuler.navigation_errors.results import SimulationAccuracyWarning
 
@@ -149,9 +150,10 @@ def test_evaluate_warns_once_for_the_worst_group_that_lost_its_accuracy():
                    for name in PARAMETERS.names}, fidelity="simulated")
     with pytest.warns(SimulationAccuracyWarning) as caught:
         out = evaluate(cases)
-    assert len(caught) == 1 and "by 0.87 of" in str(caught[0].message)
     relative = out["simulation_minus_closed_m"] / out["max_spherical_m"]
-    assert np.all(relative[:2] > SIMULATION_TOLERANCE) and relative[2] < 1e-11
+    assert len(caught) == 1 and f"by {relative[1]:.2g} of" in str(caught[0].message) and relative[1] > 0.1
+    # the default Earth over 1e8 s (1.8e4 periods): 1e-11 to 1e-9 of the error by the libraries, well inside 1e-6
+    assert np.all(relative[:2] > SIMULATION_TOLERANCE) and relative[2] < SIMULATION_TOLERANCE / 100
 
 
 def test_unknown_fidelity_is_refused():

@@ -2,7 +2,7 @@
 
 A :class:`Parameter` names a user-settable input of a system's ``run``, its
 display unit (bare numbers are taken in it), its default, its allowed range and
-its help. :func:`parse_parameters` turns what the user wrote into SI values and
+its help. :meth:`ParameterSet.case` turns what the user wrote into SI values and
 raises :class:`~schuler.exceptions.InvalidParameter` naming the option or key.
 
 Examples
@@ -523,34 +523,3 @@ class ParameterSet:
             values[name] = self._by_name[name].parse(raw, label(name))
         return Case(values, given)
 
-
-def parse_parameters(parameters, values: dict[str, Any], *, labels: str = "name") -> dict[str, Any]:
-    """Parse user values (display units or unit strings) into SI for a set of parameters.
-
-    Parameters
-    ----------
-    parameters : iterable of Parameter
-    values : dict
-        name -> value as written; missing or None values take the default
-        (None defaults stay None).
-    labels : {"name", "option"}
-        Name errors by key (scenario files) or by CLI option.
-
-    Raises
-    ------
-    InvalidParameter
-        For an unknown name or an invalid value.
-    """
-    by_name = {p.name: p for p in parameters}
-    unknown = sorted(set(values) - set(by_name))
-    if unknown:
-        raise InvalidParameter(unknown[0], f"unknown parameter; allowed: {', '.join(sorted(by_name))}")
-    parsed = {}
-    for name, spec in by_name.items():
-        raw = values.get(name)
-        label = spec.option if labels == "option" else name
-        if raw is None:
-            parsed[name] = None if spec.default is None else spec.parse(spec.default, label)
-        else:
-            parsed[name] = spec.parse(raw, label)
-    return parsed

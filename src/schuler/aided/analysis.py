@@ -25,8 +25,14 @@ import scipy.stats
 
 from schuler.aided.ekf import FilterRun
 from schuler.aided.error_state import ATTITUDE, POSITION, VELOCITY
+from schuler.core.attitude import (
+    conjugate,
+    euler_from_quaternion,
+    quaternion_multiply,
+    rotation_vector_from_quaternion,
+    wrap_angle,
+)
 from schuler.core.earth import radii_of_curvature
-from schuler.navigate.attitude import conjugate, euler_from_quaternion, quaternion_multiply, rotation_vector, wrap_angle
 
 GROUPS = {"position": POSITION, "velocity": VELOCITY, "attitude": ATTITUDE}
 
@@ -101,7 +107,8 @@ def errors(run: FilterRun, truth: Truth) -> Errors:
                          wrap_angle(sol[..., 1] - truth.longitude) * (R_E + h) * np.cos(truth.latitude),
                          -(sol[..., 2] - h)], axis=-1)
     q = sol[..., 6:10]
-    psi = -rotation_vector(quaternion_multiply(q, conjugate(np.broadcast_to(truth.quaternion, q.shape))))
+    true_q = np.broadcast_to(truth.quaternion, q.shape)
+    psi = -rotation_vector_from_quaternion(quaternion_multiply(q, conjugate(true_q)))
     heading = wrap_angle(euler_from_quaternion(q)[..., 2] - euler_from_quaternion(truth.quaternion)[..., 2])
     return Errors(run.t_s, position, sol[..., 3:6] - truth.velocity, psi, heading)
 

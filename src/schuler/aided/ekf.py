@@ -56,12 +56,12 @@ from schuler.aided.error_state import (
     transition,
 )
 from schuler.aided.gnss import GnssRecord
+from schuler.core.attitude import dcm_from_quaternion, quaternion_from_rotation_vector, quaternion_multiply
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.exceptions import InvalidParameter, SimulationError
 from schuler.memory import require
 from schuler.navigate import _kernels
 from schuler.navigate._loops import strapdown_chunk
-from schuler.navigate.attitude import quaternion_from_rotation_vector, quaternion_multiply, rotation_matrix
 from schuler.navigate.validity import domain_message
 
 _NEVER = 2**62  # an output interval that never comes: the kernel stores nothing
@@ -301,7 +301,7 @@ class _Navigator:
         q = st[:, _kernels.QUAT:_kernels.QUAT + 4]
         return measurements.Solution(st[:, _kernels.LAT].copy(), st[:, _kernels.LON].copy(),
                                      st[:, _kernels.HGT].copy(), st[:, _kernels.VEL:_kernels.VEL + 3].copy(),
-                                     rotation_matrix(q), self.last_rate.copy())
+                                     dcm_from_quaternion(q), self.last_rate.copy())
 
     def point(self, accumulator: _Accumulator) -> NavigationPoint:
         sol = self.solution()

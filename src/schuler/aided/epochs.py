@@ -40,10 +40,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.core.attitude import conjugate, dcm_from_quaternion, quaternion_multiply, rotation_vector_from_quaternion
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
-from schuler.navigate.attitude import conjugate, quaternion_multiply, rotation_matrix, rotation_vector
 from schuler.navigate.truth import DEFAULT_CHUNK, TruthGenerator
 
 DEFAULT_ODOMETER_SIGMA_M_S = 0.05
@@ -169,7 +169,7 @@ class EpochTruth:
         if np.linalg.norm(arm) > LARGEST_LEVER_ARM_M:
             raise InvalidParameter("lever_arm", f"{arm.tolist()} is longer than {LARGEST_LEVER_ARM_M:g} m: metres "
                                                 "are expected (is it in cm or mm?)")
-        C = rotation_matrix(self.quaternion)
+        C = dcm_from_quaternion(self.quaternion)
         offset = C @ arm
         velocity = self.velocity_ned_m_s + np.einsum("nij,nj->ni", C, np.cross(self.body_rate_rad_s, arm))
         return offset_position(self.latitude_rad, self.longitude_rad, self.height_m, offset), velocity
@@ -256,7 +256,7 @@ def body_rate(trajectory, t) -> np.ndarray:
     t = np.asarray(t, dtype=float)
     _, before = trajectory.kinematics(t - RATE_STEP_S)
     _, after = trajectory.kinematics(t + RATE_STEP_S)
-    return rotation_vector(quaternion_multiply(conjugate(before), after)) / (2.0 * RATE_STEP_S)
+    return rotation_vector_from_quaternion(quaternion_multiply(conjugate(before), after)) / (2.0 * RATE_STEP_S)
 
 
 def truth_at(trajectory, duration: float, t, *, imu_rate: float = 100.0, earth_rate: float = EARTH_RATE,
@@ -425,7 +425,7 @@ def simulate_odometer(trajectory, duration: float, *, imu_rate: float = 100.0, r
     index, stamps = epoch_schedule(rate, duration)
     truth = truth_at(trajectory, duration, stamps, imu_rate=imu_rate, earth_rate=earth_rate)
     arm = vector3(lever_arm, "lever_arm")
-    C = rotation_matrix(truth.quaternion)
+    C = dcm_from_quaternion(truth.quaternion)
     body_velocity = np.einsum("nji,nj->ni", C, truth.velocity_ned_m_s) + np.cross(truth.body_rate_rad_s, arm)
     speed = (1.0 + scale_factor_error) * body_velocity[:, 0] + _noise(streams, "odometer", member, index, sigma)
     return OdometerRecord(stamps, speed, float(sigma))

@@ -44,9 +44,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.core.attitude import skew
 from schuler.core.earth import EARTH_RATE, radii_of_curvature, somigliana_gravity
 from schuler.core.propagation import discretise_noise
-from schuler.core.rotation import skew
 from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel, SensorErrors, gauss_markov_for_bias_instability
 
@@ -178,7 +178,7 @@ class NavigationPoint:
     velocity : ndarray, shape ([N,] 3)
         NED, m/s.
     body_to_ned : ndarray, shape ([N,] 3, 3)
-        C_b^n.
+        C_b^n, plain numbers.
     specific_force : ndarray, shape ([N,] 3)
         f^b, body axes, m/s^2 (mean over the step).
     angular_rate : ndarray, shape ([N,] 3)
@@ -315,7 +315,7 @@ def noise_input(model: FilterModel, body_to_ned: np.ndarray) -> np.ndarray:
     model : FilterModel
         Noise densities and sensor-error processes.
     body_to_ned : ndarray, shape ([N,] 3, 3)
-        C_b^n, through which the sensor noises enter psi' and delta_v'.
+        C_b^n (plain numbers), through which the sensor noises enter psi' and delta_v'.
     """
     C = np.asarray(body_to_ned, dtype=float)
     n = model.size

@@ -40,7 +40,7 @@ def predict(P: np.ndarray, Phi: np.ndarray, Q: np.ndarray) -> np.ndarray:
     P : ndarray, shape (N, n, n)
         Covariance of the error state, (state units)^2.
     Phi : ndarray, shape ([N,] n, n)
-        Transition matrix over the step.
+        Transition matrix over the step, in the state units (plain numbers for like states).
     Q : ndarray, shape ([N,] n, n)
         Discrete process noise over the step, (state units)^2.
     """

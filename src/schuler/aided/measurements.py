@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from schuler.aided.error_state import ATTITUDE, GYRO_BIAS, GYRO_SCALE, POSITION, VELOCITY
+from schuler.core.attitude import skew
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
-from schuler.core.rotation import skew
 
 
 @dataclass(frozen=True)

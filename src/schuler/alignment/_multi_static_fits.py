@@ -15,7 +15,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from schuler.alignment import _kernels
-from schuler.alignment.attitude import rotation_matrix, skew_batch
+from schuler.core.attitude import dcm_from_rotation_vector, skew
 from schuler.exceptions import IdentificationError
 from schuler.imu.error_model import flicker_terms
 
@@ -144,7 +144,7 @@ def earth_corrected(R: np.ndarray, S: np.ndarray, durations: np.ndarray, omega0:
     out, P = np.empty_like(R), np.eye(3)
     for j in range(len(R)):
         theta = R[j].T @ (S[j] @ omega0 - durations[j] * (P.T @ omega0))
-        out[j] = R[j] @ rotation_matrix(theta)
+        out[j] = R[j] @ dcm_from_rotation_vector(theta)
         P = P @ out[j]
     return out
 
@@ -188,7 +188,7 @@ class GyroProblem:
         G = p[:9].reshape(3, 3)
         Rc, S, Q = self.rotations(p, G @ noise["rate"] @ G.T)
         H = sensitivity(jacobian).reshape(p.size, -1, 3)
-        cross = -skew_batch(np.einsum("jki,jk->ji", Rc, self.d[:-1]))
+        cross = -skew(np.einsum("jki,jk->ji", Rc, self.d[:-1]))
         Y = np.einsum("pja,jab,jcb->pjc", H, cross, Rc)                # dp per rotation error, start frame
         covariance = np.einsum("pja,jab,qjb->pq", Y, Q, Y)
         per_bias = -np.einsum("pja,jab,bc->pjc", Y, S, G)               # dp per bias error in motion j

@@ -1,5 +1,5 @@
 """Multi-position calibration side by side: six positions with a rate test, the automatic multi-static
-method, and the pulse method of system 3, on records of one grade whose errors are known.
+method, and the pulse method of schuler calibrate, on records of one grade whose errors are known.
 
 :func:`compare_calibration` draws one IMU of the grade (its constant errors
 addressed by seed and member 0), simulates both procedures with it, calibrates,
@@ -8,7 +8,7 @@ normalised error z = (estimate - true) / sigma should be of order 1). The
 simulated IMU has the grade's constant errors and white noise -- what the
 calibration models; the slow terms (bias instability, rate random walk) and
 g-sensitivity are left out, as they are what no calibration removes. The pulse
-method (system 3) is passed in by the caller (``pulse_method(angle_random_walk,
+method (schuler calibrate) is passed in by the caller (``pulse_method(angle_random_walk,
 drift, latitude, members, seed)`` -> its drift and azimuth spread), since this
 package does not import the seed systems.
 """
@@ -22,9 +22,9 @@ from typing import Any
 
 import numpy as np
 
-from schuler.alignment.attitude import earth_rate_ned
 from schuler.alignment.multi_static import MultiStaticPlan, calibrate_multi_static, identifiable_truth
 from schuler.alignment.six_position import SixPositionPlan, calibrate_six_position
+from schuler.core.earth import earth_rate_ned
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.simulate import ImuSimulator
 from schuler.imu.spec import preset
@@ -81,7 +81,7 @@ class CalibrationComparison(Result):
     ``six_position`` and ``multi_static`` map each estimated quantity to
     ``estimate``, ``true``, ``sigma`` (predicted 1-sigma) and ``z`` (normalised
     error), SI (rad/s, m/s^2, dimensionless matrices), plus ``duration_s`` and
-    ``max_abs_z``. ``pulse`` is system 3's Monte Carlo spread for the x gyro
+    ``max_abs_z``. ``pulse`` is schuler calibrate's Monte Carlo spread for the x gyro
     (``drift_sigma_rad_s``, ``azimuth_sigma_rad``, ``procedure_time_s``).
     """
 
@@ -127,7 +127,7 @@ class CalibrationComparison(Result):
                       f"{max(multi['accel_bias']['sigma']) / 9.80665e-6:.3g}",
                       f"{max(multi['accel_scale']['sigma']) * 1e6:.3g}", f"{multi['max_abs_z']:.2f}")
         if self.pulse is not None:
-            table.add_row(f"pulse method, system 3 ({self.pulse['members']} members)",
+            table.add_row(f"pulse method, schuler calibrate ({self.pulse['members']} members)",
                           f"{self.pulse['procedure_time_s']:.0f}", f"{self.pulse['drift_sigma_rad_s'] * deg_h:.3g}",
                           "-", "-", "-")
         return Group(table, *self.notes)
@@ -199,7 +199,7 @@ def compare_calibration(grade: str, *, latitude_rad: float, seed: int = 0, dwell
     sample_interval_s : float
         dt, s.
     pulse_method : callable, optional
-        System 3's spread: ``f(angle_random_walk, drift, latitude, members, seed) -> dict``.
+        schuler calibrate's spread: ``f(angle_random_walk, drift, latitude, members, seed) -> dict``.
     pulse_members : int
         Its Monte Carlo members.
     """
@@ -213,7 +213,8 @@ def compare_calibration(grade: str, *, latitude_rad: float, seed: int = 0, dwell
         pulse = dict(pulse_method(float(model.gyro.random_walk[0]), float(preset(grade).gyro.bias[0]), latitude_rad,
                                   pulse_members, seed))
         pulse["members"] = int(pulse_members)
-        notes.append("pulse method (system 3): the x gyro's drift from alternating torque pulses at two platform "
-                     "positions, with the grade's angle random walk and system 3's own default error budget")
+        notes.append("pulse method (schuler calibrate): the x gyro's drift from alternating torque pulses at two "
+                     "platform positions, with the grade's angle random walk and schuler calibrate's own default "
+                     "error budget")
     return CalibrationComparison(grade=grade, latitude_rad=latitude_rad, seed=seed, six_position=six,
                                  multi_static=multi, pulse=pulse, notes=notes)

@@ -2,7 +2,7 @@
 
 At rest the specific force is f^n = (0, 0, -g) and the angular rate the Earth
 rate omega^n = Omega (cos L, 0, -sin L) (NED). With their means over the window
-measured in the body frame, TRIAD (:func:`~schuler.alignment.attitude.triad`)
+measured in the body frame, TRIAD (:func:`~schuler.core.attitude.triad`)
 with -f (down) as the primary vector and -f x omega (east) as the secondary
 gives C_b^n: roll and pitch from the specific force alone,
 
@@ -30,8 +30,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from schuler.alignment.attitude import earth_rate_ned, euler_from_dcm, triad
 from schuler.alignment.data import MethodEstimate, StaticBatch
+from schuler.core.attitude import euler_from_dcm, triad
+from schuler.core.earth import earth_rate_ned
 
 DOWN = np.array([0.0, 0.0, 1.0])
 

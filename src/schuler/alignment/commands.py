@@ -7,7 +7,7 @@ is the CSV beside the figure (:func:`~schuler.alignment.plots.comparison_data_fi
 :func:`~schuler.alignment.plots.write_files` writes both for a system that writes
 its own files). The systems that own the command names add them to their
 ``actions``; the north and calibrate ones hand over
-their own evaluation (``parameters`` and ``evaluate`` of system 5 or 3) so that
+their own evaluation (``parameters`` and ``evaluate`` of schuler north or 3) so that
 the ground gyrocompass and the pulse method stand beside the new methods
 without this package importing a seed system.
 
@@ -23,7 +23,6 @@ from collections.abc import Callable
 
 import numpy as np
 
-from schuler.alignment.attitude import wrap_angle
 from schuler.alignment.calibration_comparison import CalibrationComparison, compare_calibration
 from schuler.alignment.comparison import (
     GYROCOMPASS_DESIGNS,
@@ -39,6 +38,7 @@ from schuler.alignment.north import AXES, DEFAULT_CAROUSEL_PERIOD
 from schuler.alignment.north_comparison import NorthComparison, compare_north
 from schuler.alignment.plots import comparison_figures, write_files
 from schuler.contract import Action, Cases
+from schuler.core.attitude import wrap_angle
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
 from schuler.imu.files import read_record
@@ -107,7 +107,7 @@ CALIBRATE_COMPARE_PARAMETERS = ParameterSet((
               maximum=1000, kind="integer"),
     Parameter("static", "s", 3.0, "Multi-static hold per orientation.", minimum=1.5, maximum=600),
     Parameter("imu_rate", "Hz", 100.0, "Sample rate of the records.", minimum=1, maximum=10000),
-    Parameter("monte_carlo", "", 20, "Members of system 3's pulse-method Monte Carlo (0: leave it out).",
+    Parameter("monte_carlo", "", 20, "Members of schuler calibrate's pulse-method Monte Carlo (0: leave it out).",
               minimum=0, maximum=100_000, kind="integer"),
     _SEED,
 ), owner="calibrate compare")
@@ -207,14 +207,14 @@ def evaluate_with(parameters: ParameterSet, evaluate: Callable, common: dict, va
 
 
 def north_compare_action(parameters: ParameterSet, evaluate: Callable) -> Action:
-    """``north compare``, with system 5 (its ``parameters`` and ``evaluate``) as the ground gyrocompass.
+    """``north compare``, with schuler north (its ``parameters`` and ``evaluate``) as the ground gyrocompass.
 
     Parameters
     ----------
     parameters : ParameterSet
-        System 5's parameters (``readout_noise``, ``latitude``, ``duration`` among them).
+        schuler north's parameters (``readout_noise``, ``latitude``, ``duration`` among them).
     evaluate : callable
-        System 5's ``evaluate(cases)``; its ``north_std_predicted_rad`` output is used.
+        schuler north's ``evaluate(cases)``; its ``north_std_predicted_rad`` output is used.
 
     Returns
     -------
@@ -244,14 +244,14 @@ def north_compare_action(parameters: ParameterSet, evaluate: Callable) -> Action
 
 
 def calibrate_compare_action(parameters: ParameterSet, evaluate: Callable) -> Action:
-    """``calibrate compare``, with system 3 (its ``parameters`` and ``evaluate``) as the pulse method.
+    """``calibrate compare``, with schuler calibrate (its ``parameters`` and ``evaluate``) as the pulse method.
 
     Parameters
     ----------
     parameters : ParameterSet
-        System 3's parameters (``angle_random_walk``, ``drift_x``, ``latitude`` among them).
+        schuler calibrate's parameters (``angle_random_walk``, ``drift_x``, ``latitude`` among them).
     evaluate : callable
-        System 3's ``evaluate(cases)``; its ``drift_x_error_rad_s``, ``azimuth_error_rad`` and
+        schuler calibrate's ``evaluate(cases)``; its ``drift_x_error_rad_s``, ``azimuth_error_rad`` and
         ``procedure_time_s`` outputs are used.
 
     Returns

@@ -24,7 +24,6 @@ from typing import Any
 
 import numpy as np
 
-from schuler.alignment.attitude import wrap_angle
 from schuler.alignment.coarse import align_coarse
 from schuler.alignment.data import BYTES_PER_SAMPLE, MethodEstimate, StaticBatch, convergence_time, window_indices
 from schuler.alignment.gyrocompass import DEFAULT_DAMPING, DEFAULT_TIME_CONSTANT, align_gyrocompass, loop_gains
@@ -37,6 +36,7 @@ from schuler.alignment.staged_gyrocompass import (
     design_gyrocompass,
     staged_limit,
 )
+from schuler.core.attitude import wrap_angle
 from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.record import ImuRecord

@@ -26,7 +26,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from schuler.alignment.attitude import wrap_angle
+from schuler.core.attitude import wrap_angle
 from schuler.core.earth import normal_gravity
 from schuler.exceptions import InvalidParameter
 from schuler.imu.record import ImuRecord
@@ -168,24 +168,6 @@ class StaticBatch:
             ends = np.append(ends, self.samples)
         return ends
 
-    def mean_rates(self, stop: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Mean angular rate (rad/s) and specific force (m/s^2) over samples [0, stop), each (m, 3).
-
-        Parameters
-        ----------
-        stop : int, optional
-            Number of samples averaged from the start (default: all).
-
-        Returns
-        -------
-        angular_rate : ndarray of shape (m, 3)
-            Mean angular rate, rad/s, body axes.
-        specific_force : ndarray of shape (m, 3)
-            Mean specific force, m/s^2, body axes.
-        """
-        stop = self.samples if stop is None else int(stop)
-        span = stop * self.sample_interval_s
-        return self.gyro_increment[:, :stop].sum(axis=1) / span, self.accel_increment[:, :stop].sum(axis=1) / span
 
 
 def window_indices(samples: int, dt: float, start_s: float, duration_s: float | None) -> tuple[int, int]:

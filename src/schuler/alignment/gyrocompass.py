@@ -8,7 +8,7 @@ accelerometers (control law (1.6) with c_Gamma = -c1 g, c_a = c2 g):
 
 so a north tilt decays with c_Gamma and an east tilt, which a heading error
 makes grow at Omega cos L per radian, turns the frame in azimuth until it
-stops (the loop (1.19)/(1.20) of system 4, the same equations under the mapping
+stops (the loop (1.19)/(1.20) of schuler align, the same equations under the mapping
 of :func:`~schuler.alignment.limits.kpi_equivalent_inputs`). The gains come from
 a time constant T and damping zeta by the manual's design (end of its Sec. 2):
 T^2 p^2 + 2 T zeta p + 1 = p^2 + c_Gamma p + U_eta c_a, so
@@ -38,10 +38,11 @@ import math
 import numpy as np
 
 from schuler.alignment import _kernels
-from schuler.alignment.attitude import earth_rate_ned, euler_from_dcm
 from schuler.alignment.data import MethodEstimate, StaticBatch
 from schuler.alignment.inertial import start_attitude
 from schuler.alignment.limits import horizontal_rate
+from schuler.core.attitude import euler_from_dcm
+from schuler.core.earth import earth_rate_ned
 from schuler.exceptions import InvalidParameter
 
 DEFAULT_TIME_CONSTANT = 30.0

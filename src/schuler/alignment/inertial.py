@@ -38,8 +38,9 @@ from __future__ import annotations
 import numpy as np
 
 from schuler.alignment import _kernels
-from schuler.alignment.attitude import earth_rate_ned, euler_from_dcm, rotation_matrix, skew_batch, triad
 from schuler.alignment.data import MethodEstimate, StaticBatch
+from schuler.core.attitude import dcm_from_rotation_vector, euler_from_dcm, skew, triad
+from schuler.core.earth import earth_rate_ned
 
 
 def navigation_velocity(times, latitude, gravity) -> np.ndarray:
@@ -62,7 +63,7 @@ def navigation_velocity(times, latitude, gravity) -> np.ndarray:
     omega = earth_rate_ned(latitude)
     rate = float(np.linalg.norm(omega))
     t = np.asarray(times, dtype=float)[:, None, None]
-    W = skew_batch(omega)
+    W = skew(omega)
     integral = (t * np.eye(3) + (1.0 - np.cos(rate * t)) / rate**2 * W
                 + (rate * t - np.sin(rate * t)) / rate**3 * (W @ W))
     return integral @ np.array([0.0, 0.0, -gravity])
@@ -98,7 +99,7 @@ def net_rotation(batch: StaticBatch) -> np.ndarray:
     from scipy.spatial.transform import Rotation
 
     start, body = _start_and_end(batch)
-    earth_turn = rotation_matrix(-earth_rate_ned(batch.latitude_rad) * batch.duration_s)
+    earth_turn = dcm_from_rotation_vector(-earth_rate_ned(batch.latitude_rad) * batch.duration_s)
     relative = earth_turn @ start @ body @ np.swapaxes(start, 1, 2)
     return Rotation.from_matrix(relative).as_rotvec()
 
@@ -148,7 +149,7 @@ def align_inertial(batch: StaticBatch, history_step_s: float = 1.0) -> MethodEst
     first, second = first[usable], second[usable]
     v_nav = navigation_velocity(times, batch.latitude_rad, batch.gravity)
     start_attitude = triad(velocity[:, first], velocity[:, second], v_nav[first], v_nav[second])
-    earth_turn = rotation_matrix(-earth_rate_ned(batch.latitude_rad) * times[second][:, None])
+    earth_turn = dcm_from_rotation_vector(-earth_rate_ned(batch.latitude_rad) * times[second][:, None])
     dcm = earth_turn @ start_attitude @ attitude[:, second]
     roll, pitch, heading = euler_from_dcm(dcm)
     return MethodEstimate("inertial_frame", roll[:, -1], pitch[:, -1], heading[:, -1], None, times[second], roll,

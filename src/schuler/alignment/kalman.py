@@ -50,18 +50,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from schuler.alignment import _kernels
-from schuler.alignment.attitude import (
-    dcm_from_euler,
-    earth_rate_ned,
-    euler_from_dcm,
-    orthonormalise,
-    rotation_matrix,
-    skew_batch,
-)
 from schuler.alignment.data import MethodEstimate, StaticBatch
 from schuler.alignment.inertial import start_attitude
 from schuler.alignment.limits import accuracy_limit, effective_bias_sigma
-from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.attitude import dcm_from_euler, dcm_from_rotation_vector, euler_from_dcm, orthonormalise, skew
+from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY, earth_rate_ned
 from schuler.exceptions import InvalidParameter
 
 STATES = 12
@@ -202,10 +195,10 @@ def _transition(C: np.ndarray, gravity: float, omega: np.ndarray, dt: float):
     """
     m = C.shape[0]
     F = np.zeros((m, STATES, STATES))
-    W = skew_batch(omega)
+    W = skew(omega)
     F[:, 0:3, 0:3] = -W
     F[:, 0:3, 6:9] = -np.eye(3)
-    F[:, 3:6, 0:3] = skew_batch(np.array([0.0, 0.0, -gravity]))
+    F[:, 3:6, 0:3] = skew(np.array([0.0, 0.0, -gravity]))
     F[:, 3:6, 3:6] = -2.0 * W
     F[:, 3:6, 9:12] = np.eye(3)
     Fdt = F * dt
@@ -303,7 +296,7 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
         x = np.einsum("mij,mj->mi", gain, velocity)
         P = P - gain @ S @ np.swapaxes(gain, 1, 2)
         P = 0.5 * (P + np.swapaxes(P, 1, 2))
-        C = orthonormalise(rotation_matrix(x[:, 0:3]) @ C)
+        C = orthonormalise(dcm_from_rotation_vector(x[:, 0:3]) @ C)
         velocity -= x[:, 3:6]
         gyro_bias += x[:, 6:9]
         accel_bias += x[:, 9:12]

@@ -26,7 +26,7 @@ with a fixed bandwidth (the gyrocompass) does not average indefinitely: its
 stationary noise follows from its transfer function
 (:func:`gyrocompass_noise`).
 
-Correspondence with system 4: the strapdown gyrocompass loop's error equations
+Correspondence with schuler align: the strapdown gyrocompass loop's error equations
 are the KPI manual's full model (1.18) under the mapping drift = epsilon = -C b_g
 (``drift_east = -b_gE``, ``drift_north = -b_gN``, ``drift_up = b_gD``),
 eps_beta = -b_aN / g, eps_alpha = b_aE / g, and heading error = delta (see
@@ -107,25 +107,6 @@ def east_component(heading, body_vector) -> np.ndarray:
     heading = np.asarray(heading, dtype=float)
     return np.sin(heading) * b[..., 0] + np.cos(heading) * b[..., 1]
 
-
-def north_component(heading, body_vector) -> np.ndarray:
-    """b_N = cos(psi) b_x - sin(psi) b_y of body vectors (..., 3) of a level body at heading psi.
-
-    Parameters
-    ----------
-    heading : float or array_like
-        Heading psi of the level body, rad (broadcast against the leading dimensions).
-    body_vector : array_like of shape (..., 3)
-        Vector in body axes x fwd, y right, z down, any unit (e.g. a gyro bias in rad/s).
-
-    Returns
-    -------
-    ndarray of shape (...)
-        Its north component, in the vector's unit.
-    """
-    b = np.asarray(body_vector, dtype=float)
-    heading = np.asarray(heading, dtype=float)
-    return np.cos(heading) * b[..., 0] - np.sin(heading) * b[..., 1]
 
 
 def static_errors(latitude, heading, gyro_bias, accel_bias, gravity=STANDARD_GRAVITY):
@@ -328,7 +309,7 @@ def gyrocompass_steady_state(latitude, c_gamma, c_a, gyro_bias_ned, accel_bias_n
 
 
 def kpi_equivalent_inputs(gyro_bias_ned, accel_bias_ned, gravity=STANDARD_GRAVITY) -> dict[str, float]:
-    """System 4's inputs (KPI manual (1.18)) that give the strapdown gyrocompass loop's equations exactly.
+    """schuler align's inputs (KPI manual (1.18)) that give the strapdown gyrocompass loop's equations exactly.
 
     Parameters
     ----------

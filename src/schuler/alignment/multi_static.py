@@ -102,8 +102,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from schuler.alignment import _multi_static_fits as fits
-from schuler.alignment.attitude import earth_rate_ned, rotation_matrix
-from schuler.core.earth import EARTH_RATE, normal_gravity
+from schuler.core.attitude import dcm_from_rotation_vector
+from schuler.core.earth import EARTH_RATE, earth_rate_ned, normal_gravity
 from schuler.core.random import RandomStreams
 from schuler.exceptions import IdentificationError, InvalidParameter
 from schuler.imu.error_model import ErrorModel
@@ -212,7 +212,7 @@ class MultiStaticPlan:
         for C0, C1 in zip(attitudes[:-1], attitudes[1:]):
             turn = Rotation.from_matrix(C0.T @ C1).as_rotvec()
             fractions = (np.arange(move) + 0.5) / move
-            C = C0 @ rotation_matrix(fractions[:, None] * turn)
+            C = C0 @ dcm_from_rotation_vector(fractions[:, None] * turn)
             gyro_parts.append(turn / (move * dt) + np.einsum("kji,j->ki", C, omega))
             accel_parts.append(np.einsum("kji,j->ki", C, down))
             hold(C1, still)
@@ -246,7 +246,7 @@ def detect_static(accel, sample_interval_s: float, *, initial_s: float, factor: 
     initial_s : float
         Length of the initial static period, s.
     factor : float
-        Threshold as a multiple of the initial period's mean statistic.
+        Threshold as a multiple of the initial period's mean statistic (a ratio).
     window_s, min_static_s : float
         Sliding window and shortest static interval, s.
     """
@@ -362,7 +362,7 @@ def calibrate_multi_static(gyro, accel, sample_interval_s: float, *, initial_s: 
     initial_s : float
         Length of the initial static period, s.
     gravity_m_s2 : float, optional
-        Local g (default: normal gravity at ``latitude_rad``).
+        Local g, m/s^2 (default: normal gravity at ``latitude_rad``).
     latitude_rad : float
         Site latitude L, rad: the default g and the Earth rate's vertical part, Omega sin L (module notes, step 3).
     window_s, min_static_s : float

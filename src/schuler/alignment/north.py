@@ -59,8 +59,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from schuler.alignment.attitude import wrap_angle
 from schuler.alignment.limits import horizontal_rate
+from schuler.core.attitude import wrap_angle
 from schuler.core.earth import EARTH_RATE
 from schuler.exceptions import InvalidParameter
 
@@ -151,7 +151,7 @@ def turntable_rates(latitude: float, heading: float, start, end, sample_interval
 
 
 @dataclass
-class NorthEstimate:
+class TurntableNorthEstimate:
     """North from a turntable record, for every record of a batch.
 
     Attributes
@@ -175,7 +175,7 @@ class NorthEstimate:
     bias_rad_s: np.ndarray
 
 
-def find_north(rates, start, end, latitude: float, method: str, axes: str = "x") -> NorthEstimate:
+def find_north(rates, start, end, latitude: float, method: str, axes: str = "x") -> TurntableNorthEstimate:
     """North from gyro samples on a turntable schedule, every record at once (module notes).
 
     Parameters
@@ -191,7 +191,7 @@ def find_north(rates, start, end, latitude: float, method: str, axes: str = "x")
 
     Returns
     -------
-    NorthEstimate
+    TurntableNorthEstimate
     """
     if axes not in AXES:
         raise InvalidParameter("axes", f"{axes!r} is not one of {', '.join(AXES)}")
@@ -236,7 +236,7 @@ def find_north(rates, start, end, latitude: float, method: str, axes: str = "x")
         norm = a**2 + b**2
         gradient = np.stack([b, -a]) / norm
         sigma = np.sqrt(variance * np.einsum("im,ij,jm->m", gradient, covariance[:2, :2], gradient))
-    return NorthEstimate(method, axes, heading, sigma, single_two, solution[bias_column:].T)
+    return TurntableNorthEstimate(method, axes, heading, sigma, single_two, solution[bias_column:].T)
 
 
 def north_sigma(method: str, axes: str, random_walk, latitude: float, duration, heading: float = math.pi / 2):

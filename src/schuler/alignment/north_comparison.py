@@ -5,7 +5,7 @@ per method (the IMU layer's error model, draws addressed by seed and member),
 finds north in all of them at once, and sets the Monte Carlo spread beside the
 closed form (:func:`~schuler.alignment.north.north_sigma`); the accuracy versus
 time (analytic, 30 s to 1 h) and versus grade (every preset at the chosen
-time) go with it. The ground gyrocompass of system 5 enters through a function
+time) go with it. The ground gyrocompass of schuler north enters through a function
 the caller passes in (``ground_gyrocompass(durations, readout_noise, latitude)``
 -> 1-sigma of north): this package does not import the seed systems, the
 system that owns the command hands its own evaluation over.
@@ -19,7 +19,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from schuler.alignment.attitude import wrap_angle
 from schuler.alignment.data import BYTES_PER_SAMPLE
 from schuler.alignment.north import (
     DEFAULT_CAROUSEL_PERIOD,
@@ -29,6 +28,7 @@ from schuler.alignment.north import (
     schedule,
     turntable_rates,
 )
+from schuler.core.attitude import wrap_angle
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.simulate import ImuSimulator, iter_simulation
 from schuler.imu.spec import GRADES, preset
@@ -179,7 +179,7 @@ class NorthComparison(Result):
                           f"{row['monte_carlo_sigma_rad'] * arcmin:.3g}")
         sigma = self.ground_gyrocompass["sigma_rad"]
         if sigma is not None and math.isfinite(sigma):
-            table.add_row("ground gyrocompass (system 5)", "", "", "", f"{sigma * arcmin:.3g}", "")
+            table.add_row("ground gyrocompass (schuler north)", "", "", "", f"{sigma * arcmin:.3g}", "")
         return Group(table, *self.notes)
 
 
@@ -203,7 +203,7 @@ def compare_north(grade: str, *, latitude_rad: float, heading_rad: float, durati
     members, seed : int
         Monte Carlo members per method and their seed.
     ground_gyrocompass : callable, optional
-        ``f(durations, readout_noise, latitude) -> 1-sigma`` of system 5.
+        ``f(durations, readout_noise, latitude) -> 1-sigma`` of schuler north.
     """
     model = preset(grade)
     samples = int(round(duration_s / sample_interval_s))
@@ -240,8 +240,8 @@ def compare_north(grade: str, *, latitude_rad: float, heading_rad: float, durati
         versus_time["ground_gyrocompass"] = curve.tolist()
         gyro_entry["sigma_rad"] = float(np.asarray(ground_gyrocompass(np.array([duration_s]), noise,
                                                                        latitude_rad))[0])
-        notes.append("ground gyrocompass (system 5): the source's instrument (rotor run-down, 4 unknowns identified) "
-                     f"read every {READOUT_STEP_S:g} s with the grade's angle noise sqrt(Q^2 + N^2 h) = "
+        notes.append("ground gyrocompass (schuler north): the source's instrument (rotor run-down, 4 unknowns "
+                     f"identified) read every {READOUT_STEP_S:g} s with the grade's angle noise sqrt(Q^2 + N^2 h) = "
                      f"{math.degrees(noise) * 3600:.3g} arcsec; its directive torque H Omega cos L acts on a "
                      "sensitive element whose swing is observed directly, so the same read-out noise costs far less "
                      "azimuth than rate noise does a strapdown gyro (its own errors, e.g. suspension torques, "

@@ -12,11 +12,11 @@ from pathlib import Path
 
 import numpy as np
 
-from schuler.alignment.attitude import wrap_angle
 from schuler.alignment.calibration_comparison import CalibrationComparison
 from schuler.alignment.comparison import AlignmentComparison
 from schuler.alignment.north import NORTH_METHODS
 from schuler.alignment.north_comparison import NorthComparison
+from schuler.core.attitude import wrap_angle
 from schuler.io import save_figure_formats, write_dataframe_csv
 
 ARCMIN = 180.0 * 60.0 / math.pi
@@ -24,7 +24,7 @@ WIDTH_IN = 7.0
 DPI = 100
 LABELS = {"coarse": "coarse (TRIAD)", "inertial_frame": "inertial frame (i0)", "kalman": "Kalman",
           "gyrocompass": "gyrocompass loop", "two_position": "two positions", "four_position": "four positions",
-          "carousel": "carousel", "ground_gyrocompass": "ground gyrocompass (system 5)"}
+          "carousel": "carousel", "ground_gyrocompass": "ground gyrocompass (schuler north)"}
 
 
 def _pyplot():
@@ -75,7 +75,7 @@ def heading_figure(result: AlignmentComparison):
 
 
 def north_figure(result: NorthComparison):
-    """1-sigma of north against time (each method analytic, Monte Carlo at the chosen time; system 5) and per grade.
+    """1-sigma of north against time (each method analytic, Monte Carlo at the chosen time; schuler north), per grade.
 
     Parameters
     ----------

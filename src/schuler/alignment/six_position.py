@@ -40,8 +40,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from schuler.alignment.attitude import dcm_from_euler, earth_rate_ned
-from schuler.core.earth import normal_gravity
+from schuler.core.attitude import dcm_from_euler
+from schuler.core.earth import earth_rate_ned, normal_gravity
 from schuler.exceptions import InvalidParameter
 
 ORIENTATIONS = {

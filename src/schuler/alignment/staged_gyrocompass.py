@@ -63,7 +63,6 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from schuler.alignment import _kernels
-from schuler.alignment.attitude import earth_rate_ned, euler_from_dcm
 from schuler.alignment.data import MethodEstimate, StaticBatch
 from schuler.alignment.inertial import start_attitude
 from schuler.alignment.limits import (
@@ -72,7 +71,8 @@ from schuler.alignment.limits import (
     effective_bias_sigma,
     horizontal_rate,
 )
-from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.attitude import euler_from_dcm
+from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY, earth_rate_ned
 from schuler.exceptions import InvalidParameter
 
 PROPAGATION_STEP_S = 1.0
@@ -104,7 +104,7 @@ COARSE_AZIMUTH_SHARE = 0.5
 
 
 @dataclass(frozen=True)
-class Stage:
+class LoopStage:
     """One stage of the loop: its span, its level loop and its azimuth root (SI).
 
     Attributes
@@ -220,11 +220,11 @@ class GyrocompassDesign:
 
     Attributes
     ----------
-    stages : tuple of Stage
+    stages : tuple of LoopStage
         In time order, the first starting at 0 s and the last ending at the window's end.
     """
 
-    stages: tuple[Stage, ...]
+    stages: tuple[LoopStage, ...]
 
     def as_dicts(self) -> list[dict]:
         """The stages as plain dictionaries (JSON)."""
@@ -298,12 +298,12 @@ def design_gyrocompass(errors, *, latitude: float, duration: float,
     azimuth_end = fine_end + min(AZIMUTH_SETTLING / fastest, COARSE_AZIMUTH_SHARE * (duration - fine_end))
     fine_period = 2.0 * math.pi / fine
     return GyrocompassDesign((
-        Stage("coarse levelling", 0.0, coarse_end, COARSE_LEVEL_PERIOD_S, None),
-        Stage("fine levelling", coarse_end, fine_end, fine_period, None),
-        Stage("coarse azimuth", fine_end, azimuth_end, fine_period, 1.0 / fastest),
+        LoopStage("coarse levelling", 0.0, coarse_end, COARSE_LEVEL_PERIOD_S, None),
+        LoopStage("fine levelling", coarse_end, fine_end, fine_period, None),
+        LoopStage("coarse azimuth", fine_end, azimuth_end, fine_period, 1.0 / fastest),
         # sigma = 1 / (tau0 + t) from tau0 = 1 / sigma_max: no step in k3, which would freeze the sway's
         # heading ripple k3 X / g into the heading
-        Stage("fine azimuth", azimuth_end, duration, fine_period, 1.0 / fastest, growing=True)))
+        LoopStage("fine azimuth", azimuth_end, duration, fine_period, 1.0 / fastest, growing=True)))
 
 
 def _propagate(A: np.ndarray, intensity: np.ndarray, span: float) -> tuple[np.ndarray, np.ndarray]:

@@ -25,8 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from schuler.alignment.attitude import dcm_from_euler, earth_rate_ned
 from schuler.alignment.data import StaticBatch
+from schuler.core.attitude import dcm_from_euler
+from schuler.core.earth import earth_rate_ned
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
 

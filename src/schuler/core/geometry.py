@@ -286,7 +286,7 @@ def time_grid(duration: float, step: float, *, names: tuple[str, str] = ("durati
     names : (str, str)
         The caller's names of the duration and the step, used in error messages.
     max_points : int
-        Largest grid accepted; a longer one is refused before allocation.
+        Largest grid accepted, in number of points; a longer one is refused before allocation.
 
     Returns
     -------
@@ -325,7 +325,7 @@ def time_grids(durations, steps, *, names: tuple[str, str] = ("duration", "step"
     names : (str, str)
         As in :func:`time_grid`.
     max_points : int
-        Largest padded array accepted (N times the longest grid).
+        Largest padded array accepted, in number of points (N times the longest grid).
 
     Returns
     -------

@@ -302,11 +302,11 @@ def simulate(system: StateSpace, time, initial_state=None, inputs=None, input_se
     time : array_like, shape (T,)
         Strictly increasing time points, s; the response starts at ``time[0]``.
     initial_state : array_like, shape (n,) or (N, n), optional
-        State at ``time[0]`` (default zero).
+        State at ``time[0]``, in the state units (default zero).
     inputs : array_like, shape (m,) or (N, m), optional
         Inputs constant over the run, shared or per member.
     input_series : array_like, shape (T, m) or (N, T, m), optional
-        Inputs varying in time, ``input_series[..., k, :]`` held on
+        Inputs varying in time, in the input units, ``input_series[..., k, :]`` held on
         ``[time[k], time[k+1])``; added to ``inputs`` when both are given.
 
     Returns

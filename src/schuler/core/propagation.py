@@ -73,7 +73,7 @@ def zoh_discretize(A: np.ndarray, B: np.ndarray, dt) -> tuple[np.ndarray, np.nda
     A : ndarray, shape (..., n, n)
         State matrix, 1/s.
     B : ndarray, shape (..., n, m)
-        Input matrix.
+        Input matrix, SI (state unit per input unit and second).
     dt : float or ndarray of shape (k,)
         Step(s), s. With k steps the results gain a leading axis of length k.
 
@@ -358,12 +358,15 @@ def propagate_steps_exact(A: np.ndarray, B: np.ndarray, grid: Grid, x0: np.ndarr
     Parameters
     ----------
     A : ndarray, shape (1 or N, n, n)
+        State matrices, SI (1/s for states in their units).
     B : ndarray, shape (1 or N, n, m)
+        Input matrices, SI (state unit per input unit and second).
     grid : Grid
         The time grid (n_time points).
     x0 : ndarray, shape (N, n)
+        Initial states, SI.
     u : ndarray, shape (1 or N, 1 or n_time, m)
-        ``u[:, k]`` holds on [t_k, t_(k+1)); a time length of 1 holds over the run.
+        Inputs, SI; ``u[:, k]`` holds on [t_k, t_(k+1)); a time length of 1 holds over the run.
 
     Returns
     -------

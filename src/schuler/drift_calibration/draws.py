@@ -127,7 +127,7 @@ def draw_errors(budget: Mapping[str, np.ndarray], streams: RandomStreams | None,
     members : array_like of int, shape (N,)
         Global member numbers: the addresses of the draws.
     channels, positions, cycles : int
-        C, K and M of the procedure.
+        C, K and M of the procedure: the number of channels, of positions and of cycles.
     samples : int
         S, noise samples per phase (``cycle_grid(shape, steps).size - 1``).
 

@@ -23,7 +23,7 @@ in memory-bounded batches.
 Observability: the azimuth comes from the horizontal Earth rate Omega cos(phi),
 so an error in the measured rates maps into the azimuth as 1 / (Omega cos(phi))
 (:func:`~schuler.drift_calibration.procedure.azimuth_sensitivity`). Above
-70 deg a :class:`DegradedAccuracyWarning` says so; beyond ``max_latitude``
+70 deg a :class:`AzimuthAccuracyWarning` says so; beyond ``max_latitude``
 (85 deg unless set) :class:`~schuler.exceptions.NotObservable` is raised: the
 error-free procedure still returns the azimuth to rounding there, but any
 instrument error is amplified beyond use (at 89.99 deg the typical budget gives
@@ -69,7 +69,7 @@ PULSE_CURRENT = 0.01
 """Peak pulse current i of the modelled instrument, A; K_M follows from the pulse rate (K_M / H) i."""
 
 
-class DegradedAccuracyWarning(UserWarning):
+class AzimuthAccuracyWarning(UserWarning):
     """The calibration works, but its azimuth accuracy is poor (high latitude)."""
 
 
@@ -229,7 +229,7 @@ def check_observable(latitude: np.ndarray, max_latitude: np.ndarray) -> None:
         warnings.warn(
             f"latitude {math.degrees(highest):g} deg: azimuth accuracy degrades as 1/cos(latitude), "
             f"{1 / math.cos(highest):.1f} times the equator's error for the same instrument errors",
-            DegradedAccuracyWarning, stacklevel=2)
+            AzimuthAccuracyWarning, stacklevel=2)
 
 
 def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:

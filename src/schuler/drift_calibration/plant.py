@@ -43,9 +43,9 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from schuler.core.attitude import skew
 from schuler.core.earth import EARTH_RATE
 from schuler.core.geometry import earth_rate_north_up
-from schuler.core.rotation import skew
 from schuler.drift_calibration.pulses import PulseShape
 from schuler.exceptions import SimulationError
 

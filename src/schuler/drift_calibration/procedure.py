@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.core.attitude import wrap_angle
 from schuler.core.earth import EARTH_RATE
 from schuler.drift_calibration.draws import ProcedureErrors
 from schuler.drift_calibration.stabilizer import NOISE_STEPS, Stabilizer, simulate_cycle
@@ -266,17 +267,6 @@ def fit_positions(rates_x, rates_y=None, mode: str = "three-axis"):
         return {"drift_x": solution[:, 0], "drift_y": np.full(len(data), np.nan), "c": solution[:, 1],
                 "s": solution[:, 2]}
     return {"drift_x": solution[:, 0], "drift_y": solution[:, 1], "c": solution[:, 2], "s": solution[:, 3]}
-
-
-def wrap_angle(angle):
-    """Angle difference brought into (-pi, pi], rad.
-
-    Parameters
-    ----------
-    angle : float or ndarray
-        Angle, rad.
-    """
-    return -np.mod(-np.asarray(angle) + np.pi, 2.0 * np.pi) + np.pi
 
 
 @dataclass(frozen=True)

@@ -131,26 +131,6 @@ class PulseShape:
         return bool(mirrored_knots and np.allclose(left[1:-1], right[1:-1], atol=tolerance * scale)
                     and abs(self.symmetry_bracket()) <= tolerance * scale)
 
-    def with_tilt(self, tilt: float) -> PulseShape:
-        """This shape plus the zero-mean ramp ``tilt * (2u - 1)`` (a sloping pulse top).
-
-        A tilt leaves the area unchanged and adds ``-tilt / 3`` to
-        :meth:`symmetry_bracket`: the error-budget model of pulse asymmetry.
-
-        Parameters
-        ----------
-        tilt : float
-            Slope of the ramp, relative to the amplitude (dimensionless).
-
-        """
-        knots = self.knots
-        return PulseShape(
-            knots,
-            self.start_values + tilt * (2.0 * knots[:-1] - 1.0),
-            self.end_values + tilt * (2.0 * knots[1:] - 1.0),
-            name=f"{self.name} (tilt {tilt:g})",
-        )
-
 
 def rectangular() -> PulseShape:
     """The rectangular pulse of the source's Fig. 4: shape = 1 on [0, 1].

@@ -99,7 +99,7 @@ def error_state_space(omega_2, gravity: float, radius: float, schuler_tuning: fl
     radius : float
         R, m.
     schuler_tuning : float
-        kappa = k R / H (1 is the Schuler condition (11)).
+        kappa = k R / H, dimensionless (1 is the Schuler condition (11)).
 
     Examples
     --------

@@ -64,7 +64,7 @@ def steady_errors(W_star_x, W_star_y, omega_2, gravity, radius, accelerometer_bi
     gyro_drift : pair of float or ndarray
         (eps_x, eps_y), rad/s.
     schuler_tuning : float
-        kappa = k R / H.
+        kappa = k R / H, dimensionless.
 
     Returns
     -------
@@ -98,7 +98,7 @@ def split_schuler_frequencies(gravity, radius, omega_2, schuler_tuning=1.0):
     omega_2 : float or ndarray
         Vertical Earth rate, rad/s.
     schuler_tuning : float
-        kappa; the loop frequency is sqrt(kappa g / R).
+        kappa, dimensionless; the loop frequency is sqrt(kappa g / R).
 
     Returns
     -------

@@ -261,7 +261,9 @@ def steady_state_gain_matrix(A, B) -> np.ndarray:
     Parameters
     ----------
     A : ndarray, shape (..., n, n)
+        State matrix, SI (1/s).
     B : ndarray, shape (..., n, m)
+        Input matrix, SI.
 
     Examples
     --------
@@ -366,8 +368,9 @@ def band_settling_time(time, signal, final, initial, band=0.01) -> np.ndarray:
     time : ndarray, shape (n_time,)
         s.
     signal : ndarray, shape (n_time,) or (N, n_time)
+        The transient, in any unit.
     final, initial : float or ndarray, shape () or (N,)
-        Reference steady value and initial value.
+        Reference steady value and initial value, in the signal's unit.
     band : float
         Relative half-width of the band (0.01: 1 %).
 

@@ -39,7 +39,7 @@ MAX_DURATION = 48 * 3600.0
 MAX_TIME_POINTS = 2_000_000
 
 
-class DegradedAccuracyWarning(UserWarning):
+class GyrocompassingAccuracyWarning(UserWarning):
     """Gyrocompassing works but its accuracy or time is poor (high latitude, slow settling)."""
 
 
@@ -144,7 +144,7 @@ class AlignmentCase:
             warnings.warn(
                 f"latitude {math.degrees(worst):g} deg: azimuth accuracy degrades as 1/cos(latitude), "
                 f"{1 / math.cos(worst):.1f} times the equator's error for the same drifts",
-                DegradedAccuracyWarning, stacklevel=3,
+                GyrocompassingAccuracyWarning, stacklevel=3,
             )
 
     def gains(self) -> tuple[np.ndarray, np.ndarray]:

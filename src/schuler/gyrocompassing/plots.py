@@ -96,7 +96,7 @@ def sweep_curves(x, x_label: str, columns: dict, groups=None):
         Display-unit columns: ``azimuth_error_analytic_arcmin``, optional
         ``azimuth_error_arcmin`` (simulated), ``settling_time_s``, optional
         ``settling_time_simulated_s``.
-    groups : ndarray of str, optional
+    groups : sequence of str, optional
         A label per case: one curve per label (other swept parameters).
     """
     fig, (ax_error, ax_time) = _figure(2)

@@ -20,7 +20,7 @@ from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.core.lti import simulate
 from schuler.core.random import RandomStreams
 from schuler.gyrocompassing import analytic, evaluation, models, plots
-from schuler.gyrocompassing.case import AlignmentCase, DegradedAccuracyWarning
+from schuler.gyrocompassing.case import AlignmentCase, GyrocompassingAccuracyWarning
 from schuler.gyrocompassing.simulation import evaluate_cases, run_case
 from schuler.references import KPI_LAB_MANUAL
 from schuler.reproduction import Reproduction, Tolerance, compare
@@ -163,7 +163,7 @@ def report(outdir: Path) -> ReportSection:
                                      c_a=float(fixed_gains[1]))
     with warnings.catch_warnings():
         # the sweep reaches 80 deg on purpose, to show the degradation the warning is about
-        warnings.simplefilter("ignore", DegradedAccuracyWarning)
+        warnings.simplefilter("ignore", GyrocompassingAccuracyWarning)
         swept = evaluate_cases(sweep_case, "full", simulate_runs=True)
     mc_case = evaluation.PARAMETERS.case(drift_east=EXAMPLE_DRIFT, sigma_drift=EXAMPLE_DRIFT,
                                          sigma_drift_z=EXAMPLE_DRIFT, sigma_accel=EXAMPLE_ACCEL_ERROR, duration=1200.0)

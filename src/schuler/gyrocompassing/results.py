@@ -6,7 +6,7 @@ import math
 import warnings
 from typing import Any
 
-from schuler.gyrocompassing.case import DegradedAccuracyWarning
+from schuler.gyrocompassing.case import GyrocompassingAccuracyWarning
 from schuler.gyrocompassing.evaluation import single_case
 from schuler.gyrocompassing.simulation import CaseRun
 from schuler.gyrocompassing.simulation import run_case as simulate_case
@@ -87,7 +87,7 @@ def case_runs(result: SystemResult) -> tuple[CaseRun, CaseRun] | None:
     duration, step = result.outputs["simulated_duration_s"], result.parameters["output_step"]
     with warnings.catch_warnings():
         # the run has warned already: these are the same case
-        warnings.simplefilter("ignore", DegradedAccuracyWarning)
+        warnings.simplefilter("ignore", GyrocompassingAccuracyWarning)
         run = simulate_case(single, model, duration=duration, time_step=step)
         simplified = run if model == "simplified" else simulate_case(single, "simplified", duration=duration,
                                                                      time_step=step)

@@ -25,7 +25,7 @@ from schuler.exceptions import InvalidParameter
 from schuler.gyrocompassing import analytic
 from schuler.gyrocompassing.case import (
     AlignmentCase,
-    DegradedAccuracyWarning,
+    GyrocompassingAccuracyWarning,
     analytic_results,
     automatic_duration,
     check_model,
@@ -87,6 +87,7 @@ def simulate_cases(system: StateSpace, time: np.ndarray, initial_state: np.ndarr
     time : ndarray
         Output times, s.
     initial_state : ndarray, shape (n,) or (N, n)
+        States at ``time[0]``, SI.
     inputs : ndarray, shape (6,) or (N, 6)
         Constant inputs, SI.
     members : int
@@ -257,7 +258,7 @@ def run_case(case: AlignmentCase, model: str = "full", *, duration: float | None
         warnings.warn(
             f"the analytic settling time {closed['settling_time_s']:.4g} s exceeds the run ({duration:.4g} s): "
             "the simulated azimuth error is not yet the steady state",
-            DegradedAccuracyWarning, stacklevel=2,
+            GyrocompassingAccuracyWarning, stacklevel=2,
         )
     time = time_grid(duration, time_step)
     system = case.model(model)

@@ -149,7 +149,7 @@ class JobServerManager(DiskcacheManager):
         Parameters
         ----------
         job : int or str or None
-            The job's process id as :meth:`call_job_fn` returned it.
+            The job's process id as :meth:`call_job_fn` returned it (an index, not a number to compute with).
         """
         import psutil
 
@@ -169,7 +169,7 @@ class JobServerManager(DiskcacheManager):
         Parameters
         ----------
         job : int or str or None
-            The job's process id.
+            The job's process id (an index).
         """
         return self._own_job(job) is not None
 
@@ -179,7 +179,7 @@ class JobServerManager(DiskcacheManager):
         Parameters
         ----------
         job : int or str or None
-            The job's process id.
+            The job's process id (an index).
         """
         return False
 

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.core.attitude import dcm_from_quaternion
 from schuler.core.earth import EARTH_RATE, earth_rate_ned, gravity_ned, radii_of_curvature, transport_rate_ned
-from schuler.navigate.attitude import rotation_matrix
 
 SUBSTEPS = 8
 """Points per step of the trapezoidal means (the coefficients change little within a minute)."""
@@ -118,7 +118,7 @@ def step_coefficients(trajectory, latitude: float, height: float, duration: floa
     rho = transport_rate_ned(lat, hgt, velocity[:, 0], velocity[:, 1])
     force_ned = (np.gradient(velocity, time, axis=0) - gravity_ned(lat, hgt)
                  + np.cross(2.0 * omega + rho, velocity))
-    C = rotation_matrix(quaternion)
+    C = dcm_from_quaternion(quaternion)
     turn = np.einsum("kji,kjl->kil", C, np.gradient(C, time, axis=0))
     body_turn = np.stack([turn[:, 2, 1], turn[:, 0, 2], turn[:, 1, 0]], axis=-1)
     body_rate = np.einsum("kji,kj->ki", C, omega + rho) + body_turn

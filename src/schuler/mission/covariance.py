@@ -49,13 +49,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.core.attitude import dcm_from_quaternion
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.exceptions import InvalidParameter
 from schuler.mission.coefficients import StepCoefficients, step_coefficients
 from schuler.mission.exponential import expm_stack
 from schuler.mission.setup import CONSTANT_SOURCES, SOURCES, WHITE_SOURCES, MissionSetup
 from schuler.mission.stages import alignment_noise, initial_state_map, sensor_inputs
-from schuler.navigate.attitude import rotation_matrix
 from schuler.navigation_errors.three_d import wgs84_error_matrices
 
 OUTPUT_CHANNELS = ("position_north", "position_east", "velocity_north", "velocity_east", "heading")
@@ -354,7 +354,7 @@ class _MissionTerms:
                                     coefficients.specific_force_ned, EARTH_RATE, vertical)
         n = F.shape[-1]
         sigma = setup.constant_sigmas * np.array([name not in disabled for name in CONSTANT_SOURCES])
-        start_rotation = rotation_matrix(trajectory.kinematics(np.array([0.0]))[1])[0]
+        start_rotation = dcm_from_quaternion(trajectory.kinematics(np.array([0.0]))[1])[0]
         inputs = sensor_inputs(coefficients.body_to_ned, coefficients.body_rate,
                                coefficients.body_specific_force) * sigma[None, :, None]
         C = coefficients.body_to_ned

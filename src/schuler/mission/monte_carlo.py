@@ -27,17 +27,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.core.attitude import (
+    dcm_from_quaternion,
+    euler_from_quaternion,
+    quaternion_from_rotation_vector,
+    quaternion_multiply,
+    wrap_angle,
+)
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.core.random import RandomStreams
 from schuler.mission.setup import CONSTANT_SOURCES, MissionSetup
 from schuler.mission.stages import alignment_noise, initial_state_map
-from schuler.navigate.attitude import (
-    euler_from_quaternion,
-    quaternion_from_rotation_vector,
-    quaternion_multiply,
-    rotation_matrix,
-    wrap_angle,
-)
 from schuler.navigate.errors import InitialErrors, SensorErrors
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.results import NavigationResult
@@ -224,7 +224,7 @@ def run_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate: 
     trajectory = setup.trajectory()
     start_quaternion = trajectory.kinematics(np.array([0.0]))[1][0]
     n = 9 if setup.vertical_channel == "free" else 7
-    draws, x0 = member_draws(setup, members, streams, n, rotation_matrix(start_quaternion))
+    draws, x0 = member_draws(setup, members, streams, n, dcm_from_quaternion(start_quaternion))
     column = {name: i for i, name in enumerate(CONSTANT_SOURCES)}
 
     def triad(family: str) -> np.ndarray:

@@ -21,7 +21,7 @@ Modules, from the vehicle to the verdicts:
   along a run, in the run's own variables: first-order agreement;
 - :mod:`~schuler.navigate.seeds`  Bollay's five error sources and Drozdovich's worked example against
   the nonlinear INS;
-- :mod:`~schuler.navigate.attitude`  Euler angles, quaternions, rotation vectors;
+- :mod:`~schuler.core.attitude`  Euler angles, quaternions, rotation vectors;
 - :mod:`~schuler.navigate.results`, :mod:`~schuler.navigate.plots`  typed results and figures.
 
 The time loops are numba kernels in the private ``_kernels``, ``_loops`` and

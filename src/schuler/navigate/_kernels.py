@@ -2,7 +2,7 @@
 
 Private: plain floats and arrays in, plain floats and arrays out. The public
 functions live in :mod:`schuler.core.earth` (the same formulas, vectorised with
-numpy; the tests hold the two together) and :mod:`schuler.navigate.attitude`.
+numpy; the tests hold the two together) and :mod:`schuler.core.attitude`.
 
 Quaternions are Hamilton's, scalar first, q = (q0, q1, q2, q3); q_bn maps body
 vectors into the navigation frame, v_n = q v_b q*, so that C_b^n = R(q_bn).

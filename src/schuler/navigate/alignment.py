@@ -46,6 +46,7 @@ from typing import ClassVar
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from schuler.core.attitude import dcm_from_quaternion, quaternion_from_rotation_vector, wrap_angle
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
@@ -61,11 +62,6 @@ from schuler.gyrocompassing.models import (
     simplified_model,
 )
 from schuler.navigate._alignment_kernel import align
-from schuler.navigate.attitude import (
-    quaternion_from_rotation_vector,
-    rotation_matrix,
-    wrap_angle,
-)
 from schuler.results import Result
 
 
@@ -176,12 +172,12 @@ def gyrocompass_alignment(latitude: float, azimuth: float, c_gamma: float, c_a: 
     params[:, 14], params[:, 15] = -c_gamma / gravity, c_a / gravity
     # initial platform: y axis at azimuth A + delta0, z axis tilted by (beta0 about east, alpha0 about north)
     tilt = quaternion_from_rotation_vector(np.stack([beta0, alpha0, np.zeros(n)], axis=-1))
-    platform_to_enu = rotation_matrix(tilt) @ _level_to_enu(A + delta0)
+    platform_to_enu = dcm_from_quaternion(tilt) @ _level_to_enu(A + delta0)
     platform_to_level = np.swapaxes(_level_to_enu(np.full(n, A)), -1, -2) @ platform_to_enu
     q = np.ascontiguousarray(_quaternion_from_matrix(platform_to_level))
     out = np.empty((n, n_steps // every + 1, 4))
     align(q, np.ascontiguousarray(params), float(time_step), n_steps, every, out)
-    C = _level_to_enu(A) @ rotation_matrix(out)  # platform -> ENU, (N, n_time, 3, 3)
+    C = _level_to_enu(A) @ dcm_from_quaternion(out)  # platform -> ENU, (N, n_time, 3, 3)
     y_axis, z_axis = C[..., :, 1], C[..., :, 2]
     delta = wrap_angle(np.arctan2(y_axis[..., 0], y_axis[..., 1]) - A)
     beta = -np.arcsin(np.clip(z_axis[..., 1], -1.0, 1.0))

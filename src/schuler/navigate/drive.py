@@ -34,8 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.core.attitude import quaternion_from_euler
 from schuler.exceptions import InvalidParameter
-from schuler.navigate.attitude import quaternion_from_euler
 from schuler.navigate.trajectory import WaypointProfile
 
 SHORTEST_SPEED_CHANGE_S = 4.0

@@ -49,18 +49,18 @@ import warnings
 
 import numpy as np
 
-from schuler.core.earth import EARTH_RATE, radii_of_curvature, somigliana_gravity
-from schuler.exceptions import InvalidParameter, SimulationError
-from schuler.navigate import _kernels, _loops
-from schuler.navigate.attitude import (
+from schuler.core.attitude import (
     attitude_error,
     conjugate,
+    dcm_from_quaternion,
     euler_from_quaternion,
     quaternion_from_euler,
     quaternion_multiply,
-    rotation_matrix,
     wrap_angle,
 )
+from schuler.core.earth import EARTH_RATE, radii_of_curvature, somigliana_gravity
+from schuler.exceptions import InvalidParameter, SimulationError
+from schuler.navigate import _kernels, _loops
 from schuler.navigate.errors import InitialErrors, SensorErrors, SensorNoise
 from schuler.navigate.results import NavigationResult, TruthSamples
 from schuler.navigate.truth import DEFAULT_CHUNK, TruthGenerator
@@ -241,7 +241,7 @@ class _IntervalMeans:
         for name, values in (("latitude_rad", chunk.positions[:, 0]), ("height_m", chunk.positions[:, 2]),
                              ("velocity_ned_m_s", chunk.velocities),
                              ("specific_force_ned_m_s2", chunk.nav_increments[:, 3:] / self.dt),
-                             ("body_to_ned", rotation_matrix(chunk.quaternions))):
+                             ("body_to_ned", dcm_from_quaternion(chunk.quaternions))):
             np.add.at(self.sums[name], bins, values)
 
     def means(self) -> dict:

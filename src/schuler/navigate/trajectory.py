@@ -2,7 +2,7 @@
 
 A trajectory gives the vehicle's start position and, at any times, its ground
 velocity in NED (m/s) and its attitude as the quaternion q_bn (aerospace roll,
-pitch and heading, see :mod:`schuler.navigate.attitude`). The position is not an input:
+pitch and heading, see :mod:`schuler.core.attitude`). The position is not an input:
 the truth generator (:mod:`schuler.navigate.truth`) integrates the velocity with
 the navigation algorithm's own position update, so that the truth and the ideal
 IMU are consistent to rounding.
@@ -32,7 +32,7 @@ Examples
 --------
 >>> path = GreatCircle(latitude=np.radians(45.0), longitude=0.0, height=0.0, heading=np.radians(30.0),
 ...                    speed=250.0, duration=3600.0)
->>> from schuler.navigate.attitude import euler_from_quaternion
+>>> from schuler.core.attitude import euler_from_quaternion
 >>> v, q = path.kinematics(np.array([0.0, 3600.0]))
 >>> heading = euler_from_quaternion(q)[:, 2]
 >>> bool(np.allclose(np.linalg.norm(v, axis=1), 250.0)), bool(heading[1] > heading[0])
@@ -46,9 +46,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from schuler.core.attitude import quaternion_from_euler
 from schuler.core.earth import STANDARD_GRAVITY, radii_of_curvature
 from schuler.exceptions import InvalidParameter, SimulationError
-from schuler.navigate.attitude import quaternion_from_euler
 
 MAX_LATITUDE = np.radians(89.0)
 """Trajectories must stay within 89 deg of the equator: NED and the transport rate are singular at the poles."""

@@ -110,7 +110,7 @@ def validity_messages(t_s: np.ndarray, computed_height_m: np.ndarray, attitude_e
     ids : ndarray of int, shape (N,)
         Global member numbers.
     batch : int or None
-        Batch size (None: a single run).
+        Batch size, members (None: a single run).
     vertical_channel : str
         The run's vertical channel (a free one gets a hint).
 

@@ -39,7 +39,7 @@ from schuler.navigation_errors.inputs import (
     grid_points,
     time_grid,
 )
-from schuler.navigation_errors.results import PeriodResult, VerticalResult
+from schuler.navigation_errors.results import PeriodResult, VerticalChannelResult
 from schuler.navigation_errors.vertical_channel import (
     BaroLoopGains,
     aided_steady_state_error,
@@ -158,7 +158,7 @@ def loop_gains(order: int, time_constant: float, k1: float | None, k2: float | N
 
 def vertical(*, accel_bias_up: float, duration: float, output_step: float | None, order: int, time_constant: float,
              k1: float | None, k2: float | None, k3: float | None, baro_bias: float, earth: str,
-             radius: float | None, gravity: float | None) -> VerticalResult:
+             radius: float | None, gravity: float | None) -> VerticalChannelResult:
     """Pure-inertial vertical channel (Bollay 1966, Problem 4) vs the baro-aided loop, SI in and out.
 
     Takes every option of :data:`VERTICAL_PARAMETERS` (build them with its
@@ -189,7 +189,7 @@ def vertical(*, accel_bias_up: float, duration: float, output_step: float | None
 
     Returns
     -------
-    VerticalResult
+    VerticalChannelResult
         The unaided and aided altitude errors (m) over time (s), the closed form beside them, and the loop's
         gains and poles.
 
@@ -208,7 +208,7 @@ def vertical(*, accel_bias_up: float, duration: float, output_step: float | None
     unaided, aided = altitude_errors(t, gains, accel_bias_up, baro_bias, R, g)
     closed = hover_altitude_error(t, accel_bias_up, R, g)
     poles = baro_aided_model(gains, R, g).eigenvalues()
-    return VerticalResult(
+    return VerticalChannelResult(
         order=order, k1_per_s=gains.k1, k2_per_s2=gains.k2, k3_per_s3=gains.k3, accel_bias_up_m_s2=accel_bias_up,
         baro_bias_m=baro_bias, duration_s=float(t[-1]), final_unaided_m=float(unaided[-1]),
         final_closed_form_m=float(closed[-1]), final_aided_m=float(aided[-1]),

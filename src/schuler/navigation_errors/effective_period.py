@@ -38,7 +38,7 @@ def thrust_gravity(thrust_factor, gravity):
     Parameters
     ----------
     thrust_factor : float or ndarray
-        n (> 0).
+        n (> 0), a ratio of thrust to weight.
     gravity : float or ndarray
         g0, m/s^2 (> 0).
 

@@ -25,7 +25,7 @@ from schuler.navigation_errors.results import (
     PeriodResult,
     Problem3Curves,
     Problem3Figures,
-    VerticalResult,
+    VerticalChannelResult,
 )
 from schuler.navigation_errors.single_channel import SOURCES
 from schuler.navigation_errors.three_d_run import ThreeDResult
@@ -50,7 +50,7 @@ def figures(result: Result) -> dict[str, Any]:
         return problem3_figures(result.curves)
     if isinstance(result, SystemResult):
         return _run_figures(result)
-    if isinstance(result, VerticalResult):
+    if isinstance(result, VerticalChannelResult):
         return {"errors_vertical_run": plots.plot_vertical(
             result.t_s, result.unaided_m, {f"baro-aided, order {result.order}": result.aided_m}, "m",
             "Vertical channel: pure inertial vs baro-aided")}
@@ -83,7 +83,7 @@ def data_files(result: Result, out_dir: Path) -> list[Path]:
     out_dir = Path(out_dir)
     if isinstance(result, (Reproduction, Problem3Figures)):
         return problem3_tables(result.data if isinstance(result, Reproduction) else result.curves, out_dir)
-    if isinstance(result, VerticalResult):
+    if isinstance(result, VerticalChannelResult):
         return [write_dataframe_csv(result.to_dataframe(), out_dir / "errors_vertical_run.csv")]
     if isinstance(result, PeriodResult):
         speeds, periods = _period_curve(result)

@@ -148,7 +148,7 @@ class ErrorRunResult(SystemResult):
 
 
 @dataclass
-class VerticalResult(Result):
+class VerticalChannelResult(Result):
     """Altitude error: pure inertial (simulated and closed form, Bollay's Problem 4) vs the baro-aided loop.
 
     Altitude errors are indicated - true, positive up; ``accel_bias_up_m_s2``

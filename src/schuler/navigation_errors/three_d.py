@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from schuler.core.attitude import skew
 from schuler.core.earth import (
     EARTH_RATE,
     NORTH_GRAVITY_PER_HEIGHT,
@@ -66,7 +67,6 @@ from schuler.core.earth import (
     transport_rate_ned,
 )
 from schuler.core.lti import StateSpace, zoh_discretize
-from schuler.core.rotation import skew
 from schuler.exceptions import InvalidParameter
 
 _AXES = ("north", "east", "down")
@@ -228,13 +228,6 @@ def foucault_velocity_response(time, velocity_error_north: float, latitude: floa
     return z.real, z.imag
 
 
-def _skew_batch(v: np.ndarray) -> np.ndarray:
-    """[v x] for vectors (K, 3), shape (K, 3, 3)."""
-    zero = np.zeros(v.shape[0])
-    return np.stack([np.stack([zero, -v[:, 2], v[:, 1]], -1), np.stack([v[:, 2], zero, -v[:, 0]], -1),
-                     np.stack([-v[:, 1], v[:, 0], zero], -1)], -2)
-
-
 def wgs84_gravity_gradient(latitude, height) -> np.ndarray:
     """d delta_g / d delta_r on WGS-84: the error of computed gravity per metre of position error, 1/s^2.
 
@@ -333,12 +326,12 @@ def wgs84_error_matrices(latitude, height, velocity_ned, specific_force_ned, rat
     omega = earth_rate_ned(L, rate)
     rho = transport_rate_ned(L, h, v[:, 0], v[:, 1])
     F = np.zeros((L.size, 9, 9))
-    F[:, 0:3, 0:3] = -_skew_batch(rho)
+    F[:, 0:3, 0:3] = -skew(rho)
     F[:, 0:3, 3:6] = np.eye(3)
     F[:, 3:6, 0:3] = wgs84_gravity_gradient(L, h)
-    F[:, 3:6, 3:6] = -_skew_batch(2.0 * omega + rho)
-    F[:, 3:6, 6:9] = _skew_batch(f)
-    F[:, 6:9, 6:9] = -_skew_batch(omega + rho)
+    F[:, 3:6, 3:6] = -skew(2.0 * omega + rho)
+    F[:, 3:6, 6:9] = skew(f)
+    F[:, 6:9, 6:9] = -skew(omega + rho)
     G = np.zeros((L.size, 9, 6))
     G[:, 3:6, 0:3] = np.eye(3)
     G[:, 6:9, 3:6] = np.eye(3)
@@ -422,7 +415,7 @@ def propagate_along(time, latitude, height, velocity_ned, specific_force_ned, in
     velocity_ned, specific_force_ned : array_like, shape (K, 3)
         Per step, m/s and m/s^2.
     initial_state : array_like, shape (n,) or (N, n)
-        States as :func:`psi_angle_model` at ``time[0]``.
+        States as :func:`psi_angle_model` at ``time[0]``, SI.
     inputs : array_like, shape (6,), (K, 6) or (N, K, 6), optional
         nabla (m/s^2) and epsilon (rad/s) in NED, per step.
     rate : float
