@@ -56,7 +56,7 @@ VARIATIONS = {
                  {"trajectory": "great-circle", "speed": 200.0, "heading": 1.0, "gyro_bias_x": 1e-7,
                   "imu": "tactical"}],
     "aided": [{"aiding": "gnss-position", "gnss_rate": 2.0}, {"lever_arm_x": 1.0, "imu": "industrial"}],
-    "mission": [{"grade": "navigation", "trajectory": "stationary"},
+    "mission": [{"imu": "navigation", "trajectory": "stationary"},
                 {"alignment": "gyrocompass", "calibration": "multi-position", "alignment_duration": 600.0}],
 }
 """Further cases per system on which run and evaluate must agree."""

@@ -26,10 +26,10 @@ def setup_of(**values):
 
 
 MISSIONS = {
-    "kalman-cruise": {"grade": "tactical", "trajectory": "cruise", "duration": 3600.0},
-    "gyrocompass-stationary": {"grade": "navigation", "alignment": "gyrocompass", "trajectory": "stationary",
+    "kalman-cruise": {"imu": "tactical", "trajectory": "cruise", "duration": 3600.0},
+    "gyrocompass-stationary": {"imu": "navigation", "alignment": "gyrocompass", "trajectory": "stationary",
                                "duration": 7200.0, "alignment_duration": 900.0},
-    "ground-flight": {"grade": "industrial", "alignment": "ground-gyrocompass", "calibration": "multi-position",
+    "ground-flight": {"imu": "industrial", "alignment": "ground-gyrocompass", "calibration": "multi-position",
                       "trajectory": "flight", "duration": 1800.0, "initial_position_error": 10.0},
 }
 
@@ -65,7 +65,7 @@ def test_a_gyro_bias_acts_through_the_heading_it_leaves_and_during_navigation():
     # one source: the east gyro bias of a level vehicle heading north is the y gyro; after a Kalman alignment
     # the heading error it leaves and its drift cancel in the psi equation's east line (equilibrium), so at rest
     # psi_E stays put and the north error it makes is only the 24-h mode's: far less than without the alignment
-    setup = setup_of(grade="navigation", trajectory="stationary", heading=0.0, duration=4 * 3600.0)
+    setup = setup_of(imu="navigation", trajectory="stationary", heading=0.0, duration=4 * 3600.0)
     with_alignment = covariance_budget(setup)
     i = with_alignment.sources.index("gyro_bias_y")
     through_both = with_alignment.horizontal()[-1, i]
@@ -73,20 +73,20 @@ def test_a_gyro_bias_acts_through_the_heading_it_leaves_and_during_navigation():
     sigma = setup.constant_sigmas[CONSTANT_SOURCES.index("gyro_bias_y")]
     # psi_D = -epsilon_E / (Omega cos L), epsilon_E = -b_y: the closed form (Groves 2013, Sec. 5.6.2)
     assert x0[-1] == pytest.approx(sigma / (EARTH_RATE * math.cos(setup.latitude)), rel=1e-12)
-    free = covariance_budget(setup_of(grade="navigation", trajectory="stationary", heading=0.0,
+    free = covariance_budget(setup_of(imu="navigation", trajectory="stationary", heading=0.0,
                                       duration=4 * 3600.0, alignment="ground-gyrocompass",
                                       north_reference_error=0.0))
     assert through_both < 0.05 * free.horizontal()[-1, i]
 
 
 def test_calibration_residuals_follow_their_closed_forms():
-    pulse = setup_of(grade="tactical", calibration="pulse", calibration_duration=600.0, trajectory="stationary",
+    pulse = setup_of(imu="tactical", calibration="pulse", calibration_duration=600.0, trajectory="stationary",
                      duration=3600.0)
     gyro = pulse.error_model.gyro
     floor = np.hypot(0.0034 * gyro.bias, gyro.random_walk / math.sqrt(600.0))
     assert np.all(pulse.gyro_bias_sigma() >= floor)
     assert np.all(pulse.gyro_bias_sigma() <= np.hypot(floor, 2 * gyro.bias_instability))
-    multi = setup_of(grade="tactical", calibration="multi-position", calibration_duration=600.0,
+    multi = setup_of(imu="tactical", calibration="multi-position", calibration_duration=600.0,
                      trajectory="stationary", duration=3600.0)
     # the multi-position test removes the accelerometer turn-on bias (1 mg) down to its noise and slow terms
     assert np.all(multi.accel_bias_sigma() < 0.1 * pulse.accel_bias_sigma())
@@ -95,7 +95,7 @@ def test_calibration_residuals_follow_their_closed_forms():
 
 
 def test_the_monte_carlo_starts_from_the_attitude_error_the_covariance_assumes():
-    setup = setup_of(grade="tactical", trajectory="cruise", duration=600.0, heading=math.radians(30.0))
+    setup = setup_of(imu="tactical", trajectory="cruise", duration=600.0, heading=math.radians(30.0))
     trajectory = setup.trajectory()
     q0 = trajectory.kinematics(np.array([0.0]))[1][0]
     members = np.arange(6)
@@ -108,7 +108,7 @@ def test_the_monte_carlo_starts_from_the_attitude_error_the_covariance_assumes()
 
 
 def test_members_do_not_depend_on_chunking():
-    setup = setup_of(grade="industrial", trajectory="stationary", duration=600.0)
+    setup = setup_of(imu="industrial", trajectory="stationary", duration=600.0)
     streams = RandomStreams(5)
     whole = final_horizontal_errors(run_members(setup, np.arange(4), streams, 1.0))
     parts = np.concatenate([final_horizontal_errors(run_members(setup, np.arange(i, i + 2), streams, 1.0))
@@ -120,18 +120,18 @@ def test_covariance_agrees_with_the_nonlinear_monte_carlo_short():
     # a cheap variant of the slow three-mission check: 400 members, navigation grade, 2-h stationary.
     # The RMS over 400 members of a 2-D error has a relative standard error of about 1/sqrt(4 * 400) = 2.5 %;
     # 10 % is four of them
-    setup = setup_of(grade="navigation", trajectory="stationary", duration=7200.0, alignment_duration=900.0)
+    setup = setup_of(imu="navigation", trajectory="stationary", duration=7200.0, alignment_duration=900.0)
     sigma = covariance_budget(setup).sigma("horizontal_position")[-1]
     errors = final_horizontal_errors(run_members(setup, np.arange(400), RandomStreams(11), 1.0))
     assert math.sqrt(np.mean(errors**2)) == pytest.approx(sigma, rel=0.10)
 
 
 LONG_MISSIONS = {
-    "stationary-24h": {"grade": "navigation", "trajectory": "stationary", "duration": 86400.0,
+    "stationary-24h": {"imu": "navigation", "trajectory": "stationary", "duration": 86400.0,
                        "alignment_duration": 900.0, "output_step": 600.0, "imu_rate": 0.5},
-    "flight-2h": {"grade": "navigation", "trajectory": "flight", "duration": 7200.0, "alignment_duration": 900.0,
+    "flight-2h": {"imu": "navigation", "trajectory": "flight", "duration": 7200.0, "alignment_duration": 900.0,
                   "imu_rate": 1.0},
-    "cruise-10h": {"grade": "navigation", "trajectory": "cruise", "duration": 36000.0, "alignment_duration": 900.0,
+    "cruise-10h": {"imu": "navigation", "trajectory": "cruise", "duration": 36000.0, "alignment_duration": 900.0,
                    "output_step": 600.0, "imu_rate": 0.5},
 }
 """The issue's three missions; reduced IMU rates (exact for the noise increments, ample for the smooth paths)."""
@@ -163,9 +163,9 @@ def test_bad_stage_choices_are_refused_by_name():
 
 def test_a_better_gyro_buys_more_than_a_longer_alignment_for_a_tactical_flight():
     base = {"trajectory": "flight", "duration": 7200.0}
-    tactical = covariance_budget(setup_of(grade="tactical", **base)).sigma("horizontal_position")[-1]
-    longer = covariance_budget(setup_of(grade="tactical", alignment_duration=1800.0, **base))
-    navigation = covariance_budget(setup_of(grade="navigation", **base)).sigma("horizontal_position")[-1]
+    tactical = covariance_budget(setup_of(imu="tactical", **base)).sigma("horizontal_position")[-1]
+    longer = covariance_budget(setup_of(imu="tactical", alignment_duration=1800.0, **base))
+    navigation = covariance_budget(setup_of(imu="navigation", **base)).sigma("horizontal_position")[-1]
     assert navigation < longer.sigma("horizontal_position")[-1] < tactical
     assert from_unit(1.0, "arcmin") > 0
 

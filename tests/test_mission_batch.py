@@ -40,7 +40,7 @@ def test_the_covariance_analysis_makes_no_scipy_exponential(monkeypatch):
         raise AssertionError("scipy.linalg.expm called")
 
     monkeypatch.setattr(scipy.linalg, "expm", refuse)
-    budget = covariance_budget(setup_of(grade="tactical", trajectory="flight", duration=2400.0))
+    budget = covariance_budget(setup_of(imu="tactical", trajectory="flight", duration=2400.0))
     assert budget.sigma("horizontal_position")[-1] > 0
 
 
@@ -50,8 +50,8 @@ def test_a_batch_of_budgets_is_each_budget_alone(batch_steps, monkeypatch):
 
     monkeypatch.setattr(covariance, "BATCH_STEPS", batch_steps)
     headings = np.radians([0.0, 75.0, 200.0])
-    setups = [setup_of(grade="tactical", trajectory="flight", duration=2400.0, heading=h) for h in headings]
-    setups.append(setup_of(grade="consumer", alignment="ground-gyrocompass", calibration="multi-position",
+    setups = [setup_of(imu="tactical", trajectory="flight", duration=2400.0, heading=h) for h in headings]
+    setups.append(setup_of(imu="consumer", alignment="ground-gyrocompass", calibration="multi-position",
                            trajectory="cruise", duration=2400.0, speed=20.0))
     for batched, setup in zip(covariance_budgets(setups), setups):
         alone = covariance_budget(setup)
@@ -66,7 +66,7 @@ def test_a_batch_of_budgets_needs_one_step_grid():
 
 
 def test_members_of_different_imu_rates_each_fly_at_their_own():
-    case = {"grade": "industrial", "alignment": "ground-gyrocompass", "trajectory": "stationary", "duration": 600.0}
+    case = {"imu": "industrial", "alignment": "ground-gyrocompass", "trajectory": "stationary", "duration": 600.0}
     streams = RandomStreams(9)
     values = SYSTEM.evaluate_values({**case, "imu_rate": np.array([1.0, 4.0])}, members=np.array([3, 4]),
                                     random=streams)

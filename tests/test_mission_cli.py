@@ -55,7 +55,7 @@ def test_sweep_under_the_group_gives_the_summary_of_schuler_sweep(run_cli, tmp_p
     import schuler.study.plots
 
     monkeypatch.setattr(schuler.study.plots, "plot_sweep_summary", lambda *args, **kwargs: [])
-    grid = ("--param", "grade=navigation,tactical", "--param", "alignment_duration=300,600",
+    grid = ("--param", "imu=navigation,tactical", "--param", "alignment_duration=300,600",
             "--param", "duration=1800")
     scenario = EXAMPLES / "mission_tactical.toml"
     under_group = run_cli("mission", "sweep", scenario, *grid, "--out", tmp_path / "group", "--json")
@@ -110,7 +110,7 @@ def test_the_covariance_over_the_members_agrees_with_their_monte_carlo(run_cli):
 
 
 def test_the_table_labels_each_covariance_beside_the_monte_carlo(run_cli):
-    out = run_cli("mission", "run", "--grade", "navigation", "--trajectory", "stationary", "--duration", "600",
+    out = run_cli("mission", "run", "--imu", "navigation", "--trajectory", "stationary", "--duration", "600",
                   "--monte-carlo", "4")
     assert out.code == 0, out.stderr
     for label in ("1-sigma (covariance at the nominal case)",

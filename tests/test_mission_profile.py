@@ -62,7 +62,7 @@ def flight_profile(tmp_path):
 
 
 def test_a_profile_file_of_the_built_in_flight_gives_its_budget(flight_profile):
-    common = {"grade": "tactical", "duration": 1800.0}
+    common = {"imu": "tactical", "duration": 1800.0}
     from_file = setup_of(profile=str(flight_profile), **common)
     assert from_file.latitude == pytest.approx(math.radians(45.0), rel=1e-15)
     assert from_file.heading == pytest.approx(math.radians(30.0), rel=1e-15)  # the first waypoint's
@@ -77,7 +77,7 @@ def test_a_profile_file_of_the_built_in_flight_gives_its_budget(flight_profile):
 def test_covariance_agrees_with_the_monte_carlo_along_a_profile(flight_profile):
     # 300 members: the RMS of a 2-D error has a relative standard error of about 1/sqrt(4 * 300) = 2.9 %;
     # 12 % is four of them
-    setup = setup_of(profile=str(flight_profile), grade="navigation", duration=1800.0)
+    setup = setup_of(profile=str(flight_profile), imu="navigation", duration=1800.0)
     sigma = covariance_budget(setup).sigma("horizontal_position")[-1]
     errors = final_horizontal_errors(run_members(setup, np.arange(300), RandomStreams(21), 2.0,
                                                  output_step=setup.duration))
@@ -98,7 +98,7 @@ def test_a_bad_profile_is_refused_in_one_line(run_cli, arguments, message):
 @pytest.mark.slow
 def test_covariance_agrees_with_the_monte_carlo_along_the_manoeuvring_flight():
     # climbs, descents, turns of both senses: 1,000 members, relative standard error ~1.6 %, the 10 %
-    setup = setup_of(profile=str(MANOEUVRING), grade="tactical", duration=3600.0)
+    setup = setup_of(profile=str(MANOEUVRING), imu="tactical", duration=3600.0)
     sigma = covariance_budget(setup).sigma("horizontal_position")[-1]
     errors = final_horizontal_errors(run_members(setup, np.arange(1000), RandomStreams(21), 2.0,
                                                  output_step=setup.duration))

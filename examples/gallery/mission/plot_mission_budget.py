@@ -13,11 +13,10 @@ the stacked budget shows which source grows into the error, and when.
 import matplotlib.pyplot as plt
 
 import schuler
-from schuler.mission.plots import stacked_budget
 
 mission = schuler.get_system("mission")
-r = mission.run(grade="navigation", trajectory="stationary", duration=2 * 3600.0, output_step=120.0)
-stacked_budget(r.history)
+r = mission.run(imu="navigation", trajectory="stationary", duration=2 * 3600.0, output_step=120.0)
+r.plot("mission_budget")
 plt.show()
 
 # %%
@@ -33,4 +32,4 @@ print(f"sum of the shares: {sum(r.budget.values()):.9f}")
 # Carlo of the nonlinear INS beside it with ``--monte-carlo``)::
 #
 #     schuler run examples/mission_navigation.toml
-#     schuler mission run --grade navigation --trajectory cruise --duration '10 h' --monte-carlo 1000 --json
+#     schuler mission run --imu navigation --trajectory cruise --duration '10 h' --monte-carlo 1000 --json

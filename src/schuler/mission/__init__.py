@@ -3,7 +3,7 @@
 Conventions: NED navigation frame, body x forward / y right / z down, errors =
 computed - true, sensor bias = measured - true, SI inside.
 
-- :mod:`~schuler.mission.setup`  the instrument (grade, spec file or recording), calibration, alignment,
+- :mod:`~schuler.mission.setup`  the instrument (``imu``: a grade, spec file or recording), calibration, alignment,
   trajectory, sources;
 - :mod:`~schuler.mission.stages`  the alignment's residuals as a linear map of the sources;
 - :mod:`~schuler.mission.coefficients`  the trajectory's kinematics averaged over each step;

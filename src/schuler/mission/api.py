@@ -1,22 +1,24 @@
 """The mission study on the contract: ``SYSTEM`` (``schuler mission``).
 
 The pieces: :mod:`~schuler.mission.evaluation` (parameters, outputs,
-``evaluate``, ``run_case``), :mod:`~schuler.mission.reproduction` (``reproduce``,
-``report``), :mod:`~schuler.mission.results` (the result type and ``write_files``).
+``evaluate`` with histories), :mod:`~schuler.mission.plots` (``figures``),
+:mod:`~schuler.mission.reproduction` (``reproduce``, ``report``),
+:mod:`~schuler.mission.results` (the result type, rendered as a budget).
 
 Examples
 --------
->>> r = SYSTEM.run(grade="navigation", trajectory="stationary", duration=3600.0)
->>> round(sum(r.budget.values()), 6)
-1.0
+>>> r = SYSTEM.run(imu="navigation", trajectory="stationary", duration=3600.0)
+>>> round(sum(r.budget.values()), 6), list(r.figures())
+(1.0, ['mission_budget'])
 """
 
 from __future__ import annotations
 
 from schuler.contract import System
-from schuler.mission.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case
+from schuler.mission.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes
+from schuler.mission.plots import figures
 from schuler.mission.reproduction import SOURCE, report, reproduce
-from schuler.mission.results import write_files
+from schuler.mission.results import MissionResult
 from schuler.params import Case
 
 SECONDS_PER_SAMPLE = 8e-7
@@ -42,9 +44,9 @@ SYSTEM = System(
     parameters=PARAMETERS,
     outputs=OUTPUTS,
     evaluate=evaluate,
-    run_case=run_case,
     reproduce=reproduce,
-    write_files=write_files,
+    figures=figures,
+    result_type=MissionResult,
     report=report,
     random_terms=True,
     member_bytes=member_bytes,

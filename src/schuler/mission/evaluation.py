@@ -1,4 +1,4 @@
-"""What the mission system evaluates: its parameters, outputs, ``evaluate`` and ``run_case``.
+"""What the mission system evaluates: its parameters, outputs and ``evaluate``.
 
 :func:`evaluate` runs the covariance analysis of each case
 (:mod:`schuler.mission.covariance`; cases sharing every parameter are computed
@@ -6,7 +6,9 @@ once, the distinct cases of one duration, output step and vertical channel in
 one batch). With random streams (a Monte Carlo), each member also flies the
 nonlinear INS with its own draws (:mod:`schuler.mission.monte_carlo`) and
 reports its final horizontal position error; the nominal case (no random
-streams) draws nothing, so that error is 0.
+streams) draws nothing, so that error is 0. With ``histories=True`` the first
+case's budget comes in full: its 1-sigma histories and each source's variance
+(:func:`budget_histories`), the shares, the dominant source and the instrument.
 """
 
 from __future__ import annotations
@@ -15,15 +17,17 @@ import math
 
 import numpy as np
 
-from schuler.contract import Cases, Output
+from schuler.contract import Cases, Evaluation, Output
+from schuler.core.response import Histories
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.spec import GRADES
-from schuler.mission.covariance import CovarianceBudget, covariance_budget, covariance_budgets
+from schuler.mission.covariance import CovarianceBudget, covariance_budgets
 from schuler.mission.monte_carlo import final_horizontal_errors, run_members
-from schuler.mission.results import MissionResult
+from schuler.mission.plots import BUDGET_HISTORIES
 from schuler.mission.setup import (
     ALIGNMENTS,
     CALIBRATIONS,
+    SOURCES,
     TRAJECTORIES,
     VERTICAL_CHANNELS,
     error_model,
@@ -33,13 +37,9 @@ from schuler.navigate.mechanization import estimate_memory
 from schuler.params import Case, Parameter, ParameterSet
 
 PARAMETERS = ParameterSet((
-    Parameter("grade", "", "tactical", "IMU grade preset (schuler.imu presets with their data-sheet sources).",
-              choices=GRADES, kind="choice"),
-    Parameter("imu_spec", "", None, "IMU spec file (TOML, as schuler imu writes them); replaces the grade.",
-              kind="text"),
-    Parameter("instrument", "", None, "IMU: a grade, a TOML spec file or a recording (.csv, .imu, .parquet) whose "
-              "identified noise terms (Allan analysis) become the model; replaces grade and imu_spec.",
-              kind="text"),
+    Parameter("imu", "", "tactical", "IMU: a grade (" + ", ".join(GRADES) + "; schuler.imu presets with their "
+              "data-sheet sources), a TOML spec file (as schuler imu writes them) or a recording (.csv, .imu, "
+              ".parquet) whose identified noise terms (Allan analysis) become the model.", kind="text"),
     Parameter("latitude", "deg", 45.0, "Latitude of the start point.", minimum=-80, maximum=80),
     Parameter("longitude", "deg", 0.0, "Longitude of the start point.", minimum=-180, maximum=360),
     Parameter("height", "m", 0.0, "Height of the mission above the ellipsoid.", minimum=-500, maximum=20000),
@@ -59,8 +59,9 @@ PARAMETERS = ParameterSet((
     Parameter("gyrocompass_damping", "", 0.8, "Damping ratio of system 4's azimuth loop.", minimum=0.1, maximum=10),
     Parameter("north_reference_error", "arcsec", 10.0, "1-sigma heading error of the ground gyrocompass (system 5).",
               minimum=0, maximum=36000),
-    Parameter("trajectory", "", "cruise", "Mission: stationary, cruise (a geodesic at the speed) or flight "
-              "(take-off run, two 90-deg turns).", choices=TRAJECTORIES, kind="choice"),
+    Parameter("trajectory", "", "cruise", "Mission: stationary, cruise (a geodesic at the speed), flight "
+              "(take-off run, two 90-deg turns) or drive (a car's: four stops, 10 m/s in town, 20 m/s on the road, "
+              "90-deg turns; its own speeds).", choices=TRAJECTORIES, kind="choice"),
     Parameter("profile", "", None, "Waypoint profile FILE.toml (format: schuler.navigate.profile) flown instead of "
               "the trajectory; its [start] and first heading set the start point and heading.", kind="text"),
     Parameter("duration", "s", 7200.0, "Mission duration (after the alignment).", minimum=60, maximum=10 * 86400),
@@ -74,9 +75,9 @@ PARAMETERS = ParameterSet((
               minimum=0, maximum=1e5),
     Parameter("imu_rate", "Hz", 2.0, "IMU rate of the Monte Carlo's nonlinear INS (reduced: exact for the "
               "noise, ample for the smooth trajectories).", minimum=0.1, maximum=1000),
-), owner="mission", exclusive=(("grade", "instrument"), ("imu_spec", "instrument"),
-                                *(("profile", name) for name in ("trajectory", "latitude", "longitude", "height",
-                                                                 "heading", "speed"))))
+), owner="mission", exclusive=tuple(("profile", name) for name in ("trajectory", "latitude", "longitude", "height",
+                                                                   "heading", "speed")),
+   renamed={"grade": "imu", "imu_spec": "imu", "instrument": "imu"})
 """Every option of ``schuler mission run`` (and key of a ``mission`` scenario)."""
 
 OUTPUTS = (
@@ -134,7 +135,44 @@ def _values(cases: Cases, i: int) -> dict:
     return {name: case[name] for name in PARAMETERS.names}
 
 
-def evaluate(cases: Cases) -> dict[str, np.ndarray]:
+def budget_histories(budget: CovarianceBudget) -> Histories:
+    """The budget over time: the 1-sigma errors and each source's horizontal position variance.
+
+    Parameters
+    ----------
+    budget : CovarianceBudget
+        The mission's covariance analysis (SI).
+
+    Returns
+    -------
+    Histories
+        Over ``t_s``: ``position_error_sigma_m`` (horizontal), ``velocity_error_sigma_m_s`` (horizontal),
+        ``heading_error_sigma_rad`` and ``variance_<source>_m2`` for every source, in budget order.
+    """
+    channels = {"position_error_sigma_m": budget.sigma("horizontal_position"),
+                "velocity_error_sigma_m_s": budget.sigma("horizontal_velocity"),
+                "heading_error_sigma_rad": budget.sigma("heading")}
+    units = {"position_error_sigma_m": "m", "velocity_error_sigma_m_s": "m/s", "heading_error_sigma_rad": "rad"}
+    horizontal = budget.horizontal()
+    for i, name in enumerate(budget.sources):
+        channels[f"variance_{name}_m2"] = horizontal[:, i]
+        units[f"variance_{name}_m2"] = "m^2"
+    return Histories(np.asarray(budget.time, dtype=float), channels, units)
+
+
+def _in_full(budget: CovarianceBudget, model: ErrorModel) -> tuple[dict, dict]:
+    """The first case's budget in full: histories and JSON-safe extras."""
+    shares = budget.shares()
+    extras = {"budget": shares, "dominant_source": max(shares, key=lambda name: shares[name]),
+              "instrument": model.name}
+    return {BUDGET_HISTORIES: budget_histories(budget)}, extras
+
+
+EXTRA_UNITS = {"budget": "1", **{name: "1" for name in SOURCES}}
+"""Units of the extras (the budget's keys are source names whose values are shares; the map is flat by key)."""
+
+
+def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
 
     The covariance analysis runs once per distinct case, and the distinct cases of one duration, output step
@@ -146,67 +184,52 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     cases : Cases
         A batch of validated cases (SI values); with ``cases.random`` set, member ``cases.members[i]`` also flies
         the nonlinear INS with its own draws.
+    histories : bool
+        Also the first case in full (an :class:`~schuler.contract.Evaluation`): the budget's histories
+        ``mission_budget`` (:func:`budget_histories`: sigmas in m, m/s, rad, variances in m^2 over ``t_s``),
+        ``budget`` (each source's share of the final horizontal position variance, summing to 1),
+        ``dominant_source`` and ``instrument`` (the IMU's name).
 
     Returns
     -------
-    dict of str to ndarray
+    dict of str to ndarray, or Evaluation
         Output name -> values of shape (number of cases,), SI (``member_position_error_m`` 0 without random
         streams).
+
+    Examples
+    --------
+    >>> run = evaluate(Cases.from_case(PARAMETERS.case(imu="navigation", trajectory="stationary",
+    ...                                                duration=3600.0)), histories=True)
+    >>> round(sum(run.extras["budget"].values()), 9), run.extras["dominant_source"] in run.extras["budget"]
+    (1.0, True)
     """
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     out["member_position_error_m"] = np.zeros(n)
-    models: dict[tuple, ErrorModel] = {}
+    models: dict[str, ErrorModel] = {}
+    first: tuple[dict, dict] = ({}, {})
     for shape_index, shape_group in cases.groups(*_SHAPE_KEYS):
         distinct = list(shape_group.groups(*_BUDGET_KEYS))
         setups = []
         for _, group in distinct:
             values = _values(group, 0)
-            key = (values["grade"], values["imu_spec"], values["instrument"])
-            if key not in models:
-                models[key] = error_model(*key)
-            setups.append(mission_setup(values, model=models[key]))
+            if values["imu"] not in models:
+                models[values["imu"]] = error_model(values["imu"])
+            setups.append(mission_setup(values, model=models[values["imu"]]))
         for (index, group), setup, budget in zip(distinct, setups, covariance_budgets(setups)):
             rows = shape_index[index]
             for name, value in budget_outputs(budget).items():
                 out[name][rows] = value
+            if histories and rows[0] == 0:
+                first = _in_full(budget, setup.error_model)
             if cases.random is not None:
                 for rate_index, members in group.groups("imu_rate"):
                     rate = float(members.float("imu_rate")[0])
                     result = run_members(setup, members.members, cases.random, rate, output_step=setup.duration)
                     out["member_position_error_m"][rows[rate_index]] = final_horizontal_errors(result)
-    return out
-
-
-def run_case(case: Case, fidelity: str | None = None) -> MissionResult:
-    """One mission in full: the covariance outputs, the budget's shares and its histories.
-
-    Parameters
-    ----------
-    case : Case
-        Every parameter of :data:`PARAMETERS`, SI.
-    fidelity : str or None
-        The contract's evaluation fidelity; this system has a single way of evaluating, so it is not used.
-
-    Returns
-    -------
-    MissionResult
-        The outputs (SI), each source's share of the final horizontal position variance, the dominant source,
-        the instrument's name and the budget's histories.
-
-    Examples
-    --------
-    >>> r = run_case(PARAMETERS.case(grade="navigation", trajectory="stationary", duration=3600.0))
-    >>> round(sum(r.budget.values()), 9), r.dominant_source in r.budget
-    (1.0, True)
-    """
-    setup = mission_setup({name: case[name] for name in PARAMETERS.names})
-    budget = covariance_budget(setup)
-    outputs = budget_outputs(budget)
-    shares = budget.shares()
-    return MissionResult(**outputs, member_position_error_m=0.0, budget=shares,
-                         dominant_source=max(shares, key=lambda name: shares[name]),
-                         instrument=setup.error_model.name, history=budget, monte_carlo=None)
+    if not histories:
+        return out
+    return Evaluation(out, histories=first[0], extras=first[1], units=EXTRA_UNITS)
 
 
 def member_bytes(case: Case) -> int:
@@ -227,4 +250,5 @@ def member_bytes(case: Case) -> int:
     return int(estimate_memory(1, 2, 4096, True)) + 64 * 1024
 
 
-__all__ = ["OUTPUTS", "PARAMETERS", "budget_outputs", "evaluate", "member_bytes", "run_case"]
+__all__ = ["OUTPUTS", "PARAMETERS", "budget_histories", "budget_outputs", "evaluate",
+           "member_bytes"]

@@ -1,24 +1,28 @@
-"""Figures of the mission study: the error budget stacked over time."""
+"""Figures of the mission study: the error budget stacked over time (the ``figures`` hook of ``SYSTEM``)."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from schuler.mission.covariance import CovarianceBudget
+from schuler.core.response import Histories
 
 SHOWN_SOURCES = 8
 """Sources drawn separately in the stacked plot (the rest are summed as "others")."""
 
+BUDGET_HISTORIES = "mission_budget"
+"""Stem of the budget's histories (``mission_budget.csv``) and of its figure."""
 
-def stacked_budget(budget: CovarianceBudget):
+_PREFIX, _SUFFIX = "variance_", "_m2"
+
+
+def stacked_budget(histories: Histories):
     """Horizontal position-error variance over time, stacked by source (largest final shares first).
 
     Parameters
     ----------
-    budget : CovarianceBudget
-        The mission's covariance analysis (variances in m^2, times in s; drawn in km^2 over hours).
+    histories : Histories
+        The budget's histories (:func:`~schuler.mission.evaluation.budget_histories`): each source's
+        ``variance_<source>_m2`` in m^2 over ``t_s`` in s (drawn in km^2 over hours).
 
     Returns
     -------
@@ -27,16 +31,18 @@ def stacked_budget(budget: CovarianceBudget):
     """
     import matplotlib.pyplot as plt
 
-    horizontal = budget.horizontal()
+    names = [name for name in histories.names if name.startswith(_PREFIX) and name.endswith(_SUFFIX)]
+    sources = [name[len(_PREFIX):-len(_SUFFIX)] for name in names]
+    horizontal = np.stack([np.asarray(histories[name], dtype=float) for name in names], axis=1)
     order = np.argsort(-horizontal[-1])
     shown = [i for i in order[:SHOWN_SOURCES] if horizontal[-1, i] > 0]
     rest = [i for i in order if i not in shown]
     layers = [horizontal[:, i] for i in shown]
-    labels = [budget.sources[i] for i in shown]
+    labels = [sources[i] for i in shown]
     if rest and np.any(horizontal[:, rest]):
         layers.append(horizontal[:, rest].sum(axis=1))
         labels.append("others")
-    hours = budget.time / 3600.0
+    hours = np.asarray(histories.time, dtype=float) / 3600.0
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
     total = horizontal.sum(axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -53,26 +59,16 @@ def stacked_budget(budget: CovarianceBudget):
     return fig
 
 
-def write_figures(figures: dict, out_dir, formats=("png", "svg")) -> list[Path]:
-    """Save figures (stem -> Figure) into ``out_dir`` in ``formats``; returns the paths.
+def figures(result) -> dict:
+    """The figures of a mission result: the stacked budget of a run (``{}`` for results without histories).
 
     Parameters
     ----------
-    figures : dict of str to matplotlib.figure.Figure
-        File stem -> figure.
-    out_dir : str or Path
-        Folder to write into.
-    formats : tuple of str
-        File formats (suffixes without the dot), e.g. ``("png", "svg")``.
-
-    Returns
-    -------
-    list of Path
-        The files written.
+    result : Result
+        What a ``mission`` command returned (a run's :class:`~schuler.mission.results.MissionResult`, or the
+        reproduction, which draws none).
     """
-    from schuler.io import save_figure_formats
-
-    paths: list[Path] = []
-    for stem, fig in figures.items():
-        paths += save_figure_formats(fig, Path(out_dir) / stem, formats)
-    return paths
+    histories = getattr(result, "histories", {})
+    if BUDGET_HISTORIES not in histories:
+        return {}
+    return {BUDGET_HISTORIES: stacked_budget(histories[BUDGET_HISTORIES])}

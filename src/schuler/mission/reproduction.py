@@ -19,10 +19,10 @@ import numpy as np
 from schuler.contract import FigureRef, ReportSection
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.gyrocompassing.analytic import gains_from_design
-from schuler.imu.error_model import ErrorModel, SensorErrors
+from schuler.io import save_figure_formats
 from schuler.mission import plots
 from schuler.mission.covariance import covariance_budget
-from schuler.mission.evaluation import PARAMETERS
+from schuler.mission.evaluation import PARAMETERS, budget_histories
 from schuler.mission.setup import CONSTANT_SOURCES, mission_setup
 from schuler.mission.stages import initial_state_map
 from schuler.references import GROVES_2013, KPI_LAB_MANUAL
@@ -40,11 +40,6 @@ SOURCE = f"{GROVES_2013.citation}; {KPI_LAB_MANUAL.citation}"
 def _setup(**values):
     case = PARAMETERS.case(values)
     return mission_setup({name: case[name] for name in PARAMETERS.names})
-
-
-def _single_source_model(gyro_y: float = 0.0, accel_x: float = 0.0) -> ErrorModel:
-    return ErrorModel(gyro=SensorErrors(bias=np.array([0.0, gyro_y, 0.0])),
-                      accel=SensorErrors(bias=np.array([accel_x, 0.0, 0.0])), name="worked example")
 
 
 def reproduce() -> Reproduction:
@@ -83,7 +78,7 @@ def reproduce() -> Reproduction:
         "levelling tilt psi_E from a 100 ug north accelerometer bias", to_unit(tilt, "arcsec"), "arcsec",
         printed="-b_N / g", value=float(to_unit(-EXAMPLE_ACCEL / STANDARD_GRAVITY, "arcsec")),
         where="Groves (2013), Sec. 5.6.1", tolerance=Tolerance(relative=1e-9)))
-    mission = _setup(grade="tactical", trajectory="cruise", duration=7200.0)
+    mission = _setup(imu="tactical", trajectory="cruise", duration=7200.0)
     budget = covariance_budget(mission)
     shares = budget.shares()
     rows.append(compare("sum of the shares of the final horizontal position variance", sum(shares.values()), "1",
@@ -115,8 +110,8 @@ def report(figures_dir: Path) -> ReportSection:
         The report's section: the reproduction's rows, the budget figure with its caption, commands and notes.
     """
     reproduction = reproduce()
-    files = plots.write_figures({"mission_budget": plots.stacked_budget(reproduction.data)}, figures_dir,
-                                formats=("png",))
+    files = save_figure_formats(plots.stacked_budget(budget_histories(reproduction.data)),
+                                Path(figures_dir) / plots.BUDGET_HISTORIES, ("png",))
     shares = reproduction.data.shares()
     dominant = max(shares, key=lambda name: shares[name])
     return ReportSection(
@@ -134,7 +129,7 @@ def report(figures_dir: Path) -> ReportSection:
                  for path in files],
         commands=["schuler mission reproduce",
                   "schuler run examples/mission_tactical.toml --json",
-                  "schuler mission run --grade navigation --trajectory flight --monte-carlo 1000 --out mission",
+                  "schuler mission run --imu navigation --trajectory flight --monte-carlo 1000 --out mission",
                   "schuler sweep examples/mission_tactical.toml --param alignment_duration=300,900,1800"],
         notes=[*reproduction.notes, "budget of the tactical 2-h cruise (share of the final horizontal position "
                "variance): " + ", ".join(f"{name} {100 * shares[name]:.1f} %" for name in

@@ -1,31 +1,28 @@
-"""What ``schuler mission run`` returns and writes: :class:`MissionResult` and :func:`write_files`."""
+"""What ``schuler mission run`` returns: :class:`MissionResult`, the one result rendered as a budget."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any, ClassVar
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from schuler.mission.covariance import CovarianceBudget
-from schuler.mission.setup import SOURCES
-from schuler.reproduction import Reproduction
-from schuler.results import Result, RunResult
+from schuler.results import SystemResult
 from schuler.units import to_unit
 
 
-@dataclass
-class MissionResult(RunResult):
+@dataclass(kw_only=True)
+class MissionResult(SystemResult):
     """One mission: the covariance analysis's final 1-sigma errors and the error budget (SI).
 
-    ``budget`` maps every source to its share of the final horizontal
-    position-error variance (the shares sum to 1); ``history`` holds every
-    source's contribution at every output step (not in ``to_dict``; written by
-    :func:`write_files`). The top-level 1-sigma values are the covariance at the
-    nominal case. With a Monte Carlo, ``to_dict()["monte_carlo"]`` also holds the
-    comparison of like with like, in m:
+    The outputs (``position_error_sigma_m`` ...) read as attributes; the extras
+    ``budget`` (every source's share of the final horizontal position-error
+    variance, the shares sum to 1), ``dominant_source`` and ``instrument`` too;
+    ``histories["mission_budget"]`` holds the 1-sigma errors and every source's
+    variance at every output step (``mission_budget.csv``). The top-level
+    1-sigma values are the covariance at the nominal case. With a Monte Carlo,
+    ``to_dict()["monte_carlo"]`` also holds the comparison of like with like, in m:
 
     * ``position_error_sigma_m``: the root mean square of the members' final
       horizontal position errors (nonlinear INS);
@@ -38,23 +35,6 @@ class MissionResult(RunResult):
     * ``nominal_covariance_position_error_sigma_m``: the covariance at the
       nominal case (the top-level ``position_error_sigma_m``).
     """
-
-    position_error_sigma_m: float
-    position_error_north_sigma_m: float
-    position_error_east_sigma_m: float
-    velocity_error_sigma_m_s: float
-    heading_error_sigma_rad: float
-    initial_heading_error_sigma_rad: float
-    initial_tilt_sigma_rad: float
-    dominant_share: float
-    member_position_error_m: float
-    budget: dict[str, float]
-    dominant_source: str
-    instrument: str
-    history: CovarianceBudget | None = field(default=None, repr=False)
-
-    # the budget's keys are source names whose values are shares (the units map is flat by key)
-    units: ClassVar[dict[str, str]] = {"dominant_share": "1", "budget": "1", **{name: "1" for name in SOURCES}}
 
     def to_dict(self) -> dict[str, Any]:
         data = super().to_dict()
@@ -127,44 +107,3 @@ class MissionResult(RunResult):
                 shares.add_row(name, f"{100 * share:.2f} %")
         return Group(table, shares)
 
-
-def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """The stacked budget plot (PNG, SVG) and the budget's histories (CSV) of a run.
-
-    Parameters
-    ----------
-    result : Result
-        What a ``mission`` command returned: a :class:`MissionResult` (files when it holds its history) or a
-        reproduction (no files).
-    out_dir : Path
-        Folder to write into.
-
-    Returns
-    -------
-    list of Path
-        The files written: ``mission_budget.png``, ``.svg`` and ``.csv`` (sigmas in m, m/s, rad and each
-        source's horizontal variance in m^2 over ``t_s``).
-    """
-    import pandas as pd
-
-    from schuler.io import write_dataframe_csv
-    from schuler.mission import plots
-
-    out_dir = Path(out_dir)
-    if isinstance(result, Reproduction):
-        return []
-    if not isinstance(result, MissionResult):
-        raise TypeError(f"mission writes no files for {type(result).__name__}")
-    if result.history is None:
-        return []
-    history = result.history
-    files = plots.write_figures({"mission_budget": plots.stacked_budget(history)}, out_dir)
-    columns: dict[str, Any] = {"t_s": history.time,
-                               "position_error_sigma_m": history.sigma("horizontal_position"),
-                               "velocity_error_sigma_m_s": history.sigma("horizontal_velocity"),
-                               "heading_error_sigma_rad": history.sigma("heading")}
-    horizontal = history.horizontal()
-    for i, name in enumerate(history.sources):
-        columns[f"variance_{name}_m2"] = horizontal[:, i]
-    files.append(write_dataframe_csv(pd.DataFrame(columns), out_dir / "mission_budget.csv"))
-    return files

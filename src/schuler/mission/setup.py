@@ -5,8 +5,8 @@ right / z down, errors = computed - true, sensor bias = measured - true, SI.
 
 The life of the instrument, in the order the stages happen:
 
-0. **The instrument**: a grade's preset, a spec file, or a recording's
-   identified noise terms (:func:`error_model`).
+0. **The instrument** (``imu``): a grade's preset, a spec file, or a
+   recording's identified noise terms (:func:`error_model`).
 
 1. **Calibration** leaves a residual gyro bias per axis (and, for the
    multi-position method, residual accelerometer biases and scale factors):
@@ -57,8 +57,8 @@ from schuler.core.earth import STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.instrument import resolve_model
-from schuler.imu.spec import load_spec_file, preset
 from schuler.imu.system_inputs import residual_bias
+from schuler.navigate.drive import drive
 from schuler.navigate.profile import load_profile
 from schuler.navigate.trajectory import GreatCircle, Stationary, WaypointProfile
 
@@ -66,7 +66,7 @@ CALIBRATIONS = ("pulse", "multi-position")
 ALIGNMENTS = ("kalman", "strapdown-gyrocompass", "gyrocompass", "ground-gyrocompass")
 SELF_ALIGNMENTS = ("kalman", "strapdown-gyrocompass")
 """Strapdown self-alignments at rest: to first order, the same residuals (:mod:`schuler.mission.stages`)."""
-TRAJECTORIES = ("stationary", "cruise", "flight")
+TRAJECTORIES = ("stationary", "cruise", "flight", "drive")
 VERTICAL_CHANNELS = ("off", "free")
 
 AXES = ("x", "y", "z")
@@ -126,7 +126,9 @@ class MissionSetup:
         the speed and height from the start. ``flight``: at rest at t = 0, a
         take-off run to the speed over 300 s, a 90-deg right turn at 35 % and a
         90-deg left turn at 70 % of the mission (120 s each), level at the height.
-        ``profile``: the waypoint profile file's (:mod:`schuler.navigate.profile`;
+        ``drive``: a car's drive over the duration (:func:`schuler.navigate.drive.drive`: four stops, 10 m/s in
+        town, 20 m/s on the road, 90-deg turns, no banking) from the start point and heading; the speed is not
+        used. ``profile``: the waypoint profile file's (:mod:`schuler.navigate.profile`;
         after its last waypoint it holds that waypoint's values).
         """
         if self.profile is not None:
@@ -137,6 +139,9 @@ class MissionSetup:
         if self.trajectory_kind == "cruise":
             return GreatCircle(latitude=self.latitude, longitude=self.longitude, height=self.height,
                                heading=self.heading, speed=self.speed, duration=self.duration)
+        if self.trajectory_kind == "drive":
+            return drive(latitude=self.latitude, longitude=self.longitude, height=self.height, heading=self.heading,
+                         duration=self.duration)
         d = self.duration
         shortest = 4 * (FLIGHT_ACCELERATION_TIME + FLIGHT_TURN_TIME)
         if d < shortest:
@@ -201,48 +206,41 @@ class MissionSetup:
         return np.asarray(self.error_model.accel.random_walk, dtype=float)
 
 
-def error_model(grade: str, imu_spec: str | None, instrument: str | None = None) -> ErrorModel:
-    """The instrument's error model.
+def error_model(imu: str) -> ErrorModel:
+    """The instrument's error model from ``imu``: a grade, a TOML spec file or a recording.
 
-    ``instrument`` (a grade, a TOML spec file or a recording .csv, .imu,
-    .parquet) when given: a recording's identified noise terms become the model
-    (:func:`~schuler.imu.instrument.resolve_model`, the resolution ``--imu``
-    uses: Allan analysis then :func:`~schuler.imu.characterise.model_from_analysis`).
+    A recording (.csv, .imu, .parquet) gives its identified noise terms
+    (:func:`~schuler.imu.instrument.resolve_model`, the resolution every system's
+    ``imu`` uses: Allan analysis then :func:`~schuler.imu.characterise.model_from_analysis`).
     An Allan curve shows noise only, so such a model has no turn-on biases nor
     scale-factor errors: what calibration leaves of it is the noise floor and
-    the slow terms' change. Else ``imu_spec`` (a TOML spec file), else the
-    grade's preset.
+    the slow terms' change.
 
     Parameters
     ----------
-    grade : str
-        Grade preset, one of :data:`~schuler.imu.spec.GRADES`.
-    imu_spec : str or None
-        Path of a TOML spec file; replaces the grade.
-    instrument : str, optional
-        A grade, a TOML spec file or a recording (``.csv``, ``.imu``, ``.parquet``); replaces both.
+    imu : str
+        A grade (:data:`~schuler.imu.spec.GRADES`), a TOML spec file or a recording (``.csv``, ``.imu``,
+        ``.parquet``); its errors are SI.
 
     Returns
     -------
     ErrorModel
         The instrument's errors, SI.
+
+    Raises
+    ------
+    InvalidParameter
+        ``imu`` names neither a grade nor an existing file (named ``imu``).
     """
-    if instrument:
-        path = Path(instrument)
-        # a recording is analysed once per process and file version (sweep chunks and Monte Carlo batches reuse it)
-        stamp = (path.stat().st_mtime_ns, path.stat().st_size) if path.is_file() else None
-        return _resolved(str(instrument), stamp)
-    if imu_spec:
-        return load_spec_file(imu_spec)
-    return preset(grade)
+    path = Path(imu)
+    # a recording is analysed once per process and file version (sweep chunks and Monte Carlo batches reuse it)
+    stamp = (path.stat().st_mtime_ns, path.stat().st_size) if path.is_file() else None
+    return _resolved(str(imu), stamp)
 
 
 @lru_cache(maxsize=8)
-def _resolved(instrument: str, stamp: tuple[int, int] | None) -> ErrorModel:
-    try:
-        return resolve_model(instrument)
-    except InvalidParameter as error:
-        raise InvalidParameter("instrument", error.reason) from None
+def _resolved(imu: str, stamp: tuple[int, int] | None) -> ErrorModel:
+    return resolve_model(imu)
 
 
 def mission_setup(values, model: ErrorModel | None = None) -> MissionSetup:
@@ -259,7 +257,7 @@ def mission_setup(values, model: ErrorModel | None = None) -> MissionSetup:
         ratio; ``north_reference_error`` in rad; ``initial_position_error`` in m), choices and paths as text.
     model : ErrorModel, optional
         The instrument's error model when the caller has resolved it already (a batch of cases of one
-        instrument); not given: resolved from ``grade``, ``imu_spec`` and ``instrument``.
+        instrument); not given: resolved from ``imu``.
 
     Returns
     -------
@@ -276,8 +274,7 @@ def mission_setup(values, model: ErrorModel | None = None) -> MissionSetup:
         start = {name: float(values[name]) for name in ("latitude", "longitude", "height", "heading")}
         kind = str(values["trajectory"])
     return MissionSetup(
-        error_model=model if model is not None else error_model(values["grade"], values["imu_spec"],
-                                                                values["instrument"]),
+        error_model=model if model is not None else error_model(values["imu"]),
         calibration=str(values["calibration"]), calibration_duration=float(values["calibration_duration"]),
         pulse_relative_error=float(values["pulse_relative_error"]),
         alignment=str(values["alignment"]), alignment_duration=float(values["alignment_duration"]),

@@ -54,6 +54,9 @@ def first_problem(error: ValidationError, model: type[BaseModel], system: System
     where = " ".join(part for part in (table, _short(key)) if part)
     kind = problem["type"]
     if kind == "extra_forbidden":
+        renamed = system.parameters.renamed.get(key)
+        if renamed is not None:  # a former name (scripts written for an older version) says what it became
+            return f"{where}: renamed to {renamed!r} (see CHANGELOG.md)"
         allowed = _allowed_keys(model, location[:-1])
         hint = difflib.get_close_matches(key, allowed, n=1) if len(key) <= 100 else []
         suggestion = f"did you mean {hint[0]!r}? " if hint else ""
