@@ -40,6 +40,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -289,8 +290,8 @@ def _trajectory(name: str, case: Case) -> tuple[object, float]:
             "stationary is at rest)" if name == "stationary" else "the drive sets its own: --city-speed, "
             "--road-speed, --turn-speed)"))
     defaults = DRIVE_START if name == "drive" else {"latitude": DEFAULT_LATITUDE, "longitude": 0.0, "height": 0.0}
-    start = {key: defaults.get(key, 0.0) if case[key] is None else case[key]
-             for key in ("latitude", "longitude", "height", "heading")}
+    start: dict[str, Any] = {key: defaults.get(key, 0.0) if case[key] is None else case[key]
+                             for key in ("latitude", "longitude", "height", "heading")}
     if name == "drive":
         path = drive(**start, **{key: case[key] for key in (*DRIVE_OPTIONS, "duration") if case[key] is not None})
         return path, path.duration

@@ -226,7 +226,7 @@ def figures(result: Result) -> dict[str, Any]:
         return {"navigate_gyrocompassing": plots.plot_gyrocompassing(data["gyrocompassing"]),
                 "navigate_bollay": plots.plot_bollay(data["bollay"]),
                 "navigate_drozdovich": plots.plot_drozdovich(data["drozdovich"])}
-    if HISTORIES not in getattr(result, "histories", {}):
+    if not isinstance(result, NavigateResult) or HISTORIES not in result.histories:
         return {}
     drawn = {HISTORIES: plots.plot_errors(result.histories[HISTORIES], result.mode)}
     if result.monte_carlo is not None:
@@ -256,6 +256,6 @@ def data_files(result: Result, out_dir: Path) -> list[Path]:
 
     if not isinstance(result, Reproduction):
         return []
-    data = result.data
-    return [write_dataframe_csv(pd.DataFrame(data["gyrocompassing_table"]), Path(out_dir) / "navigate_gyrocompassing.csv"),
-            write_dataframe_csv(pd.DataFrame(data["bollay"].summary()), Path(out_dir) / "navigate_bollay.csv")]
+    data, out_dir = result.data, Path(out_dir)
+    return [write_dataframe_csv(pd.DataFrame(data["gyrocompassing_table"]), out_dir / "navigate_gyrocompassing.csv"),
+            write_dataframe_csv(pd.DataFrame(data["bollay"].summary()), out_dir / "navigate_bollay.csv")]
