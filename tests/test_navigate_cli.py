@@ -7,6 +7,7 @@ import math
 import pandas as pd
 import pytest
 
+from schuler.navigate.channels import ERROR_CHANNELS
 from schuler.study.scenario import parse_scenario
 from schuler.study.sweep import run_sweep
 
@@ -37,6 +38,41 @@ def test_run_json_has_the_issue_names(run_cli):
     assert len(free["height_error_m"]) == 11 and len(free["velocity_error_down_m_s"]) == 11
     # 1e-5 g down: the free channel diverges (g/R-unstable), faster than the 0.5 b t^2 of a flat Earth
     assert free["height_error_m"][-1] < -0.5 * 1e-5 * 9.80665 * 600**2
+
+
+MAIN_KEYS = sorted([
+    "schuler_version", "inputs", "trajectory", "mode", "vertical_channel", "imu", "duration_s", "imu_rate_hz",
+    "output_step_s", "warnings", *(f"{kind}_{channel}" for channel in ERROR_CHANNELS for kind in ("final", "max_abs")),
+    "final_horizontal_position_error_m", "max_horizontal_position_error_m", "t_s", "position_error_north_m",
+    "position_error_east_m", "velocity_error_north_m_s", "velocity_error_east_m_s", "roll_error_rad",
+    "pitch_error_rad", "heading_error_rad", "monte_carlo", "units", "files"])
+"""The top-level keys of ``navigate run --json --out DIR`` on the light case, recorded before the system moved to
+the one evaluation (a documented script contract: ``t_s`` and the histories at the top level)."""
+
+
+def test_the_light_case_keeps_its_json_keys_files_and_columns(run_cli, tmp_path):
+    from schuler import get_system
+    from test_contract import light
+
+    parameters = get_system("navigate").parameters
+    args = [text for key, value in light("navigate").items()
+            for text in (parameters[key].option, f"{value!r} {parameters[key].si_unit}")]
+    out = run_cli("navigate", "run", *args, "--json", "--out", tmp_path)
+    assert out.code == 0, out.stderr
+    data = out.json()
+    assert sorted(data) == MAIN_KEYS
+    # the units of before, and now the outputs' too
+    before = {"imu_rate_hz": "Hz", "t_s": "s", "position_error_north_m": "m", "velocity_error_east_m_s": "m/s",
+              "heading_error_rad": "rad"}
+    assert {name: data["units"][name] for name in before} == before
+    assert data["units"]["final_position_error_north_m"] == "m"
+    written = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
+    assert written == ["navigate_errors.csv", "navigate_errors.png", "navigate_errors.svg"]
+    table = pd.read_csv(tmp_path / "navigate_errors.csv")
+    assert list(table.columns) == list(ARRAYS)
+    assert table["position_error_north_m"].tolist() == pytest.approx(data["position_error_north_m"], rel=1e-12)
+    # 0.1 m/s north at rest at 45 deg: (dV / w_s) sin(w_s t), 54.6 m after 10 min (as on main: 54.572255355756)
+    assert data["final_position_error_north_m"] == pytest.approx(54.572255355756, rel=1e-12)
 
 
 def test_human_output_and_help(run_cli):

@@ -28,14 +28,14 @@ def close_figures():
 def test_error_panels_single_and_batch():
     single = navigate(Stationary(latitude=0.8), 600.0, imu_rate=10.0, output_step=60.0,
                       initial_errors=InitialErrors(velocity_error_north=0.1))
-    fig = plots.plot_errors(single)
+    fig = plots.plot_errors(single.histories(), single.mode)
     visible = [axis for axis in fig.axes if axis.get_visible()]
     assert len(visible) == 7  # the vertical channel is off: no height or vertical-velocity panel
     line = visible[0].lines[0]
     np.testing.assert_allclose(line.get_ydata(), single.position_error_north_m)
     batch = navigate(Stationary(latitude=0.8), 600.0, imu_rate=10.0, output_step=60.0, vertical_channel="free",
                      initial_errors=InitialErrors(velocity_error_north=[0.1, 0.2, 0.3]))
-    fig = plots.plot_errors(batch)
+    fig = plots.plot_errors(batch.histories(), batch.mode)
     assert len([axis for axis in fig.axes if axis.get_visible()]) == 9
     np.testing.assert_allclose(fig.axes[0].lines[0].get_ydata(), batch.position_error_north_m.mean(axis=0))
 

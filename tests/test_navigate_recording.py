@@ -1,4 +1,4 @@
-"""``navigate run --imu RECORD``: a recorded IMU file replayed as a static vehicle against a stationary truth."""
+"""``navigate run --record FILE``: a recorded IMU file replayed as a static vehicle against a stationary truth."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.files import read_record, write_record
 from schuler.imu.record import ImuRecord
@@ -38,7 +39,7 @@ def _record(model, path: Path, seed: int = 11) -> Path:
 
 def test_replay_equals_the_library_on_the_same_samples(run_cli, tmp_path):
     path = _record(preset("tactical"), tmp_path)
-    out = run_cli("navigate", "run", "--imu", path, *SITE, "--json")
+    out = run_cli("navigate", "run", "--record", path, *SITE, "--json")
     assert out.code == 0, out.stderr
     data = out.json()
     assert data["t_s"][-1] == 90.0 and len(data["t_s"]) == 10
@@ -51,7 +52,8 @@ def test_replay_equals_the_library_on_the_same_samples(run_cli, tmp_path):
                                    err_msg=channel)
     # tactical grade (1 deg/h, 1 mg at +1 sigma and its noise) moves the INS by metres in 90 s, not nanometres
     assert 1.0 < data["max_horizontal_position_error_m"] < 1e3
-    assert data["inputs"]["imu"] == str(path)
+    assert data["inputs"]["record"] == str(path) and data["inputs"]["imu"] is None
+    assert data["imu"] == "recording static.csv (static)"
 
 
 def test_a_constant_bias_record_replays_as_the_synthetic_bias(tmp_path):
@@ -75,7 +77,7 @@ def test_a_constant_bias_record_replays_as_the_synthetic_bias(tmp_path):
 
 def test_an_ideal_record_navigates_at_the_numerical_floor(run_cli, tmp_path):
     path = _record(ErrorModel(), tmp_path)
-    data = run_cli("navigate", "run", "--imu", path, *SITE, "--json").json()
+    data = run_cli("navigate", "run", "--record", path, *SITE, "--json").json()
     # floor: double rounding of Omega dt ~ 1e-6 rad and g dt ~ 0.2 m/s per sample over 4500 samples
     assert data["max_horizontal_position_error_m"] < 1e-6
     assert data["max_abs_velocity_error_north_m_s"] < 1e-8 and data["max_abs_velocity_error_east_m_s"] < 1e-8
@@ -89,10 +91,11 @@ def test_an_ideal_record_navigates_at_the_numerical_floor(run_cli, tmp_path):
     (("--imu-rate", "100"), "--imu-rate", "differs from the recording's 50 Hz"),
     (("--trajectory", "great-circle"), "--trajectory", "static vehicle"),
     (("--mode", "platform"), "--mode", "strapdown"),
+    (("--imu", "tactical"), "--record", "leave imu out"),
 ])
 def test_refusals_are_one_line(run_cli, tmp_path, options, name, words):
     path = _record(ErrorModel(), tmp_path)
-    out = run_cli("navigate", "run", "--imu", path, *SITE, *options)
+    out = run_cli("navigate", "run", "--record", path, *SITE, *options)
     assert out.code == 2, out.stdout
     assert out.stderr.startswith(f"schuler: error: {name}:") and words in out.stderr, out.stderr
     assert len(out.stderr.strip().splitlines()) == 1
@@ -100,12 +103,23 @@ def test_refusals_are_one_line(run_cli, tmp_path, options, name, words):
 
 def test_a_csv_record_needs_its_site(run_cli, tmp_path):
     path = _record(ErrorModel(), tmp_path)
-    out = run_cli("navigate", "run", "--imu", path, "--heading", "30")
-    assert out.code == 2 and out.stderr.startswith("schuler: error: --imu:") and "--latitude" in out.stderr
-    out = run_cli("navigate", "run", "--imu", path, "--latitude", "45")
-    assert out.code == 2 and out.stderr.startswith("schuler: error: --imu:") and "--heading" in out.stderr
-    shorter = run_cli("navigate", "run", "--imu", path, *SITE, "--duration", "30", "--json").json()
+    out = run_cli("navigate", "run", "--record", path, "--heading", "30")
+    assert out.code == 2 and out.stderr.startswith("schuler: error: --record:") and "--latitude" in out.stderr
+    out = run_cli("navigate", "run", "--record", path, "--latitude", "45")
+    assert out.code == 2 and out.stderr.startswith("schuler: error: --record:") and "--heading" in out.stderr
+    shorter = run_cli("navigate", "run", "--record", path, *SITE, "--duration", "30", "--json").json()
     assert shorter["t_s"][-1] == 30.0
+
+
+def test_a_recording_given_as_imu_is_refused_naming_record(run_cli, tmp_path):
+    path = _record(ErrorModel(), tmp_path)
+    out = run_cli("navigate", "run", "--imu", path, *SITE)
+    assert out.code == 2 and len(out.stderr.strip().splitlines()) == 1
+    assert out.stderr.startswith("schuler: error: --imu: static.csv is a recording: replay it with record "
+                                 "(--record FILE)"), out.stderr
+    # by its suffix too, before looking for the file
+    with pytest.raises(InvalidParameter, match="imu: lasergyro.imu is a recording: replay it with record"):
+        SYSTEM.run(imu="lasergyro.imu", duration=60.0)
 
 
 @pytest.mark.skipif(not (PSINS and Path(PSINS).is_file()),
@@ -122,11 +136,11 @@ def test_the_psins_recording_drifts_as_its_mean_sensor_errors(run_cli):
     (6.94 km) is within 2.9 % of the constant-bias model's (7.14 km), the east one (body x, heading 90.6 deg)
     within 1.4 %, the heading error within 3.7 %; the bounds below leave about 2x margin.
     """
-    out = run_cli("navigate", "run", "--imu", PSINS, "--duration", "300", "--json")
+    out = run_cli("navigate", "run", "--record", PSINS, "--duration", "300", "--json")
     assert out.code == 0, out.stderr
     data = out.json()
     assert data["t_s"][-1] == 300.0 and data["inputs"]["imu_rate"] is None
-    case = SYSTEM.case(imu=PSINS, duration=300.0)
+    case = SYSTEM.case(record=PSINS, duration=300.0)
     recording = replay(PSINS, case)
     ideal = ideal_imu(recording.trajectory, 300.0, recording.imu_rate)
     dt = 1.0 / recording.imu_rate

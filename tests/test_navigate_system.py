@@ -67,10 +67,11 @@ def test_the_system_runs_the_library_with_the_values_given():
                           "velocity_error_east", "roll_error", "pitch_error", "heading_error")}),
                       sensor_errors=SensorErrors(gyro_bias=[[values[f"gyro_bias_{a}"] for a in "xyz"]],
                                                  accel_bias=[[values["accel_bias_x"], 0.0, values["accel_bias_z"]]]))
+    histories = result.histories["navigate_errors"]
     for name in ("position_error_north_m", "velocity_error_east_m_s", "heading_error_rad", "height_error_m"):
-        np.testing.assert_array_equal(result.history(name), direct.channel(name)[0])
-    assert result.errors["final_pitch_error_rad"] == direct.pitch_error_rad[0, -1]
-    assert result.errors["max_abs_roll_error_rad"] == np.abs(direct.roll_error_rad).max()
+        np.testing.assert_array_equal(histories[name], direct.channel(name)[0])
+    assert result.final_pitch_error_rad == direct.pitch_error_rad[0, -1]
+    assert result.max_abs_roll_error_rad == np.abs(direct.roll_error_rad).max()
 
 
 def test_a_velocity_error_gives_the_foucault_modulated_schuler_oscillation():
@@ -87,11 +88,12 @@ def test_a_velocity_error_gives_the_foucault_modulated_schuler_oscillation():
     w = math.sqrt(float(somigliana_gravity(latitude)) / R_N)
     vertical_rate = EARTH_RATE * math.sin(latitude)
     w_split = math.hypot(w, vertical_rate)
-    t = result.navigation.t_s
+    frame = result.to_dataframe()
+    t = frame.index.to_numpy()
     amplitude = dv / w_split * np.sin(w_split * t)
-    np.testing.assert_allclose(result.history("position_error_north_m"), amplitude * np.cos(vertical_rate * t),
+    np.testing.assert_allclose(frame["position_error_north_m"], amplitude * np.cos(vertical_rate * t),
                                rtol=0, atol=1e-3 * dv / w)
-    np.testing.assert_allclose(result.history("position_error_east_m"), amplitude * np.sin(vertical_rate * t),
+    np.testing.assert_allclose(frame["position_error_east_m"], amplitude * np.sin(vertical_rate * t),
                                rtol=0, atol=1e-3 * dv / w)
 
 
@@ -129,8 +131,9 @@ def test_monte_carlo_members_draw_the_sigmas():
     expected = sigma * abs(math.sin(w * 600.0)) / w
     # 400 members: the sample std has a standard error of 3.5 %; 4 of them
     assert summary.statistics["final_position_error_north_m"]["std"] == pytest.approx(expected, rel=0.14)
-    nominal = SYSTEM.run(**QUICK)
-    assert nominal.errors["final_position_error_north_m"] == 0.0  # the nominal case draws nothing
+    # a run without Monte Carlo is the nominal case (realisation False): the sigmas draw nothing
+    nominal = SYSTEM.run(sigma_velocity_error=sigma, **QUICK)
+    assert not SYSTEM.realisation and nominal.final_position_error_north_m == 0.0
 
 
 def test_imu_members_are_independent_of_chunking_and_of_the_order_of_members():
@@ -170,7 +173,8 @@ def test_the_nominal_imu_case_takes_every_constant_at_one_sigma():
     constants = imu_noise.representative_constants(model, 1, [0.0, 0.0, -9.8])
     direct = navigate(Stationary(latitude=math.radians(45.0)), 600.0, imu_rate=10.0, output_step=60.0,
                       sensor_errors=SensorErrors(**constants.as_dict()), initial_errors=InitialErrors(roll_error=[0.0]))
-    np.testing.assert_array_equal(result.history("position_error_east_m"), direct.position_error_east_m[0])
+    np.testing.assert_array_equal(result.histories["navigate_errors"]["position_error_east_m"],
+                                  direct.position_error_east_m[0])
     assert result.imu == model.name
     # +1 sigma: 1 deg/h, 150 ppm, 0.5 mrad, 1 mg on every axis
     assert constants.gyro_bias[0].tolist() == pytest.approx([DEG_PER_H] * 3)
@@ -230,7 +234,7 @@ def test_memory_is_refused_before_allocating(monkeypatch):
 
 def test_files_of_a_run(tmp_path):
     result = SYSTEM.run(monte_carlo=30, sigma_position_error=10.0, vertical_channel="free", **QUICK)
-    files = SYSTEM.write_files(result, tmp_path)
+    files = SYSTEM.write(result, tmp_path)
     names = sorted(p.name for p in files)
     assert names == ["navigate_errors.csv", "navigate_errors.png", "navigate_errors.svg", "navigate_monte_carlo.png",
                      "navigate_monte_carlo.svg"]
@@ -239,8 +243,7 @@ def test_files_of_a_run(tmp_path):
     table = pd.read_csv(tmp_path / "navigate_errors.csv")
     assert list(table.columns)[:2] == ["t_s", "position_error_north_m"] and "height_error_m" in table
     assert table["t_s"].iloc[-1] == 600.0
-    with pytest.raises(TypeError):
-        SYSTEM.write_files(object(), tmp_path)
+    assert SYSTEM.figures(SYSTEM.case()) == {}  # what is neither a run nor the reproduction has no figures
 
 
 def test_reproduction_rows_and_files(tmp_path):
@@ -260,7 +263,7 @@ def test_reproduction_rows_and_files(tmp_path):
     table = reproduction.details["gyrocompassing"]
     assert len(table) == 12 and table[0]["initial_azimuth_error_rad"] == pytest.approx(ARCMIN)
     assert table[-1]["initial_azimuth_error_rad"] == pytest.approx(0.4)
-    files = SYSTEM.write_files(reproduction, tmp_path)
+    files = SYSTEM.write(reproduction, tmp_path)
     assert {p.name for p in files} >= {"navigate_gyrocompassing.png", "navigate_gyrocompassing.svg",
                                        "navigate_gyrocompassing.csv", "navigate_bollay.png", "navigate_drozdovich.svg"}
     from PIL import Image

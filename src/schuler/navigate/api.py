@@ -1,22 +1,23 @@
 """The nonlinear INS on the contract: ``SYSTEM`` (``schuler navigate``).
 
 The pieces: :mod:`~schuler.navigate.evaluation` (parameters, outputs,
-``evaluate``, ``run_case``), :mod:`~schuler.navigate.reproduction` (the seeds'
+``evaluate`` with histories), :mod:`~schuler.navigate.reproduction` (the seeds'
 linear models against the nonlinear INS: ``reproduce``, ``report``),
-:mod:`~schuler.navigate.results` (the result types and ``write_files``).
+:mod:`~schuler.navigate.results` (the result type, ``figures``, ``data_files``).
 
-``imu`` is a grade, a spec file, or a recorded IMU file
-(:mod:`~schuler.navigate.recording`): a recording is a static vehicle, its
-increments navigated in place of the ideal IMU and its errors (computed - true)
-taken against a stationary truth at its site and initial attitude, for its
-length and at its rate; one member, so no Monte Carlo.
+``imu`` is a grade or a spec file; ``record`` a recorded IMU file
+(:mod:`~schuler.navigate.recording`): a static vehicle, its increments
+navigated in place of the ideal IMU and its errors (computed - true) taken
+against a stationary truth at its site and initial attitude, for its length and
+at its rate; one member, so no Monte Carlo. A run without Monte Carlo is the
+nominal case (no noise, an error model's constant errors at +1 sigma).
 
 Examples
 --------
 >>> import math
 >>> r = SYSTEM.run(latitude=math.radians(45), velocity_error_north=0.1, duration=600.0, imu_rate=10.0,
 ...                output_step=60.0)
->>> round(r.errors["final_position_error_north_m"], 1)   # (dV / w_s) sin(w_s t) at 45 deg
+>>> round(r.final_position_error_north_m, 1)   # (dV / w_s) sin(w_s t) at 45 deg
 54.6
 """
 
@@ -24,9 +25,9 @@ from __future__ import annotations
 
 from schuler.contract import System
 from schuler.navigate import imu_noise
-from schuler.navigate.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes, run_case, setup
+from schuler.navigate.evaluation import OUTPUTS, PARAMETERS, evaluate, member_bytes, setup
 from schuler.navigate.reproduction import report, reproduce
-from schuler.navigate.results import write_files
+from schuler.navigate.results import NavigateResult, data_files, figures
 from schuler.params import Case
 from schuler.references import GROVES_2013
 
@@ -57,9 +58,10 @@ SYSTEM = System(
     parameters=PARAMETERS,
     outputs=OUTPUTS,
     evaluate=evaluate,
-    run_case=run_case,
     reproduce=reproduce,
-    write_files=write_files,
+    figures=figures,
+    data_files=data_files,
+    result_type=NavigateResult,
     report=report,
     random_terms=True,
     member_bytes=member_bytes,

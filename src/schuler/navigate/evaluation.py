@@ -1,26 +1,27 @@
-"""What the nonlinear INS system evaluates: its parameters, outputs, ``evaluate`` and ``run_case``.
+"""What the nonlinear INS system evaluates: its parameters, outputs and ``evaluate``.
 
-One case is a trajectory (``stationary``, ``great-circle`` or a waypoint
-profile ``FILE.toml``, :mod:`schuler.navigate.profile`), a mechanization
-(``strapdown`` or ``platform``), a vertical channel, initial errors (computed -
-true) and sensor errors (measured - true, body axes): the biases given and,
-with ``imu``, the full error model of a grade or a spec file
+One case is a trajectory (``stationary``, ``great-circle``, ``drive`` or a
+waypoint profile ``FILE.toml``, :mod:`schuler.navigate.profile`), a
+mechanization (``strapdown`` or ``platform``), a vertical channel, initial
+errors (computed - true) and sensor errors (measured - true, body axes): the
+biases given and, with ``imu``, the full error model of a grade or a spec file
 (:mod:`schuler.navigate.imu_noise`). Without ``imu`` the IMU is ideal apart
-from the biases given. With ``imu`` naming a recorded IMU file
-(:mod:`schuler.navigate.recording`) the vehicle is static: the computer
+from the biases given. With ``record`` (a recorded IMU file,
+:mod:`schuler.navigate.recording`) the vehicle is static: the computer
 integrates the record's increments (plus the biases given) and the errors are
 against a stationary truth at the record's site and attitude; such a case is
 one member (no Monte Carlo).
 
 :func:`evaluate` runs the cases of a batch that share a trajectory and a time
 grid as the members of one batched :func:`~schuler.navigate.mechanization.navigate`
-and returns the final and the largest errors; :func:`run_case` runs one case the
-same way and keeps the histories. Random terms (``cases.random`` set: Monte
-Carlo members, sweep draws): each member draws its initial errors and biases
-around the case's values from the ``sigma_*`` parameters, and with ``imu`` the
-error model's constant errors and noise, all at its member number; the nominal
-case (``cases.random`` None) has no noise and the model's constant errors at
-+1 sigma.
+and returns the final and the largest errors; with ``histories`` also the first
+case's error histories (``navigate_errors``) and what it ran (trajectory, IMU,
+grid, warnings). Random terms (``cases.random`` set: Monte Carlo members, sweep
+draws): each member draws its initial errors and biases around the case's
+values from the ``sigma_*`` parameters, and with ``imu`` the error model's
+constant errors and noise, all at its member number; the nominal case
+(``cases.random`` None, what ``run`` shows) has no noise and the model's
+constant errors at +1 sigma.
 
 Validity (:mod:`schuler.navigate.validity`): a run whose computed height leaves
 -11 km .. 120 km or whose attitude error passes 0.1 rad warns (and says so in the
@@ -39,15 +40,17 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from schuler.contract import Cases, Output
+from schuler.contract import Cases, Evaluation, Output
 from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel
 from schuler.memory import budget, require
 from schuler.navigate import imu_noise
 from schuler.navigate.channels import DISPLAY_UNITS, ERROR_CHANNELS, suffix
+from schuler.navigate.drive import drive
 from schuler.navigate.errors import InitialErrors, SensorErrors
 from schuler.navigate.mechanization import (
     MODES,
@@ -58,14 +61,19 @@ from schuler.navigate.mechanization import (
     output_interval,
 )
 from schuler.navigate.profile import load_profile
-from schuler.navigate.recording import is_recording, replay
-from schuler.navigate.results import NavigateResult, NavigationResult
+from schuler.navigate.recording import RECORD_SUFFIXES, is_recording, replay
+from schuler.navigate.results import HISTORIES, NavigationResult
 from schuler.navigate.trajectory import GreatCircle, Stationary
 from schuler.navigate.truth import DEFAULT_CHUNK, TruthGenerator
 from schuler.params import Case, Parameter, ParameterSet
 
-TRAJECTORIES = ("stationary", "great-circle")
+TRAJECTORIES = ("stationary", "great-circle", "drive")
 """Named trajectories; any other value of ``trajectory`` is a waypoint profile file."""
+
+DRIVE_OPTIONS = ("stops", "stop_duration", "city_speed", "road_speed", "turn_speed", "turn_radius", "acceleration")
+"""The parameters of the ``drive`` trajectory (:func:`schuler.navigate.drive.drive`), not set: the drive's own."""
+DRIVE_START = {"latitude": math.radians(30.5), "longitude": math.radians(114.5), "height": 20.0}
+"""The drive's start where not given: :func:`~schuler.navigate.drive.drive`'s (the drive of ``schuler aided``)."""
 
 DEFAULT_LATITUDE = math.radians(45.0)
 DEFAULT_SPEED = 250.0
@@ -85,7 +93,8 @@ _INITIAL_SIGMAS = {"position_error_north": "sigma_position_error", "position_err
                    "roll_error": "sigma_level_error", "pitch_error": "sigma_level_error",
                    "heading_error": "sigma_heading_error"}
 _AXES = "xyz"
-_GROUPED = ("trajectory", *_START, "duration", "imu_rate", "output_step", "vertical_channel", "mode", "imu")
+_GROUPED = ("trajectory", *_START, *DRIVE_OPTIONS, "duration", "imu_rate", "output_step", "vertical_channel",
+            "mode", "imu", "record")
 _POSITION = 1e6
 """Largest initial position error, m (1000 km)."""
 _VELOCITY = 1e3
@@ -96,18 +105,36 @@ _ACCEL_BIAS = 1.0
 """Largest accelerometer bias, g."""
 
 PARAMETERS = ParameterSet((
-    Parameter("trajectory", "", "stationary", "stationary, great-circle, or a waypoint profile FILE.toml "
+    Parameter("trajectory", "", "stationary", "stationary, great-circle, drive (a car's drive with stops, speed "
+              "changes and 90-deg turns on a level road: schuler.navigate.drive), or a waypoint profile FILE.toml "
               "(format: schuler.navigate.profile).", kind="text"),
-    Parameter("latitude", "deg", None, "Start latitude (not set: 45 deg; a profile sets its own).",
-              minimum=-89, maximum=89),
-    Parameter("longitude", "deg", None, "Start longitude (not set: 0 deg).", minimum=-360, maximum=360),
-    Parameter("height", "m", None, "Height above the WGS-84 ellipsoid (not set: 0 m).", minimum=-1e4, maximum=1e5),
+    Parameter("latitude", "deg", None, "Start latitude (not set: 45 deg, the drive's 30.5 deg; a profile sets its "
+              "own).", minimum=-89, maximum=89),
+    Parameter("longitude", "deg", None, "Start longitude (not set: 0 deg, the drive's 114.5 deg).", minimum=-360,
+              maximum=360),
+    Parameter("height", "m", None, "Height above the WGS-84 ellipsoid (not set: 0 m, the drive's 20 m).",
+              minimum=-1e4, maximum=1e5),
     Parameter("heading", "deg", None, "Heading (the great circle's initial course), clockwise from north "
               "(not set: 0 deg).", minimum=-360, maximum=360),
     Parameter("speed", "m/s", None, f"Ground speed along the great circle (not set: {DEFAULT_SPEED:g} m/s).",
               minimum=0, maximum=1e4),
-    Parameter("duration", "s", None, f"Simulated time (not set: {DEFAULT_DURATION:g} s, a profile's last "
-              "waypoint time, or a recording's length in whole output steps; at most the recording's).",
+    Parameter("stops", "", None, "Drive: stationary periods, the first at the start and the last at the end "
+              "(not set: 4).", minimum=2, maximum=100, kind="integer"),
+    Parameter("stop_duration", "s", None, "Drive: length of each stop (not set: 25 s).", minimum=0,
+              exclusive_minimum=True, maximum=1e5),
+    Parameter("city_speed", "m/s", None, "Drive: cruising speed in town (not set: 10 m/s).", minimum=0,
+              exclusive_minimum=True, maximum=70),
+    Parameter("road_speed", "m/s", None, "Drive: cruising speed on the road (not set: 20 m/s).", minimum=0,
+              exclusive_minimum=True, maximum=70),
+    Parameter("turn_speed", "m/s", None, "Drive: speed through the 90-deg turns (not set: 8 m/s).", minimum=0,
+              exclusive_minimum=True, maximum=70),
+    Parameter("turn_radius", "m", None, "Drive: mean radius of the turns (not set: 40 m).", minimum=0,
+              exclusive_minimum=True, maximum=1e4),
+    Parameter("acceleration", "m/s^2", None, "Drive: mean acceleration and deceleration of its speed changes "
+              "(not set: 1.5 m/s^2).", minimum=0, exclusive_minimum=True, maximum=10),
+    Parameter("duration", "s", None, f"Simulated time (not set: {DEFAULT_DURATION:g} s, the drive's 1500 s, a "
+              "profile's last waypoint time, or a recording's length in whole output steps; at most the "
+              "recording's).",
               minimum=0, exclusive_minimum=True, maximum=MAX_DURATION),
     Parameter("imu_rate", "Hz", None, f"IMU sample rate (not set: {DEFAULT_IMU_RATE:g} Hz, or a recording's "
               "rate, the only one allowed with it).", minimum=0, exclusive_minimum=True, maximum=1e5),
@@ -136,11 +163,12 @@ PARAMETERS = ParameterSet((
                 minimum=-_ACCEL_BIAS, maximum=_ACCEL_BIAS) for a in _AXES),
     Parameter("imu", "", None, "Full sensor error model: a grade (navigation, tactical, industrial, consumer) or "
               "a spec file SPEC.toml (schuler.imu.spec); its constant errors at +1 sigma, and drawn with noise "
-              "for Monte Carlo members (not set: ideal apart from the biases given). Or a recorded IMU file "
-              "(CSV, PSINS .imu, Parquet; schuler.navigate.recording): a static vehicle whose recorded increments "
-              "are navigated, errors against a stationary truth at the record's site and attitude (--latitude, "
-              "--longitude, --height, --heading override them), at the record's rate and length; one member, "
-              "no Monte Carlo.", kind="text"),
+              "for Monte Carlo members (not set: ideal apart from the biases given). A recording is replayed with "
+              "record.", kind="text"),
+    Parameter("record", "", None, "A recorded IMU file (CSV, PSINS .imu, Parquet; schuler.navigate.recording) "
+              "replayed as a static vehicle: its increments navigated, errors against a stationary truth at the "
+              "record's site and attitude (--latitude, --longitude, --height, --heading override them), at the "
+              "record's rate and length; one member, no Monte Carlo.", kind="text"),
     Parameter("sigma_position_error", "m", 0.0, "Monte Carlo: 1-sigma of the north and east initial position "
               "errors.", minimum=0, maximum=1e5),
     Parameter("sigma_velocity_error", "m/s", 0.0, "Monte Carlo: 1-sigma of the north and east initial velocity "
@@ -219,37 +247,59 @@ def setup(case: Case) -> Setup:
     Setup
         The trajectory, time grid, mechanization, vertical channel and error
         model (or recorded increments) its members share.
+
+    Raises
+    ------
+    InvalidParameter
+        A recording given as ``imu`` (it is replayed with ``record``), ``record`` with ``imu``, an option of
+        another trajectory, a trajectory that is not one.
     """
-    if case["imu"] is not None and is_recording(case["imu"].strip()):
-        recording = replay(case["imu"].strip(), case)
+    imu = None if case["imu"] is None else case["imu"].strip()
+    if imu is not None and (is_recording(imu) or Path(imu).suffix.lower() in RECORD_SUFFIXES):
+        raise InvalidParameter("imu", f"{Path(imu).name} is a recording: replay it with record (--record FILE); "
+                                      "imu is the sensor error model, a grade or SPEC.toml")
+    name = case["trajectory"].strip()
+    given = [key for key in DRIVE_OPTIONS if case[key] is not None]
+    if given and name != "drive":
+        raise InvalidParameter(given[0], "applies to the drive trajectory only")
+    if case["record"] is not None:
+        if imu is not None:
+            raise InvalidParameter("record", "a recording carries its own sensor errors: leave imu out")
+        recording = replay(case["record"].strip(), case)
         return Setup(recording.trajectory, recording.duration, recording.imu_rate, case["output_step"],
                      case["mode"], case["vertical_channel"], None, recording.increments)
-    name = case["trajectory"].strip()
+    trajectory, duration = _trajectory(name, case)
+    model = imu_noise.load_error_model(imu) if imu is not None else None
+    imu_rate = DEFAULT_IMU_RATE if case["imu_rate"] is None else case["imu_rate"]
+    return Setup(trajectory, float(duration), imu_rate, case["output_step"], case["mode"],
+                 case["vertical_channel"], model)
+
+
+def _trajectory(name: str, case: Case) -> tuple[object, float]:
+    """The case's trajectory and duration (s): a named one from the start options, or a profile file."""
     duration = case["duration"]
-    if name in TRAJECTORIES:
-        start = {key: case[key] for key in ("latitude", "longitude", "height", "heading")}
-        start = {"latitude": DEFAULT_LATITUDE if start["latitude"] is None else start["latitude"],
-                 **{key: 0.0 if start[key] is None else start[key] for key in ("longitude", "height", "heading")}}
-        duration = DEFAULT_DURATION if duration is None else duration
-        if name == "stationary":
-            if case["speed"]:
-                raise InvalidParameter("speed", "applies to the great-circle trajectory only (stationary is at rest)")
-            trajectory: object = Stationary(**start)
-        else:
-            speed = DEFAULT_SPEED if case["speed"] is None else case["speed"]
-            trajectory = GreatCircle(**start, speed=speed, duration=duration)
-    else:
+    if name not in TRAJECTORIES:
         given = [key for key in _START if case[key] is not None]
         if given:
             raise InvalidParameter(given[0], f"is set by the profile {name} (its [start] and [[waypoint]] tables); "
                                              "leave it out")
         profile = _profile(name)
-        trajectory = profile
-        duration = profile.duration if duration is None else duration
-    model = imu_noise.load_error_model(case["imu"].strip()) if case["imu"] is not None else None
-    imu_rate = DEFAULT_IMU_RATE if case["imu_rate"] is None else case["imu_rate"]
-    return Setup(trajectory, float(duration), imu_rate, case["output_step"], case["mode"],
-                 case["vertical_channel"], model)
+        return profile, profile.duration if duration is None else duration
+    if name != "great-circle" and case["speed"]:
+        raise InvalidParameter("speed", "applies to the great-circle trajectory only (" + (
+            "stationary is at rest)" if name == "stationary" else "the drive sets its own: --city-speed, "
+            "--road-speed, --turn-speed)"))
+    defaults = DRIVE_START if name == "drive" else {"latitude": DEFAULT_LATITUDE, "longitude": 0.0, "height": 0.0}
+    start: dict[str, Any] = {key: defaults.get(key, 0.0) if case[key] is None else case[key]
+                             for key in ("latitude", "longitude", "height", "heading")}
+    if name == "drive":
+        path = drive(**start, **{key: case[key] for key in (*DRIVE_OPTIONS, "duration") if case[key] is not None})
+        return path, path.duration
+    duration = DEFAULT_DURATION if duration is None else duration
+    if name == "stationary":
+        return Stationary(**start), duration
+    speed = DEFAULT_SPEED if case["speed"] is None else case["speed"]
+    return GreatCircle(**start, speed=speed, duration=duration), duration
 
 
 def member_errors(cases: Cases, shared: Setup, specific_force) -> tuple[InitialErrors, SensorErrors]:
@@ -322,8 +372,8 @@ def bytes_per_member(shared: Setup, noisy: ErrorModel | None) -> int:
 
 
 def _refuse_monte_carlo():
-    raise InvalidParameter("monte_carlo", "--imu names a recording, which is one member (its own sensor errors, "
-                                          "recorded once): run it without --monte-carlo")
+    raise InvalidParameter("monte_carlo", "--record is one member (its own sensor errors, recorded once): run it "
+                                          "without --monte-carlo")
 
 
 def runs(cases: Cases, shared: Setup) -> Iterator[tuple[np.ndarray, NavigationResult]]:
@@ -393,8 +443,8 @@ def reduce(result: NavigationResult) -> dict[str, np.ndarray]:
     return out
 
 
-def evaluate(cases: Cases) -> dict[str, np.ndarray]:
-    """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
+def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
+    """Every output of :data:`OUTPUTS` for a batch of cases, and with ``histories`` the first case's run in full.
 
     Cases sharing a trajectory, time grid, mechanization and error model run as
     the members of one batched simulation.
@@ -403,41 +453,35 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     ----------
     cases : Cases
         A batch of validated cases (SI values; random terms from ``cases.random`` at ``cases.members``).
+    histories : bool
+        Whether to return the first case's error histories (``navigate_errors``, SI) and what it ran
+        (``trajectory``, ``mode``, ``vertical_channel``, ``imu``, ``duration_s``, ``imu_rate_hz``,
+        ``output_step_s``, ``warnings``).
     """
     out = {output.name: np.full(len(cases), np.nan) for output in OUTPUTS}
+    first = None
     for index, group in cases.groups(*_GROUPED):
         shared = setup(group.case(0))
         for part, result in runs(group, shared):
             for name, values in reduce(result).items():
                 out[name][index[part]] = values
-    return out
+            if histories and 0 in index[part]:
+                first = (group.case(0), shared, result, int(np.flatnonzero(index[part] == 0)[0]))
+    if first is None:
+        return Evaluation(out)
+    case, shared, result, member = first
+    extras = {"trajectory": case["trajectory"].strip(), "mode": shared.mode,
+              "vertical_channel": shared.vertical_channel, "imu": _imu_name(case, shared),
+              "duration_s": shared.duration, "imu_rate_hz": shared.imu_rate, "output_step_s": shared.output_step,
+              "warnings": list(result.warnings)}
+    return Evaluation(out, histories={HISTORIES: result.histories(member)}, extras=extras,
+                      units={"imu_rate_hz": "Hz"})
 
 
 def _imu_name(case: Case, shared: Setup) -> str | None:
     if shared.model is not None:
         return shared.model.name
-    return f"recording {Path(case['imu'].strip()).name} (static)" if shared.recorded is not None else None
-
-
-def run_case(case: Case, fidelity: str | None = None) -> NavigateResult:
-    """One case in full: its outputs (as :func:`evaluate` gives them) and its error histories.
-
-    Parameters
-    ----------
-    case : Case
-        A validated case (SI values).
-    fidelity : str, optional
-        Not used: the nonlinear INS has one way of evaluating (the contract's signature).
-    """
-    shared = setup(case)
-    [(_, result)] = list(runs(Cases.from_case(case, 1), shared))
-    name = case["trajectory"].strip()
-    return NavigateResult(
-        trajectory=name, mode=shared.mode, vertical_channel=shared.vertical_channel,
-        imu=_imu_name(case, shared), duration_s=shared.duration,
-        imu_rate_hz=shared.imu_rate, output_step_s=shared.output_step,
-        errors={key: float(values[0]) for key, values in reduce(result).items()}, navigation=result,
-        warnings=list(result.warnings))
+    return f"recording {Path(case['record'].strip()).name} (static)" if shared.recorded is not None else None
 
 
 def member_bytes(case: Case) -> int:

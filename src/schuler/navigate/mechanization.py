@@ -260,7 +260,7 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
 
     Parameters
     ----------
-    trajectory
+    trajectory : Stationary, GreatCircle or WaypointProfile
         A trajectory of :mod:`schuler.navigate.trajectory` (start position, velocity and attitude).
     duration : float
         s, a whole number of IMU intervals.

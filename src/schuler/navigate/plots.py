@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from schuler.navigate.channels import DISPLAY_UNITS, shown_channels, suffix
+from schuler.navigate.channels import DISPLAY_UNITS, suffix
 from schuler.units import to_unit
 
 WIDTH = 7.0
@@ -36,27 +36,31 @@ def _label_bottom(axes, used: int, label: str) -> None:
             axis.set_xlabel(label)
 
 
-def plot_errors(result, channels=None, hours: bool = True):
-    """Error histories of a :class:`~schuler.navigate.results.NavigationResult`, one panel per channel.
+def plot_errors(histories, mode: str = "strapdown", channels=None, hours: bool = True):
+    """Error histories of a run, one panel per channel (:meth:`NavigationResult.histories
+    <schuler.navigate.results.NavigationResult.histories>`, or a run's ``histories["navigate_errors"]``).
 
     A batch is drawn as its members' mean and the band of +/- one standard deviation.
 
     Parameters
     ----------
-    result : NavigationResult
+    histories : Histories
+        Time (s) and channels named as :data:`~schuler.navigate.channels.ERROR_CHANNELS` (SI: m, m/s, rad),
+        shape (n_out,) or (N, n_out).
+    mode : str
+        The mechanization, for the title (``strapdown`` or ``platform``).
     channels : sequence of str, optional
-        Names from :data:`~schuler.navigate.channels.ERROR_CHANNELS` (default: all, the vertical
-        ones only when the vertical channel is on).
+        Channels to draw (default: every channel of ``histories``).
     hours : bool
         Time axis in hours (else seconds).
     """
-    names = list(channels or shown_channels(result.vertical_channel))
+    names = list(channels or histories.names)
     rows = (len(names) + 1) // 2
     fig, axes = _figure(rows, 2, figsize=(WIDTH, 2.1 * rows + 0.6), sharex=True, squeeze=False)
-    t = result.t_s / 3600.0 if hours else result.t_s
+    t = histories.time / 3600.0 if hours else histories.time
     for axis, name in zip(axes.flat, names):
         unit = DISPLAY_UNITS[suffix(name)]
-        values = to_unit(np.asarray(result.channel(name)), unit)
+        values = to_unit(np.asarray(histories[name]), unit)
         if values.ndim == 2 and values.shape[0] == 1:  # a batch of one member is a single run
             values = values[0]
         if values.ndim == 2:
@@ -69,7 +73,7 @@ def plot_errors(result, channels=None, hours: bool = True):
         axis.set_ylabel(unit)
         axis.grid(True, alpha=0.3)
     _label_bottom(axes, len(names), "time [h]" if hours else "time [s]")
-    fig.suptitle(f"{result.mode} INS errors (computed - true)")
+    fig.suptitle(f"{mode} INS errors (computed - true)")
     fig.tight_layout()
     return fig
 

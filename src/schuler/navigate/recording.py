@@ -1,4 +1,4 @@
-"""Replaying a recorded IMU file through the INS: ``--imu RECORD``.
+"""Replaying a recorded IMU file through the INS: ``--record FILE``.
 
 A recording (the project's CSV, a PSINS ``.imu`` file, or native Parquet, read
 by :func:`schuler.imu.files.read_record`) is taken as a **static vehicle**: its
@@ -16,6 +16,9 @@ without a stated attitude, ``heading`` is needed and the record is taken as
 level (roll = pitch = 0). Longitude and height default to 0 as for the synthetic
 trajectories. The duration is the record's, cut to whole output steps, or a
 shorter ``duration``; the IMU rate is the record's.
+
+``imu`` is the sensor error model only (a grade or a spec file): a recording
+given there is refused with a message naming ``record``.
 
 Examples
 --------
@@ -38,6 +41,9 @@ from schuler.imu.spec import GRADES
 from schuler.memory import budget
 from schuler.navigate.mechanization import output_interval
 from schuler.navigate.trajectory import Stationary
+
+RECORD_SUFFIXES = (".csv", ".imu", ".parquet")
+"""Suffixes of recorded IMU files (:func:`schuler.imu.files.open_record` reads any other as CSV too)."""
 
 _RELATIVE = 1e-9
 """Relative tolerance when comparing a rate or a duration with the record's."""
@@ -69,19 +75,19 @@ class Replay:
 
 
 def is_recording(text: str) -> bool:
-    """Whether ``--imu`` names a recorded IMU file (an existing file that is neither a grade nor SPEC.toml).
+    """Whether ``text`` names a recorded IMU file (an existing file that is neither a grade nor SPEC.toml).
 
     Parameters
     ----------
     text : str
-        The value of ``--imu``: a grade, a spec file or a recording's path.
+        A grade, a spec file or a recording's path (no unit).
     """
     path = Path(text)
     return text not in GRADES and path.suffix.lower() != ".toml" and path.is_file()
 
 
 def read_recording(text: str) -> ImuRecord:
-    """The record of ``--imu FILE``, in memory within the run's budget; errors name ``imu``.
+    """The record of ``--record FILE``, in memory within the run's budget; errors name ``record``.
 
     Parameters
     ----------
@@ -96,7 +102,7 @@ def read_recording(text: str) -> ImuRecord:
     try:
         return read_record(text, max_memory_bytes=budget() // 4)
     except SchulerError as error:
-        raise InvalidParameter("imu", f"{Path(text).name}: {error}") from None
+        raise InvalidParameter("record", f"{Path(text).name}: {error}") from None
 
 
 def increments(record: ImuRecord) -> np.ndarray:
@@ -114,11 +120,11 @@ def _site(record: ImuRecord, case) -> Stationary:
     name = Path(record.source).name or "the record"
     latitude = case["latitude"] if case["latitude"] is not None else record.latitude_rad
     if latitude is None:
-        raise InvalidParameter("imu", f"{name} states no latitude: give --latitude (the site of the recording)")
+        raise InvalidParameter("record", f"{name} states no latitude: give --latitude (the site of the recording)")
     attitude = record.initial_attitude_rad
     if attitude is None:
         if case["heading"] is None:
-            raise InvalidParameter("imu", f"{name} states no initial attitude: give --heading (the record is then "
+            raise InvalidParameter("record", f"{name} states no initial attitude: give --heading (the record is then "
                                           "taken as level)")
         attitude = (0.0, 0.0, case["heading"])
     roll, pitch, heading = attitude
@@ -131,7 +137,7 @@ def _site(record: ImuRecord, case) -> Stationary:
 
 
 def replay(text: str, case) -> Replay:
-    """The recording ``--imu text`` with the options of ``case`` applied and checked.
+    """The recording ``--record text`` with the options of ``case`` applied and checked.
 
     Parameters
     ----------
@@ -152,11 +158,11 @@ def replay(text: str, case) -> Replay:
     InvalidParameter
         A trajectory other than stationary or a speed (``trajectory``, ``speed``); a rate other than
         the record's (``imu_rate``); a duration longer than the record (``duration``); a record
-        without the site or attitude and no option giving it (``imu``).
+        without the site or attitude and no option giving it (``record``).
     """
     if case["trajectory"].strip() != "stationary":
         raise InvalidParameter("trajectory", "a recording is replayed as a static vehicle: use the stationary "
-                                             "trajectory with --imu RECORD")
+                                             "trajectory with --record FILE")
     if case["speed"]:
         raise InvalidParameter("speed", "a recording is replayed as a static vehicle (at rest)")
     record = read_recording(text)

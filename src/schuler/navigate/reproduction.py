@@ -31,8 +31,8 @@ import numpy as np
 
 from schuler.contract import FigureRef, ReportSection
 from schuler.core.earth import FOOT
-from schuler.navigate import plots
 from schuler.navigate.alignment import DEPARTURE, GyrocompassingComparison, kpi_gyrocompassing
+from schuler.navigate.results import figures
 from schuler.navigate.seeds import (
     BollayComparison,
     DrozdovichComparison,
@@ -325,11 +325,8 @@ def report(outdir: Path) -> ReportSection:
 
     outdir = Path(outdir)
     reproduction = reproduce()
-    data = reproduction.data
-    figures = {"navigate_gyrocompassing": plots.plot_gyrocompassing(data["gyrocompassing"]),
-               "navigate_bollay": plots.plot_bollay(data["bollay"]),
-               "navigate_drozdovich": plots.plot_drozdovich(data["drozdovich"])}
-    for stem, figure in figures.items():
+    drawn = figures(reproduction)
+    for stem, figure in drawn.items():
         save_figure_formats(figure, outdir / stem)
     captions = {
         "navigate_gyrocompassing": "KPI gyrocompassing: normalised azimuth transients of the nonlinear platform "
@@ -347,13 +344,13 @@ def report(outdir: Path) -> ReportSection:
         title="Nonlinear INS on WGS-84: the seeds' linear models against it",
         source=f"{GROVES_2013.citation} (navigation equations); {reproduction.source}",
         summary=("A strapdown or platform INS integrated without linearisation on the WGS-84 ellipsoid, along "
-                 "stationary, great-circle or waypoint trajectories, with initial errors and the IMU layer's sensor "
-                 "error models. It referees the seeds' linear models: Bollay's closed forms hold to 0.01 % with the "
-                 "flight's own radius and gravity, Drozdovich's (29) to 0.2 % along the path, and the KPI "
+                 "stationary, great-circle, drive or waypoint trajectories, with initial errors and the IMU layer's "
+                 "sensor error models. It referees the seeds' linear models: Bollay's closed forms hold to 0.01 % "
+                 "with the flight's own radius and gravity, Drozdovich's (29) to 0.2 % along the path, and the KPI "
                  "gyrocompassing models stay within 1 % of the nonlinear platform up to 0.4 rad of initial azimuth "
                  "error."),
         rows=reproduction.rows,
-        figures=[FigureRef(f"{stem}.png", captions[stem]) for stem in figures],
+        figures=[FigureRef(f"{stem}.png", captions[stem]) for stem in drawn],
         commands=[
             "schuler navigate reproduce --out DIR",
             "schuler navigate run --latitude 45 --velocity-error-north 0.1 --gyro-bias-x 0.01 --duration '6 h' "

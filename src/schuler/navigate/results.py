@@ -1,10 +1,12 @@
-"""Typed results of the nonlinear INS, SI, with display rendering, and the system's one file writer.
+"""Typed results of the nonlinear INS, SI, with display rendering, and the system's figures and data files.
 
 * :class:`NavigationResult`: what :func:`~schuler.navigate.mechanization.navigate` returns, error
   histories of one run or of a batch of members;
-* :class:`NavigateResult`: what ``schuler navigate run`` returns, one case's outputs (the final and
-  largest errors, as ``evaluate`` gives them) with its histories, and its Monte Carlo if any;
-* :func:`write_files`: the figures (PNG + SVG) and data (CSV) of a run or of the reproduction.
+* :class:`NavigateResult`: what ``schuler navigate run`` returns (the contract's
+  :class:`~schuler.results.SystemResult`): the final and largest errors, what it ran, its error
+  histories ``histories["navigate_errors"]`` and its Monte Carlo if any;
+* :func:`figures` and :func:`data_files`: the figures of a run or of the reproduction, and the
+  reproduction's tables (the contract's one writer writes them with the histories' CSV).
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from schuler.core.response import Histories
 from schuler.navigate.channels import (
     DISPLAY_UNITS,
     ERROR_CHANNELS,
@@ -23,8 +26,11 @@ from schuler.navigate.channels import (
     suffix,
 )
 from schuler.reproduction import Reproduction
-from schuler.results import Result, RunResult, json_safe
+from schuler.results import Result, SystemResult, json_safe
 from schuler.units import to_unit
+
+HISTORIES = "navigate_errors"
+"""Stem of a run's error histories: its CSV file and figure."""
 
 
 @dataclass
@@ -115,6 +121,25 @@ class NavigationResult(Result):
             raise KeyError(f"no channel {name!r}; channels are {ERROR_CHANNELS}")
         return getattr(self, name)
 
+    def histories(self, member: int | None = None) -> Histories:
+        """The channels a run reports (the vertical ones only when the channel is on) as named histories.
+
+        Parameters
+        ----------
+        member : int, optional
+            Index of one member of a batch (its histories of shape (n_out,)); None: every member's.
+
+        Returns
+        -------
+        Histories
+            Time ``t_s`` (s) and each channel in its SI unit (m, m/s, rad).
+        """
+        names = shown_channels(self.vertical_channel)
+        channels = {name: np.asarray(self.channel(name)) for name in names}
+        if member is not None:
+            channels = {name: values[member] for name, values in channels.items()}
+        return Histories(np.asarray(self.t_s), channels, {name: suffix(name).replace("_", "/") for name in names})
+
     def render(self):
         from rich.table import Table
 
@@ -140,66 +165,26 @@ class NavigationResult(Result):
         return table
 
 
-@dataclass
-class NavigateResult(RunResult):
-    """One case of ``schuler navigate run``: its final and largest errors and its error histories.
+@dataclass(kw_only=True)
+class NavigateResult(SystemResult):
+    """One case of ``schuler navigate run``: its final and largest errors, what it ran, its error histories.
 
-    Attributes
-    ----------
-    trajectory, mode, vertical_channel : str
-    imu : str or None
-        The error model's name (None: ideal apart from the biases given).
-    duration_s, imu_rate_hz, output_step_s : float
-    errors : dict of float
-        Every output of the system's ``evaluate``, SI (``final_position_error_north_m``,
-        ``max_abs_heading_error_rad`` ...); :meth:`to_dict` puts them at the top level.
-    navigation : NavigationResult
-        The run (histories of shape (1, n_out)); :meth:`to_dict` gives ``t_s`` and
-        each channel's history, the vertical ones only when the channel is on.
-    warnings : list of str
-        Where the run left its models' validity (also warned on stderr).
+    The outputs (``final_position_error_north_m``, ``max_abs_heading_error_rad`` ...) and the extras
+    (``trajectory``, ``mode``, ``vertical_channel``, ``imu``, ``duration_s``, ``imu_rate_hz``,
+    ``output_step_s``, ``warnings``: where the run left its models' validity) read as attributes;
+    ``histories["navigate_errors"]`` (or :meth:`to_dataframe`) holds each channel's history, SI.
+    :meth:`to_dict` also gives ``t_s`` and those histories at the top level (the vertical ones only
+    when the channel is on), as scripts read them.
     """
-
-    trajectory: str
-    mode: str
-    vertical_channel: str
-    imu: str | None
-    duration_s: float
-    imu_rate_hz: float
-    output_step_s: float
-    errors: dict[str, float] = field(repr=False)
-    navigation: NavigationResult = field(repr=False)
-    warnings: list[str] = field(default_factory=list)
-
-    units: ClassVar[dict[str, str]] = {"imu_rate_hz": "Hz"}
-
-    def history(self, name: str) -> np.ndarray:
-        """A channel's error history, SI, shape (n_out,).
-
-        Parameters
-        ----------
-        name : str
-            Channel name, one of :data:`~schuler.navigate.channels.ERROR_CHANNELS` (SI unit in the name).
-
-        Returns
-        -------
-        ndarray
-            The history in the channel's SI unit (m, m/s or rad), shape (n_out,).
-        """
-        return np.asarray(self.navigation.channel(name))[0]
 
     def to_dict(self) -> dict[str, Any]:
         data = super().to_dict()
-        monte_carlo = data.pop("monte_carlo", None)
-        data.pop("units", None)
-        data.update(json_safe(self.errors))
-        data["t_s"] = json_safe(self.navigation.t_s)
-        for name in shown_channels(self.vertical_channel):
-            data[name] = json_safe(self.history(name))
-        data["monte_carlo"] = monte_carlo
-        data["units"] = {**self.units, "t_s": "s",
-                         **{name: suffix(name).replace("_", "/") for name in shown_channels(self.vertical_channel)}}
-        return data
+        tail = {name: data.pop(name) for name in ("monte_carlo", "units")}
+        data = {**{name: data.pop(name) for name in self.extras}, **data}  # what it ran first, as before
+        histories = self.histories[HISTORIES]
+        data["t_s"] = json_safe(histories.time)
+        data.update({name: json_safe(values) for name, values in histories.channels.items()})
+        return {**data, **tail, "units": {**tail["units"], "t_s": "s", **histories.units}}
 
     def render(self):
         from rich.console import Group
@@ -213,66 +198,64 @@ class NavigateResult(RunResult):
         table.add_column("largest |error|", justify="right")
         for name in (*shown_channels(self.vertical_channel), "horizontal_position_error_m"):
             unit = DISPLAY_UNITS[suffix(name)]
-            final = self.errors[f"final_{name}"]
-            largest = self.errors[f"max_abs_{name}" if name in ERROR_CHANNELS else f"max_{name}"]
+            final = self.outputs[f"final_{name}"]
+            largest = self.outputs[f"max_abs_{name}" if name in ERROR_CHANNELS else f"max_{name}"]
             table.add_row(f"{name.removesuffix('_' + suffix(name)).replace('_', ' ')} ({unit})",
                           *(f"{float(to_unit(v, unit)):,.4g}" for v in (final, largest)))
         return Group(table, self.monte_carlo.render()) if self.monte_carlo is not None else table
 
 
-def write_files(result: Result, out_dir: Path) -> list[Path]:
-    """Figures (PNG + SVG) and data (CSV) of a run or of the reproduction, into ``out_dir``.
+def figures(result: Result) -> dict[str, Any]:
+    """The figures of a run or of the reproduction, file stem -> Figure ({} for any other result).
 
-    A run: ``navigate_errors`` (the error histories), ``navigate_errors.csv`` and,
-    with a Monte Carlo, ``navigate_monte_carlo`` (the final horizontal errors).
-    The reproduction: ``navigate_gyrocompassing`` (steady state and settling
-    time of the nonlinear platform against the KPI models, by initial azimuth
-    error) with its table ``navigate_gyrocompassing.csv``, ``navigate_bollay``
-    with ``navigate_bollay.csv``, and ``navigate_drozdovich``.
+    A run: ``navigate_errors`` (the error histories) and, with a Monte Carlo, ``navigate_monte_carlo``
+    (the final horizontal errors). The reproduction: ``navigate_gyrocompassing`` (steady state and
+    settling time of the nonlinear platform against the KPI models, by initial azimuth error),
+    ``navigate_bollay`` and ``navigate_drozdovich``.
 
     Parameters
     ----------
     result : Result
         What ``run`` (a :class:`NavigateResult`) or ``reproduce`` (a
         :class:`~schuler.reproduction.Reproduction`) returned.
+    """
+    from schuler.navigate import plots
+
+    if isinstance(result, Reproduction):
+        data = result.data
+        return {"navigate_gyrocompassing": plots.plot_gyrocompassing(data["gyrocompassing"]),
+                "navigate_bollay": plots.plot_bollay(data["bollay"]),
+                "navigate_drozdovich": plots.plot_drozdovich(data["drozdovich"])}
+    if not isinstance(result, NavigateResult) or HISTORIES not in result.histories:
+        return {}
+    drawn = {HISTORIES: plots.plot_errors(result.histories[HISTORIES], result.mode)}
+    if result.monte_carlo is not None:
+        drawn["navigate_monte_carlo"] = plots.plot_final_errors(
+            result.monte_carlo.samples["final_horizontal_position_error_m"])
+    return drawn
+
+
+def data_files(result: Result, out_dir: Path) -> list[Path]:
+    """The reproduction's tables, ``navigate_gyrocompassing.csv`` and ``navigate_bollay.csv`` (a run: none).
+
+    Parameters
+    ----------
+    result : Result
+        What ``run`` or ``reproduce`` returned (a run's histories are written as its CSV by the contract).
     out_dir : Path
-        Folder for the figures (PNG, SVG) and data files (CSV).
+        Folder for the CSV files.
 
     Returns
     -------
     list of Path
         The files written.
-
-    Raises
-    ------
-    TypeError
-        For any other result type.
     """
     import pandas as pd
 
-    from schuler.io import save_figure_formats, write_dataframe_csv
-    from schuler.navigate import plots
+    from schuler.io import write_dataframe_csv
 
-    out_dir = Path(out_dir)
-    files: list[Path] = []
-    if isinstance(result, Reproduction):
-        data = result.data
-        figures = {"navigate_gyrocompassing": plots.plot_gyrocompassing(data["gyrocompassing"]),
-                   "navigate_bollay": plots.plot_bollay(data["bollay"]),
-                   "navigate_drozdovich": plots.plot_drozdovich(data["drozdovich"])}
-        for stem, figure in figures.items():
-            files += save_figure_formats(figure, out_dir / stem)
-        files.append(write_dataframe_csv(pd.DataFrame(data["gyrocompassing_table"]),
-                                         out_dir / "navigate_gyrocompassing.csv"))
-        files.append(write_dataframe_csv(pd.DataFrame(data["bollay"].summary()), out_dir / "navigate_bollay.csv"))
-        return files
-    if not isinstance(result, NavigateResult):
-        raise TypeError(f"navigate writes no files for {type(result).__name__}")
-    files += save_figure_formats(plots.plot_errors(result.navigation), out_dir / "navigate_errors")
-    columns = {"t_s": result.navigation.t_s, **{name: result.history(name)
-                                                for name in shown_channels(result.vertical_channel)}}
-    files.append(write_dataframe_csv(pd.DataFrame(columns), out_dir / "navigate_errors.csv"))
-    if result.monte_carlo is not None:
-        samples = result.monte_carlo.samples["final_horizontal_position_error_m"]
-        files += save_figure_formats(plots.plot_final_errors(samples), out_dir / "navigate_monte_carlo")
-    return files
+    if not isinstance(result, Reproduction):
+        return []
+    data, out_dir = result.data, Path(out_dir)
+    return [write_dataframe_csv(pd.DataFrame(data["gyrocompassing_table"]), out_dir / "navigate_gyrocompassing.csv"),
+            write_dataframe_csv(pd.DataFrame(data["bollay"].summary()), out_dir / "navigate_bollay.csv")]

@@ -106,7 +106,7 @@ class TruthGenerator:
 
     Parameters
     ----------
-    trajectory
+    trajectory : object
         Any object with ``latitude``, ``longitude``, ``height`` (start, rad and m)
         and ``kinematics(t) -> (velocity_ned (n, 3), q_bn (n, 4))``
         (:mod:`schuler.navigate.trajectory`).
@@ -218,7 +218,7 @@ def ideal_imu(trajectory, duration: float, imu_rate: float = 100.0, earth_rate: 
 
     Parameters
     ----------
-    trajectory
+    trajectory : Stationary, GreatCircle or WaypointProfile
         A trajectory of :mod:`schuler.navigate.trajectory`.
     duration : float
         s, a whole number of IMU intervals.
