@@ -21,7 +21,7 @@ the linearised covariance sigma^2 (J^T J)^-1 at the true parameters
 series from ``cases.random.normal_series("readout_noise", member, 0, samples)``,
 so a member's record depends only on (seed, member), never on chunking.
 
-A run (``evaluate`` with ``histories``) is the nominal case in full: its
+A run (``evaluate`` with ``histories``) is the first case in full: its
 outputs, the record and the fit to it (histories ``north_record_fit``), and
 beside them ``unknowns``, ``method``, ``reading``, ``readout_noise_rad`` and
 ``true_north_rad``.
