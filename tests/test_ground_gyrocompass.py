@@ -12,6 +12,7 @@ from scipy.integrate import quad
 from scipy.special import j0, y0
 
 from schuler.core.geometry import ARCSEC, horizontal_earth_rate, time_grid
+from schuler.core.random import RandomStreams
 from schuler.exceptions import IdentificationError, InvalidParameter, NotObservable
 from schuler.ground_gyrocompass import grid, motion, varpro
 from schuler.ground_gyrocompass.estimate import identify
@@ -278,7 +279,8 @@ def test_monte_carlo_failure_rate_is_that_of_identify_and_off_nominal_starts_fit
     # the study's records are the seed's draws through observe(), and it counts exactly identify()'s failures
     t = time_grid(0.004, 0.001)
     angle = motion.closed_form(t, TRUE["alpha0"], TRUE["alpha0_dot"], LAM, B)
-    records = observe(np.broadcast_to(angle, (5, t.size)), TRUE["alpha0"], ARCSEC, rng=np.random.default_rng(0))
+    draws = RandomStreams(0).normal_series("readout_noise", np.arange(5), 0, t.size)
+    records = observe(angle + ARCSEC * draws, TRUE["alpha0"])
     fitted = []
     for record in records:
         try:

@@ -273,3 +273,63 @@ def test_help_shows_the_new_names(run_cli):
         assert old not in help_text
     assert "--seed" in run_cli("north", "simulate", "--help").stdout
     assert "--seed" not in run_cli("north", "identify", "--help").stdout
+
+
+FIT_FILES = {f"{stem}.{ext}" for stem in ("north_fit", "north_misfit_map", "north_error_vs_time")
+             for ext in ("png", "svg")} | {"north_record_fit.csv"}
+RUN_KEYS = {"converged", "fidelity", "files", "identified_alpha0_dot_rad_s", "identified_alpha0_rad",
+            "identified_decay_rate", "identified_directive_coefficient", "identified_hm", "identified_offset_rad",
+            "identified_torque", "inputs", "method", "misfit_rad2", "model_evaluations", "monte_carlo",
+            "north_error_rad", "north_rad", "north_std_predicted_rad", "north_std_rad", "omega_h", "reading",
+            "readout_noise_rad", "residual_rms_rad", "samples", "schuler_version", "true_north_rad", "units",
+            "unknowns"}
+COMMANDS = {
+    "run": (("run",), RUN_KEYS, FIT_FILES),
+    "run-monte-carlo": (("run", "--monte-carlo", "5"), RUN_KEYS,
+                        FIT_FILES | {"north_monte_carlo.png", "north_monte_carlo.svg"}),
+    "simulate": (("simulate", "-o", "{tmp}/rec.csv"),
+                 {"directive_coefficient", "duration_s", "files", "inputs", "omega_h", "output_step_s", "reading",
+                  "readout_noise_rad", "record_file", "samples", "schuler_version", "seed", "true_north_rad",
+                  "units"}, {"north_record.png", "north_record.svg"}),
+    "identify": (("identify", "{tmp}/rec.csv"),
+                 {"alpha0_dot_rad_s", "alpha0_dot_std_rad_s", "alpha0_rad", "alpha0_std_rad", "converged",
+                  "convergence", "correlation", "decay_rate", "decay_rate_std", "directive_coefficient",
+                  "directive_coefficient_std", "files", "hm", "hm_std", "identified", "inertia", "inputs", "method",
+                  "misfit_rad2", "model_evaluations", "north_rad", "north_std_rad", "offset_rad", "offset_std_rad",
+                  "omega_h", "reading", "residual_rms_rad", "samples", "schuler_version", "torque", "torque_std",
+                  "units", "unknowns"}, FIT_FILES),
+    "reproduce": (("reproduce",),
+                  {"constants", "details", "files", "inputs", "notes", "rows", "schuler_version", "source", "system",
+                   "units"},
+                  {"north_fit.png", "north_fit.svg", "north_misfit_map.png", "north_misfit_map.svg",
+                   "north_table1.csv"}),
+    "compare": (("compare", "--monte-carlo", "4", "--duration", "60"),
+                {"axes", "carousel_period_s", "duration_s", "files", "grade", "ground_gyrocompass", "heading_rad",
+                 "inputs", "latitude_rad", "members", "methods", "notes", "sample_interval_s", "schuler_version",
+                 "seed", "units", "versus_grade", "versus_time"},
+                {"north_compare_accuracy.csv", "north_compare_accuracy.png", "north_compare_accuracy.svg"}),
+}
+"""What each command gave with --json and --out before north moved to the one evaluation (its keys and files)."""
+
+
+@pytest.mark.slow
+def test_every_command_keeps_its_json_keys_and_files(run_cli, tmp_path):
+    light = ("--duration", "600", "--readout-noise", "1")
+    for name, (args, keys, files) in COMMANDS.items():
+        args = tuple(arg.format(tmp=tmp_path) for arg in args)
+        extra = light if args[0] in ("run", "simulate") else ()
+        out = run_cli("north", *args, *extra, "--json", "--out", tmp_path / name)
+        assert out.code == 0, (name, out.stderr)
+        data = out.json()
+        assert set(data) == keys, name
+        assert {p.name for p in (tmp_path / name).iterdir() if not p.name.startswith(".")} == files, name
+        assert {Path(f).name for f in data["files"]} >= files, name
+    run = pd.read_csv(tmp_path / "run" / "north_record_fit.csv")
+    assert list(run.columns) == ["t_s", "observed_rad", "fitted_rad", "residual_rad"] and len(run) == 601
+    assert list(pd.read_csv(tmp_path / "identify" / "north_record_fit.csv").columns) == list(run.columns)
+    assert list(pd.read_csv(tmp_path / "reproduce" / "north_table1.csv").columns) == [
+        "k", "m", "alpha0_rad", "alpha0_dot_rad_s", "printed_misfit_rad2", "sum_of_squares_rad2", "misprint"]
+    assert list(pd.read_csv(tmp_path / "compare" / "north_compare_accuracy.csv").columns) == [
+        "duration_s", "two_position", "four_position", "carousel", "ground_gyrocompass"]
+    data = run_cli("north", "run", *light, "--json").json()
+    assert data["converged"] is True and data["samples"] == 601 and data["units"]["unknowns"] == "1"

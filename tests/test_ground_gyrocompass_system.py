@@ -1,4 +1,4 @@
-"""The ground gyrocompass on the contract: evaluate, run_case, Monte Carlo draws, actions, reproduction, report."""
+"""The ground gyrocompass on the contract: evaluate and run, Monte Carlo draws, actions, reproduction, report."""
 
 from __future__ import annotations
 
@@ -23,17 +23,12 @@ from schuler.ground_gyrocompass.evaluation import (
     member_bytes,
     record_window,
     records,
-    run_case,
     truth_of,
 )
 from schuler.ground_gyrocompass.monte_carlo import predicted_errors
 from schuler.ground_gyrocompass.observations import read_record
 from schuler.ground_gyrocompass.reproduction import reproduce
-from schuler.ground_gyrocompass.results import (
-    NorthIdentification,
-    ObservationRecord,
-    write_files,
-)
+from schuler.ground_gyrocompass.results import NorthIdentification, NorthRun, ObservationRecord
 from schuler.memory import MemoryBudgetExceeded
 
 ARCSEC = math.radians(1.0) / 3600.0
@@ -55,12 +50,12 @@ def batch(cases: list[dict], **kwargs) -> Cases:
     return Cases(values, **kwargs)
 
 
-def test_evaluate_equals_run_case_at_several_cases():
-    # the contract: run_case's to_dict holds every output of evaluate with the same value (1e-9 relative;
+def test_evaluate_equals_run_at_several_cases():
+    # the contract: a run's to_dict holds every output of evaluate with the same value (1e-9 relative;
     # 1e-15 rad absolute covers outputs that are round-off of 1e-2 rad angles, such as a noise-free error)
     out = evaluate(batch(CASES))
     for i, case in enumerate(CASES):
-        single = run_case(SYSTEM.case(**case)).to_dict()
+        single = SYSTEM.run(**case).to_dict()
         for output in OUTPUTS:
             expected = single[output.name]
             expected = math.nan if expected is None else float(expected)
@@ -233,12 +228,35 @@ def test_identify_record_returns_si_names(tmp_path):
         identify_record(tmp_path / "r.csv", unknowns=6)
 
 
-def test_write_files_for_every_result(tmp_path):
-    record = simulate_record(tmp_path / "r.csv", readout_noise=ARCSEC, seed=1)
-    names = {path.name for path in write_files(record, tmp_path / "simulate")}
-    assert names == {"north_record.png", "north_record.svg"}
-    with pytest.raises(TypeError, match="north writes no files"):
-        write_files(object(), tmp_path)
+def test_run_in_full_is_evaluate_with_its_record_and_fit():
+    # the run is evaluate's first case with histories: the record and fit the figures draw, typed counts and flag
+    run = SYSTEM.run(readout_noise=ARCSEC, unknowns=3, duration=300.0)
+    assert type(run) is NorthRun and run.converged is True and run.samples == 301 and run.model_evaluations > 0
+    history = run.histories["north_record_fit"]
+    assert history.names == ("observed_rad", "fitted_rad", "residual_rad") and history.time[-1] == 300.0
+    np.testing.assert_allclose(history["observed_rad"] - history["fitted_rad"], history["residual_rad"], atol=1e-18)
+    assert float(np.sum(history["residual_rad"] ** 2)) == pytest.approx(run.misfit_rad2, rel=1e-9, abs=1e-30)
+    assert (run.unknowns, run.method, run.reading) == (3, "lsq", "relative")
+    assert run.true_north_rad == TRUE_NORTH and run.readout_noise_rad == ARCSEC
+    frame = run.to_dataframe()
+    assert frame.index.name == "t_s" and frame.attrs["units"]["residual_rad"] == "rad"
+    assert "-1°13′48.00″" in str(run) and "variable projection converged" in str(run)
+
+
+def test_actions_plot_and_give_their_tables(tmp_path):
+    import matplotlib.pyplot as plt
+
+    # through the system, as the command line and users call them: their results draw their figures
+    record = SYSTEM.action("simulate")(tmp_path / "r.csv", readout_noise=ARCSEC, seed=1)
+    assert list(record.figures()) == ["north_record"]
+    assert list(record.to_dataframe().columns) == ["alpha_rad"] and record.to_dataframe().shape == (201, 1)
+    identified = SYSTEM.action("identify")(tmp_path / "r.csv", unknowns=2)
+    assert list(identified.figures()) == ["north_fit", "north_misfit_map", "north_error_vs_time"]
+    plt.close(identified.plot("north_misfit_map"))
+    table = identified.to_dataframe()
+    assert list(table.columns) == ["observed_rad", "fitted_rad", "residual_rad"] and len(table) == 201
+    np.testing.assert_array_equal(table.index, record.to_dataframe().index)
+    assert SYSTEM.figures(object()) == {} and SYSTEM.data_files(object(), tmp_path) == []
 
 
 @settings(max_examples=8, deadline=None)

@@ -19,10 +19,11 @@ Modules:
   with the estimator users run;
 * :mod:`~schuler.ground_gyrocompass.reproduction` -- the source's Tables 1-3 against the toolkit;
 * :mod:`~schuler.ground_gyrocompass.evaluation`, :mod:`~schuler.ground_gyrocompass.results`,
-  :mod:`~schuler.ground_gyrocompass.actions`, :mod:`~schuler.ground_gyrocompass.report`,
-  :mod:`~schuler.ground_gyrocompass.api` --
-  the system on the contract: parameters, ``evaluate`` and ``run_case``, result
-  types and files, ``identify`` and ``simulate``, the report, and ``SYSTEM``;
+  :mod:`~schuler.ground_gyrocompass.files`, :mod:`~schuler.ground_gyrocompass.actions`,
+  :mod:`~schuler.ground_gyrocompass.report`, :mod:`~schuler.ground_gyrocompass.api` --
+  the system on the contract: parameters and ``evaluate`` (a run is its first case
+  with histories), how a run renders and the actions' results, the figures and data
+  files, ``identify`` and ``simulate``, the report, and ``SYSTEM``;
 * :mod:`~schuler.ground_gyrocompass.plots` -- figures.
 """
 

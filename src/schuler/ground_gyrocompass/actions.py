@@ -1,7 +1,8 @@
 """The ground gyrocompass's own commands: ``north identify RECORD`` and ``north simulate -o FILE``.
 
-Both take SI values (and paths) and return a result; the files they read and write
-are handled here, never in the command line: records are CSV files with columns
+Both take SI values (and paths) and return a result that draws its figures
+(:func:`~.files.identification_figures`, :func:`~.files.record_figures`); the
+files they read and write are handled here, never in the command line: records are CSV files with columns
 ``t_s`` (s since the rotor's release) and ``alpha_rad`` (the observed coordinate,
 rad: alpha - alpha0 for the relative reading of Fedorov, Kikot and Shtefan (2020),
 eq. (10), or alpha + c for absolute readings).
@@ -29,6 +30,7 @@ from schuler.ground_gyrocompass.evaluation import (
     records,
     truth_of,
 )
+from schuler.ground_gyrocompass.files import identification_figures, record_figures
 from schuler.ground_gyrocompass.observations import read_record, write_record
 from schuler.ground_gyrocompass.results import NorthIdentification, ObservationRecord
 from schuler.memory import require
@@ -142,10 +144,12 @@ ACTIONS = (
            "The instrument's known values (or nominal starts for identified ones) are options; "
            "--unknowns chooses what is identified, --method the estimator.",
            identify_record, IDENTIFY_PARAMETERS,
-           arguments=(Argument("record", "CSV record with columns t_s and alpha_rad", "RECORD"),)),
+           arguments=(Argument("record", "CSV record with columns t_s and alpha_rad", "RECORD"),),
+           figures=identification_figures),
     Action("simulate",
            "Simulate a run-down record and write it as CSV (columns t_s, alpha_rad).\n\n"
            "The true motion is the closed form (9); --readout-noise and --seed set the read-out noise.",
-           simulate_record, SIMULATE_PARAMETERS, output_file="CSV file to write the record to."),
+           simulate_record, SIMULATE_PARAMETERS, output_file="CSV file to write the record to.",
+           figures=record_figures),
 )
 """The commands ``schuler north identify`` and ``schuler north simulate``."""

@@ -2,11 +2,11 @@
 
 Source: Fedorov, Kikot, Shtefan (2020) (:data:`schuler.references.FEDOROV_2020`).
 The pieces: :mod:`~schuler.ground_gyrocompass.evaluation` (parameters, outputs,
-``evaluate``, ``run_case``), :mod:`~schuler.ground_gyrocompass.reproduction`
+``evaluate``), :mod:`~schuler.ground_gyrocompass.reproduction`
 (``reproduce``), :mod:`~schuler.ground_gyrocompass.report` (``report``),
-:mod:`~schuler.ground_gyrocompass.results` (the result
-types and ``write_files``), :mod:`~schuler.ground_gyrocompass.actions`
-(``identify`` and ``simulate``).
+:mod:`~schuler.ground_gyrocompass.results` (how a run renders, the actions'
+results), :mod:`~schuler.ground_gyrocompass.files` (the figures and data files),
+:mod:`~schuler.ground_gyrocompass.actions` (``identify`` and ``simulate``).
 
 Examples
 --------
@@ -14,6 +14,8 @@ Examples
 >>> r = SYSTEM.run(unknowns=2)
 >>> round(math.degrees(r.north_rad), 6), abs(r.north_error_rad) < 1e-12
 (-1.23, True)
+>>> list(r.to_dataframe().columns), list(r.figures())
+(['observed_rad', 'fitted_rad', 'residual_rad'], ['north_fit', 'north_misfit_map', 'north_error_vs_time'])
 """
 
 from __future__ import annotations
@@ -29,12 +31,12 @@ from schuler.ground_gyrocompass.evaluation import (
     PARAMETERS,
     evaluate,
     member_bytes,
-    run_case,
     sample_count,
 )
+from schuler.ground_gyrocompass.files import data_files, figures
 from schuler.ground_gyrocompass.report import report
 from schuler.ground_gyrocompass.reproduction import REPRODUCE_PARAMETERS, reproduce
-from schuler.ground_gyrocompass.results import write_files
+from schuler.ground_gyrocompass.results import NorthRun
 from schuler.imu.instrument import apply_options, instrument_options
 from schuler.params import Case
 from schuler.references import FEDOROV_2020
@@ -63,10 +65,11 @@ SYSTEM = System(
     parameters=PARAMETERS,
     outputs=OUTPUTS,
     evaluate=evaluate,
-    run_case=run_case,
     reproduce=reproduce,
     reproduce_parameters=REPRODUCE_PARAMETERS,
-    write_files=write_files,
+    figures=figures,
+    data_files=data_files,
+    result_type=NorthRun,
     report=report,
     fidelities=FIDELITIES,
     actions=(*ACTIONS, north_compare_action(PARAMETERS, evaluate)),

@@ -23,7 +23,14 @@ from schuler.ground_gyrocompass.varpro import fit_least_squares
 from schuler.results import Result
 
 
-def _dms(angle_deg: float) -> str:
+def dms_text(angle_deg: float) -> str:
+    """An angle as signed degrees, minutes and seconds to 0.01 arcsec (``-1°13′48.00″``).
+
+    Parameters
+    ----------
+    angle_deg : float
+        The angle, deg.
+    """
     sign = "-" if angle_deg < 0 else "+"
     seconds = round(abs(angle_deg) * 3600.0, 2)
     degrees, rest = divmod(seconds, 3600.0)
@@ -177,7 +184,7 @@ def make_estimate(fit: Fit, time, observed, unknowns, reading, method, inertia, 
         identified=list(fit.names),
         north_deg=math.degrees(-values["alpha0"]),
         north_std_arcsec=None if alpha0_std is None else math.degrees(alpha0_std) * 3600.0,
-        north_dms=_dms(math.degrees(-values["alpha0"])),
+        north_dms=dms_text(math.degrees(-values["alpha0"])),
         alpha0_rad=values["alpha0"],
         alpha0_rad_std=alpha0_std,
         alpha0_dot=values["alpha0_dot"],

@@ -1,4 +1,4 @@
-"""What the ground gyrocompass system evaluates: its parameters, outputs, ``evaluate`` and ``run_case``.
+"""What the ground gyrocompass system evaluates: its parameters, outputs and ``evaluate``.
 
 A case is one run-down record: the true motion of the sensitive element,
 alpha(t) = alpha0 u1(t) + alpha0_dot u2(t) + m u3(t) (eq. (9) of Fedorov, Kikot
@@ -21,6 +21,11 @@ the linearised covariance sigma^2 (J^T J)^-1 at the true parameters
 series from ``cases.random.normal_series("readout_noise", member, 0, samples)``,
 so a member's record depends only on (seed, member), never on chunking.
 
+A run (``evaluate`` with ``histories``) is the first case in full: its
+outputs, the record and the fit to it (histories ``north_record_fit``), and
+beside them ``unknowns``, ``method``, ``reading``, ``readout_noise_rad`` and
+``true_north_rad``.
+
 Fidelities: ``closed`` (default) makes the record from the closed form (9);
 ``simulated`` integrates eqs. (1)-(2) numerically (DOP853), as the source's
 simulator did. They agree to 1e-9 rad (the tests check it).
@@ -37,18 +42,17 @@ from __future__ import annotations
 
 import math
 import sys
-from typing import Any
 
 import numpy as np
 
-from schuler.contract import Cases, Output
+from schuler.contract import Cases, Evaluation, Output
 from schuler.core.geometry import grid_points, horizontal_earth_rate, time_grid
 from schuler.exceptions import IdentificationError, InvalidParameter
 from schuler.ground_gyrocompass import motion
 from schuler.ground_gyrocompass.estimate import NorthEstimate, identify
 from schuler.ground_gyrocompass.monte_carlo import predicted_errors
 from schuler.ground_gyrocompass.observations import observe
-from schuler.ground_gyrocompass.results import NorthRun
+from schuler.ground_gyrocompass.results import RECORD_FIT, record_fit
 from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
 
@@ -390,7 +394,7 @@ def records(time: np.ndarray, cases: Cases, truth: dict[str, np.ndarray], fideli
                              offset=float(truth["offset"][i])) for i in range(len(cases))])
 
 
-def evaluate(cases: Cases) -> dict[str, np.ndarray]:
+def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
 
     Parameters
@@ -398,11 +402,19 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     cases : Cases
         Every parameter of :data:`PARAMETERS` as arrays; ``cases.random`` None
         for the nominal (noise-free) records, else the streams members draw from.
+    histories : bool
+        Whether to give the first case in full (an :class:`~schuler.contract.Evaluation`): its record and
+        fit as the histories ``north_record_fit`` (rad against ``t_s``) and the extras of the module notes.
 
     Returns
     -------
-    dict of ndarray
+    dict of ndarray or Evaluation
         One array per :class:`~schuler.contract.Output` of :data:`OUTPUTS`.
+
+    Raises
+    ------
+    IdentificationError
+        With ``histories``, when the first case's record does not determine the unknowns.
 
     Notes
     -----
@@ -410,15 +422,18 @@ def evaluate(cases: Cases) -> dict[str, np.ndarray]:
     step, unknowns, method, reading); each group's records are made in batches and
     identified one by one by the production estimator. A record the estimator
     cannot identify (:class:`~schuler.exceptions.IdentificationError`) gives NaN
-    estimates and ``converged`` 0; :func:`run_case` raises instead.
+    estimates and ``converged`` 0, except the first case's with ``histories``, which raises.
+
+    Examples
+    --------
+    >>> from schuler.contract import Cases
+    >>> run = evaluate(Cases.from_case(PARAMETERS.case(unknowns=2)), histories=True)
+    >>> round(math.degrees(run["north_rad"][0]), 6), list(run.histories["north_record_fit"].names)
+    (-1.23, ['observed_rad', 'fitted_rad', 'residual_rad'])
     """
-    return _evaluate(cases, strict=False)[0]
-
-
-def _evaluate(cases: Cases, strict: bool) -> tuple[dict[str, np.ndarray], list[NorthEstimate | None]]:
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
-    estimates: list[NorthEstimate | None] = [None] * n
+    first: NorthEstimate | IdentificationError | None = None
     fidelity = cases.fidelity or FIDELITIES[0]
     for index, group in cases.groups("duration", "output_step", "unknowns", "method", "reading"):
         per_sample = fit_bytes_per_sample(str(group["method"][0]), int(group["unknowns"][0]))
@@ -426,16 +441,36 @@ def _evaluate(cases: Cases, strict: bool) -> tuple[dict[str, np.ndarray], list[N
         batch = max(1, BATCH_BYTES // (time.size * RECORD_BYTES_PER_SAMPLE))
         for start in range(0, len(group), batch):
             part = group.take(np.arange(start, min(start + batch, len(group))))
-            values, fits = _evaluate_batch(time, part, fidelity, strict)
+            values, fits = _evaluate_batch(time, part, fidelity)
             where = index[start:start + len(part)]
             for name, array in values.items():
                 out[name][where] = array
-            for i, fit in zip(where, fits):
-                estimates[i] = fit
-    return out, estimates
+            if 0 in where:
+                first = fits[int(np.flatnonzero(where == 0)[0])]
+    if not histories:
+        return out
+    if isinstance(first, IdentificationError):
+        raise first
+    assert first is not None
+    return _run(cases, out, first)
 
 
-def _evaluate_batch(time, cases: Cases, fidelity: str, strict: bool):
+def _run(cases: Cases, outputs: dict[str, np.ndarray], estimate: NorthEstimate) -> Evaluation:
+    """The first case in full: its outputs (counts and the flag as such), record and fit, and what it was."""
+    case = cases.case(0)
+    # a run's counts read as counts and its flag as a flag, where a batch carries them as floats
+    outputs = {**outputs, "converged": outputs["converged"].astype(bool)}
+    for name in ("samples", "model_evaluations"):
+        if np.all(np.isfinite(outputs[name])):
+            outputs[name] = outputs[name].astype(np.int64)
+    extras = {"unknowns": case["unknowns"], "method": case["method"], "reading": case["reading"],
+              "readout_noise_rad": case["readout_noise"], "true_north_rad": -case["alpha0"]}
+    return Evaluation(outputs, histories={RECORD_FIT: record_fit(estimate.time, estimate.observed,
+                                                                 estimate.residuals)},
+                      extras=extras, units={"unknowns": "1"})
+
+
+def _evaluate_batch(time, cases: Cases, fidelity: str):
     truth = truth_of(cases)
     unknowns, method, reading = int(cases["unknowns"][0]), str(cases["method"][0]), str(cases["reading"][0])
     needed = unknowns + (reading == "absolute")
@@ -450,16 +485,15 @@ def _evaluate_batch(time, cases: Cases, fidelity: str, strict: bool):
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     out.update(north_std_predicted_rad=predicted, omega_h=truth["omega_h"], samples=np.full(n, float(time.size)),
                converged=np.zeros(n))
-    estimates: list[NorthEstimate | None] = []
+    # per case its estimate, or the error that refused its record
+    estimates: list[NorthEstimate | IdentificationError] = []
     for i in range(n):
         try:
             estimate = identify_north(time, observed[i], unknowns, decay_rate=float(truth["decay_rate"][i]),
                                       hm=float(cases.float("hm")[i]), inertia=float(cases.float("inertia")[i]),
                                       omega_h=float(truth["omega_h"][i]), reading=reading, method=method)
-        except IdentificationError:
-            if strict:
-                raise
-            estimates.append(None)
+        except IdentificationError as error:
+            estimates.append(error)
             continue
         estimates.append(estimate)
         for name, value in estimate_outputs(estimate).items():
@@ -538,34 +572,5 @@ def estimate_outputs(estimate: NorthEstimate) -> dict[str, float]:
     }
 
 
-def run_case(case: Case, fidelity: str | None = None) -> NorthRun:
-    """One case in full: the outputs of :func:`evaluate` and the estimate with its record (for figures).
-
-    Raises :class:`~schuler.exceptions.IdentificationError` when the record does not
-    determine the unknowns (where :func:`evaluate` gives NaN).
-
-    Parameters
-    ----------
-    case : Case
-        A validated case (SI values).
-    fidelity : str, optional
-        One of the system's fidelities (default: the first).
-
-    Examples
-    --------
-    >>> r = run_case(PARAMETERS.case(unknowns=2))
-    >>> round(math.degrees(r.north_rad), 6), abs(r.north_error_rad) < 1e-12
-    (-1.23, True)
-    """
-    fidelity = fidelity or FIDELITIES[0]
-    outputs, estimates = _evaluate(Cases.from_case(case, fidelity=fidelity), strict=True)
-    values: dict[str, Any] = {name: float(array[0]) for name, array in outputs.items()}
-    values["north_std_rad"] = None if math.isnan(values["north_std_rad"]) else values["north_std_rad"]
-    values["converged"] = bool(values["converged"])
-    return NorthRun(
-        fidelity=fidelity, unknowns=case["unknowns"], method=case["method"], reading=case["reading"],
-        readout_noise_rad=case["readout_noise"], true_north_rad=-case["alpha0"], **values, estimate=estimates[0])
-
-
 __all__ = ["FIDELITIES", "OUTPUTS", "PARAMETERS", "evaluate", "fit_bytes", "identify_north", "member_bytes",
-           "omega_h_of", "record_window", "records", "run_case", "sample_count", "truth_of"]
+           "omega_h_of", "record_window", "records", "sample_count", "truth_of"]

@@ -21,6 +21,7 @@ from typing import ClassVar
 import numpy as np
 
 from schuler.core.geometry import ARCSEC, time_grid, time_grids
+from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
 from schuler.ground_gyrocompass.motion import basis, closed_form
 from schuler.ground_gyrocompass.observations import observe
@@ -204,7 +205,9 @@ def monte_carlo(
     reading : {"relative", "absolute"}
         The observations: alpha(t) - alpha0, or alpha(t) + c (``truth["offset"]``).
     seed : int
-        Seed of the noise generator (one stream drawn in order over durations, noises and records).
+        Seed of the read-out noise: record k of window i and noise level j is member
+        ``(i * len(noises) + j) * members + k`` of the stream ``"readout_noise"``
+        (:class:`~schuler.core.random.RandomStreams`, as ``north run --monte-carlo`` draws).
     nominal : dict, optional
         The instrument's nominal ``decay_rate`` (1/s) and ``coefficient`` (1/s^2)
         handed to the estimator, as ``--lambda`` and ``--hm`` are: the known values
@@ -224,7 +227,7 @@ def monte_carlo(
     """
     if members < 2:
         raise InvalidParameter("members", "need at least 2 Monte Carlo runs")
-    rng = np.random.default_rng(seed)
+    streams = RandomStreams(seed)
     durations = np.asarray(durations, dtype=float)
     noises = np.asarray(noises, dtype=float)
     full = {"specific_torque": 0.0, "offset": 0.0, **truth}
@@ -242,8 +245,9 @@ def monte_carlo(
         angle = closed_form(time, full["alpha0"], full["alpha0_dot"], full["decay_rate"], full["coefficient"],
                             full["specific_torque"])
         for j, noise in enumerate(noises):
-            records = observe(np.broadcast_to(angle, (members, time.size)), full["alpha0"], noise, quantisation,
-                              reading, full["offset"], rng)
+            first = (i * cases + j) * members
+            draws = streams.normal_series("readout_noise", np.arange(first, first + members), 0, time.size)
+            records = observe(angle + noise * draws, full["alpha0"], 0.0, quantisation, reading, full["offset"])
             fits = fit_records(time, records, unknowns, nominal["decay_rate"], nominal["coefficient"], reading)
             error, ok = _north_errors(fits, full["alpha0"])
             error /= ARCSEC

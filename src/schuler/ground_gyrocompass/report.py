@@ -14,10 +14,12 @@ import numpy as np
 
 from schuler.contract import Cases, FigureRef, ReportSection, monte_carlo
 from schuler.core.random import RandomStreams
+from schuler.ground_gyrocompass import files as north_files
 from schuler.ground_gyrocompass import plots
 from schuler.ground_gyrocompass.evaluation import OUTPUTS, PARAMETERS, evaluate
 from schuler.ground_gyrocompass.reproduction import reproduce
-from schuler.ground_gyrocompass.results import error_vs_time_files, write_files
+from schuler.io import save_figure_formats
+from schuler.results import write_result
 from schuler.units import from_unit, to_unit
 
 REPORT_MEMBERS = 50
@@ -77,15 +79,19 @@ def report(outdir: Path) -> ReportSection:
     """
     outdir = Path(outdir)
     reproduction = reproduce(4)
-    files = write_files(reproduction, outdir)
-    files += error_vs_time_files(reproduction.data.estimate, outdir, from_unit(1.0, "arcsec"))
+    reproduction.attach_figures(north_files.figures)
+    files = write_result(reproduction, outdir, north_files.data_files)
+    fit = north_files.RecordFit.of_estimate(reproduction.data.estimate)
+    files += save_figure_formats(north_files.error_vs_time(fit, from_unit(1.0, "arcsec")),
+                                 outdir / "north_error_vs_time")
     std, predicted = accuracy_against_window(REPORT_WINDOWS, REPORT_NOISES, REPORT_MEMBERS)
     series = []
     for j, noise in enumerate(REPORT_NOISES):
         series.append((f'Monte Carlo, noise {noise:g}"', std[:, j], f"C{j}o"))
         series.append((f'predicted (Jacobian), noise {noise:g}"', predicted[:, j], f"C{j}-"))
-    files += plots.plot_error_vs_time(REPORT_WINDOWS, series, outdir / "north_monte_carlo",
-                                      f"Accuracy against time: 4 unknowns, {REPORT_MEMBERS} records per point")
+    files += save_figure_formats(plots.plot_error_vs_time(
+        REPORT_WINDOWS, series, f"Accuracy against time: 4 unknowns, {REPORT_MEMBERS} records per point"),
+        outdir / "north_monte_carlo")
     captions = {
         "north_fit": "The source's simulated run-down (200 s) and the 4-unknown fit; residuals at round-off.",
         "north_misfit_map": "The source's first grid stage for 2 unknowns (Table 1's cells) as a sum of squares: "
