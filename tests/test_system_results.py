@@ -19,16 +19,10 @@ from schuler.core.random import RandomStreams
 from schuler.results import MonteCarloStatistics, SystemResult
 from test_contract import NAMES, light
 
-ON_RUN_CASE = {name for name in NAMES if not get_system(name).evaluates_histories}
-"""Systems not yet moved to the one evaluation (they keep ``run_case`` and ``write_files``): held to the test as
-strict expected failures, so each leaves this set the moment it moves (the set only shrinks)."""
 
-
-@pytest.mark.parametrize("name", [pytest.param(name, marks=pytest.mark.xfail(
-    name in ON_RUN_CASE, reason="still on run_case", strict=True)) for name in NAMES])
+@pytest.mark.parametrize("name", NAMES)
 def test_every_system_runs_through_evaluate_into_one_result_type_that_plots(name):
     system = get_system(name)
-    assert system.evaluates_histories, f"{name} still has run_case"
     result = system.run(**light(name))
     assert type(result) is system.result_type and isinstance(result, SystemResult)
     # run is evaluate by construction: the same outputs, bit for bit

@@ -48,7 +48,7 @@ from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
 from schuler.memory import require_time
 from schuler.params import Case, Parameter, ParameterSet
-from schuler.results import Evaluation, MonteCarloSummary, Output, Result, RunResult, SystemResult, write_result
+from schuler.results import Evaluation, MonteCarloSummary, Output, Result, SystemResult, write_result
 
 RUN_CASE_MEMBERS = 4
 """Members a run in full counts as in a time estimate: its histories cost a few members where the work is large
@@ -86,7 +86,7 @@ class Action:
     write_files : callable, optional
         ``write_files(result, out_dir) -> [paths]`` for an action whose results are
         not the system's own types (a comparison built by another package); None:
-        the system's ``write_files``.
+        the system's one writer.
     figures : callable, optional
         ``figures(result) -> {stem: Figure}`` for an action whose results the
         system's ``figures`` does not draw; None: the system's.
@@ -119,16 +119,11 @@ class System:
     outputs : tuple of Output
         What ``evaluate`` returns.
     evaluate : callable
-        ``evaluate(cases: Cases) -> dict[str, ndarray]`` (vectorised; see the module notes).
-    run_case : callable
-        ``run_case(case: Case, fidelity: str | None) -> Result``: one case in full.
+        ``evaluate(cases: Cases, histories=False) -> Evaluation`` (vectorised; see the module notes).
     reproduce : callable
         ``reproduce(**options) -> Reproduction``: the source's published case.
     reproduce_parameters : ParameterSet
         Options of ``reproduce``.
-    write_files : callable
-        ``write_files(result, out_dir: Path) -> list[Path]`` for the results of
-        ``run``, ``reproduce`` and the actions.
     report : callable
         ``report(figures_dir: Path) -> ReportSection``.
     fidelities : tuple of str
@@ -186,8 +181,6 @@ class System:
     realisation: bool = False
     instrument: Callable[[ParameterSet, Case, Case], Case] | None = None
     instrument_parameters: ParameterSet = field(default_factory=lambda: ParameterSet(()))
-    run_case: Callable[[Case, str | None], Result] | None = None
-    write_files: Callable[[Result, Path], list[Path]] | None = None
     reproduce_parameters: ParameterSet = field(default_factory=lambda: ParameterSet(()))
     fidelities: tuple[str, ...] = ()
     actions: tuple[Action, ...] = ()
@@ -205,11 +198,6 @@ class System:
             replace(action, function=_attaching(action.function, action.figures or self.figures))
             for action in self.actions))
 
-    @property
-    def evaluates_histories(self) -> bool:
-        """Whether ``evaluate`` gives the run in full (``histories=True``): the contract every system moves to."""
-        return self.run_case is None
-
     def write(self, result: Result, out_dir: Path, action: str | None = None) -> list[Path]:
         """Write a result's files into ``out_dir``: its histories as CSV, its figures, the system's data files.
 
@@ -226,9 +214,6 @@ class System:
         if chosen is not None and chosen.write_files is not None:
             # an action whose results another package builds (a comparison) writes its own files
             return chosen.write_files(result, Path(out_dir))
-        if not self.evaluates_histories:
-            assert self.write_files is not None, f"{self.name} declares neither figures nor write_files"
-            return self.write_files(result, Path(out_dir))
         return write_result(result, Path(out_dir), self.data_files)
 
     def case(self, **si_values) -> Case:
@@ -332,10 +317,6 @@ class System:
         summary = None
         if members:
             summary = self.monte_carlo(case, members, streams, fidelity, draw=draw, progress=progress)
-        if not self.evaluates_histories:
-            assert self.run_case is not None
-            result = self.run_case(case, fidelity)
-            return result if summary is None else _with_monte_carlo(result, summary)
         return self.result(case, fidelity, streams if self.realisation else None, summary)
 
     def result(self, case: Case, fidelity: str | None = None, random: RandomStreams | None = None,
@@ -515,12 +496,6 @@ def _count(value, name: str) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
         raise InvalidParameter(name, f"{value!r} must be a whole number >= 0")
     return int(value)
-
-
-def _with_monte_carlo(result: Result, summary: MonteCarloSummary) -> RunResult:
-    if not isinstance(result, RunResult):
-        raise TypeError(f"{type(result).__name__} has no monte_carlo field; derive it from RunResult")
-    return replace(result, monte_carlo=summary)
 
 
 RUN_OPTIONS = (

@@ -28,9 +28,6 @@ LABELS = {"coarse": "coarse (TRIAD)", "inertial_frame": "inertial frame (i0)", "
 
 
 def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     return plt

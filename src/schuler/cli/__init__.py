@@ -93,6 +93,10 @@ def _terminate(signum, frame):
 
 def main(argv=None) -> None:
     """Entry point: run the CLI, turning errors into one line and exit code 2."""
+    import matplotlib
+
+    # the command line writes figures, never shows them: no display needed (the library leaves the backend alone)
+    matplotlib.use("Agg")
     warnings.showwarning = _show_warning
     handled = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if handled else None

@@ -2,9 +2,9 @@
 
 Source: the alternating-pulse calibration article (:data:`schuler.references.PULSE_CALIBRATION`).
 The pieces: :mod:`~schuler.drift_calibration.evaluation` (parameters, outputs,
-``evaluate``, ``run_case``), :mod:`~schuler.drift_calibration.reproduction`
+``evaluate``), :mod:`~schuler.drift_calibration.reproduction`
 (``reproduce``, ``report``), :mod:`~schuler.drift_calibration.results` (the
-result type and ``write_files``).
+result type) and :mod:`~schuler.drift_calibration.plots` (``figures``).
 
 Examples
 --------

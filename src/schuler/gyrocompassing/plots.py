@@ -15,9 +15,6 @@ from schuler.units import to_unit
 
 
 def _figure(rows: int = 1, height: float = 3.2):
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(rows, 1, figsize=(8, height * rows), sharex=rows > 1, squeeze=False)

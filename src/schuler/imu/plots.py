@@ -30,9 +30,6 @@ _ADEV_UNITS = {"gyro": "deg/h", "accel": "ug"}
 
 
 def _figure(columns: int):
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, columns, figsize=(5.2 * columns, 4.6), squeeze=False, sharey=True)
@@ -142,9 +139,6 @@ def channel_curves(analysis: AllanResult | Mapping, sensor: str = "gyro", true_m
     matplotlib.figure.Figure
         The figure, 6.5 x 4.4 in.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     unit = _ADEV_UNITS[sensor]
@@ -191,9 +185,6 @@ def monte_carlo_figure(summary, true_terms: dict):
     matplotlib.figure.Figure
         Box plots of the ratios (terms with a zero true value or no finite sample are left out).
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, axis = plt.subplots(figsize=(6.5, 4.0))

@@ -17,9 +17,6 @@ WIDTH = 7.0
 
 
 def _figure(*args, **kwargs):
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     return plt.subplots(*args, **kwargs)

@@ -20,9 +20,6 @@ SOURCE_TITLES = {
 
 
 def _figure(*args, **kwargs):
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     return plt.subplots(*args, **kwargs)
