@@ -52,7 +52,7 @@ from schuler.core.random import RandomStreams
 from schuler.imu.simulate import ImuSimulator
 from schuler.navigate import imu_noise
 from schuler.navigate.api import SYSTEM
-from schuler.navigate.errors import InitialErrors, SensorErrors, WhiteNoise
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors, WhiteNoise
 from schuler.navigate.mechanization import estimate_memory, navigate
 from schuler.navigate.trajectory import Stationary
 
@@ -111,7 +111,7 @@ def run_schuler(hours: float, errors: bool = True):
                             velocity_error_north=INITIAL["velocity_north"],
                             velocity_error_east=INITIAL["velocity_east"], roll_error=INITIAL["roll"],
                             pitch_error=INITIAL["pitch"], heading_error=INITIAL["heading"]) if errors else None
-    sensors = SensorErrors(gyro_bias=GYRO_BIAS, accel_bias=ACCEL_BIAS) if errors else None
+    sensors = ConstantSensorErrors(gyro_bias=GYRO_BIAS, accel_bias=ACCEL_BIAS) if errors else None
     return navigate(Stationary(latitude=math.radians(LATITUDE_DEG)), hours * 3600.0, imu_rate=IMU_RATE,
                     output_step=OUTPUT_STEP, initial_errors=initial, sensor_errors=sensors)
 
@@ -169,7 +169,7 @@ def batch_errors(members: int):
                             velocity_error_north=normal("vn", 0.1), velocity_error_east=normal("ve", 0.1),
                             roll_error=normal("roll", 1e-4), pitch_error=normal("pitch", 1e-4),
                             heading_error=normal("heading", 1e-3))
-    sensors = SensorErrors(gyro_bias=normal("gyro_bias", 1e-8, 3), accel_bias=normal("accel_bias", 1e-4, 3),
+    sensors = ConstantSensorErrors(gyro_bias=normal("gyro_bias", 1e-8, 3), accel_bias=normal("accel_bias", 1e-4, 3),
                            gyro_scale_factor=normal("gyro_scale", 1e-5, 3),
                            accel_scale_factor=normal("accel_scale", 1e-4, 3),
                            gyro_misalignment=misalignment, accel_misalignment=misalignment)

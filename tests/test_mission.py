@@ -140,7 +140,7 @@ LONG_MISSIONS = {
 @pytest.mark.slow
 @pytest.mark.parametrize("name", LONG_MISSIONS)
 def test_covariance_agrees_with_the_nonlinear_monte_carlo(name):
-    # issue 18: final 1-sigma within 10 % at 1,000 members (sampling error of the RMS about 1.6 %)
+    # the budget's acceptance: final 1-sigma within 10 % at 1,000 members (sampling error of the RMS about 1.6 %)
     values = dict(LONG_MISSIONS[name])
     rate = values.pop("imu_rate")
     setup = setup_of(**values)

@@ -11,7 +11,7 @@ from scipy.optimize import least_squares
 
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
-from schuler.navigate.errors import InitialErrors, SensorErrors
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors
 from schuler.navigate.linear import linear_reference
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.profile import load_profile
@@ -25,7 +25,7 @@ def _errors(scale: float):
     initial = InitialErrors(position_error_north=100 * scale, position_error_east=-50 * scale,
                             velocity_error_north=0.5 * scale, velocity_error_east=-0.3 * scale,
                             roll_error=1e-4 * scale, pitch_error=-2e-4 * scale, heading_error=1e-3 * scale)
-    sensors = SensorErrors(gyro_bias=np.array([1e-7, -2e-7, 1.5e-7]) * scale,
+    sensors = ConstantSensorErrors(gyro_bias=np.array([1e-7, -2e-7, 1.5e-7]) * scale,
                            accel_bias=np.array([1e-3, -5e-4, 2e-4]) * scale)
     return initial, sensors
 

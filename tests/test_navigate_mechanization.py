@@ -13,7 +13,7 @@ from schuler.core.earth import (
     somigliana_gravity,
 )
 from schuler.exceptions import InvalidParameter
-from schuler.navigate.errors import InitialErrors, SensorErrors, WhiteNoise
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors, WhiteNoise
 from schuler.navigate.mechanization import navigate, output_interval
 from schuler.navigate.trajectory import Stationary
 from schuler.navigation_errors.single_channel import spherical_error
@@ -36,8 +36,8 @@ def _north_channel():
 SOURCES = [
     ("tilt", 2e-5, {"initial_errors": InitialErrors(pitch_error=-2e-5)}),
     ("velocity", 0.05, {"initial_errors": InitialErrors(velocity_error_north=0.05)}),
-    ("accelerometer", 1e-4, {"sensor_errors": SensorErrors(accel_bias=[1e-4, 0.0, 0.0])}),
-    ("drift", 1e-8, {"sensor_errors": SensorErrors(gyro_bias=[0.0, -1e-8, 0.0])}),
+    ("accelerometer", 1e-4, {"sensor_errors": ConstantSensorErrors(accel_bias=[1e-4, 0.0, 0.0])}),
+    ("drift", 1e-8, {"sensor_errors": ConstantSensorErrors(gyro_bias=[0.0, -1e-8, 0.0])}),
 ]
 
 
@@ -55,7 +55,7 @@ def test_free_vertical_channel_diverges_as_the_hover_problem():
     # Bollay (1966), Problem 4 on WGS-84: delta_h'' - k1 g0 delta_h = b, k1 g0 = -dg/dh, from rest
     bias = -1e-5  # the accelerometer reads low along body z (down): the computed vertical acceleration is b up
     result = navigate(AT_REST, 3000.0, imu_rate=10.0, output_step=30.0, vertical_channel="free", earth_rate=0.0,
-                      sensor_errors=SensorErrors(accel_bias=[0.0, 0.0, bias]))
+                      sensor_errors=ConstantSensorErrors(accel_bias=[0.0, 0.0, bias]))
     g0 = float(somigliana_gravity(LATITUDE))
     radius = 2.0 / float(gravity_height_coefficient(LATITUDE))  # 2 omega^2 = k1 g0 = 2 g0 / radius
     closed = hover_altitude_error(result.t_s, -bias, radius, g0)
@@ -66,7 +66,7 @@ def test_free_vertical_channel_diverges_as_the_hover_problem():
 def test_baro_loop_settles_on_the_barometer():
     # third-order loop: the accelerometer error is estimated, the height error tends to the baro error
     result = navigate(AT_REST, 4000.0, imu_rate=10.0, output_step=100.0, vertical_channel="baro", baro_error=12.0,
-                      sensor_errors=SensorErrors(accel_bias=[0.0, 0.0, 3e-4]))
+                      sensor_errors=ConstantSensorErrors(accel_bias=[0.0, 0.0, 3e-4]))
     assert result.height_error_m[-1] == pytest.approx(12.0, abs=0.05)
     assert np.abs(result.velocity_error_down_m_s[-1]) < 1e-3
 
@@ -75,7 +75,7 @@ def _mode_differences(scale: float) -> dict[str, tuple[float, float]]:
     """Largest |strapdown - platform| and |strapdown| per channel, errors scaled by ``scale``."""
     initial = InitialErrors(position_error_north=30.0 * scale, velocity_error_east=0.02 * scale,
                             roll_error=1e-5 * scale, pitch_error=-2e-5 * scale, heading_error=3e-4 * scale)
-    sensors = SensorErrors(gyro_bias=np.array([1e-8, -2e-8, 3e-8]) * scale,
+    sensors = ConstantSensorErrors(gyro_bias=np.array([1e-8, -2e-8, 3e-8]) * scale,
                            accel_bias=np.array([1e-4, -5e-5, 0.0]) * scale)
     runs = [navigate(Stationary(latitude=math.radians(45.0)), 4 * 3600.0, imu_rate=10.0, output_step=60.0,
                      mode=mode, initial_errors=initial, sensor_errors=sensors) for mode in ("strapdown", "platform")]
@@ -96,7 +96,7 @@ def test_platform_and_strapdown_agree_at_rest_with_small_errors():
 
 def test_a_batch_runs_its_members_as_single_runs_would():
     errors = InitialErrors(velocity_error_north=[0.1, -0.2, 0.05], heading_error=[0.0, 1e-3, -2e-3])
-    sensors = SensorErrors(gyro_bias=[[1e-8, 0, 0], [0, 2e-8, 0], [0, 0, -3e-8]],
+    sensors = ConstantSensorErrors(gyro_bias=[[1e-8, 0, 0], [0, 2e-8, 0], [0, 0, -3e-8]],
                            accel_scale_factor=[[1e-4, 0, 0], [0, 0, 0], [0, 0, 5e-5]])
     batch = navigate(Stationary(latitude=0.7, heading=1.0), 1800.0, imu_rate=20.0, output_step=60.0,
                      initial_errors=errors, sensor_errors=sensors)
@@ -105,7 +105,7 @@ def test_a_batch_runs_its_members_as_single_runs_would():
         single = navigate(Stationary(latitude=0.7, heading=1.0), 1800.0, imu_rate=20.0, output_step=60.0,
                           initial_errors=InitialErrors(velocity_error_north=errors.velocity_error_north[i],
                                                        heading_error=errors.heading_error[i]),
-                          sensor_errors=SensorErrors(gyro_bias=sensors.gyro_bias[i],
+                          sensor_errors=ConstantSensorErrors(gyro_bias=sensors.gyro_bias[i],
                                                      accel_scale_factor=sensors.accel_scale_factor[i]))
         np.testing.assert_array_equal(batch.position_error_north_m[i], single.position_error_north_m)
         np.testing.assert_array_equal(batch.heading_error_rad[i], single.heading_error_rad)
@@ -173,10 +173,10 @@ def test_navigate_bad_input(kwargs, name):
 @pytest.mark.parametrize("factory, name", [
     (lambda: InitialErrors(roll_error=4.0), "roll_error"),
     (lambda: InitialErrors(velocity_error_north=[np.inf]), "velocity_error_north"),
-    (lambda: SensorErrors(gyro_bias=[1.0, 2.0]), "gyro_bias"),
-    (lambda: SensorErrors(gyro_misalignment=np.eye(3) * 1e-3), "gyro_misalignment"),
-    (lambda: SensorErrors(accel_scale_factor=[0.6, 0, 0]), "accel_scale_factor"),
-    (lambda: SensorErrors(gyro_bias=[[0, 0, 0]] * 2, accel_bias=[[0, 0, 0]] * 3), "gyro_bias"),
+    (lambda: ConstantSensorErrors(gyro_bias=[1.0, 2.0]), "gyro_bias"),
+    (lambda: ConstantSensorErrors(gyro_misalignment=np.eye(3) * 1e-3), "gyro_misalignment"),
+    (lambda: ConstantSensorErrors(accel_scale_factor=[0.6, 0, 0]), "accel_scale_factor"),
+    (lambda: ConstantSensorErrors(gyro_bias=[[0, 0, 0]] * 2, accel_bias=[[0, 0, 0]] * 3), "gyro_bias"),
     (lambda: WhiteNoise(angle_random_walk=-1.0), "angle_random_walk"),
 ])
 def test_error_models_bad_input(factory, name):

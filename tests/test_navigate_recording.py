@@ -16,7 +16,7 @@ from schuler.imu.record import ImuRecord
 from schuler.imu.simulate import simulate_record, static_truth
 from schuler.imu.spec import preset
 from schuler.navigate.api import SYSTEM
-from schuler.navigate.errors import SensorErrors
+from schuler.navigate.errors import ConstantSensorErrors
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.recording import increments, replay
 from schuler.navigate.trajectory import Stationary
@@ -67,7 +67,7 @@ def test_a_constant_bias_record_replays_as_the_synthetic_bias(tmp_path):
     replayed = navigate(Stationary(latitude=LATITUDE, heading=HEADING), 90.0, imu_rate=50.0, output_step=10.0,
                         recorded_increments=increments(record))
     synthetic = navigate(Stationary(latitude=LATITUDE, heading=HEADING), 90.0, imu_rate=50.0, output_step=10.0,
-                         sensor_errors=SensorErrors(gyro_bias=gyro_bias, accel_bias=accel_bias))
+                         sensor_errors=ConstantSensorErrors(gyro_bias=gyro_bias, accel_bias=accel_bias))
     for channel in CHANNELS:
         a, b = np.asarray(getattr(replayed, channel)), np.asarray(getattr(synthetic, channel))
         # the record's Earth rate and gravity (closed form) against the truth's inverse mechanization differ at
@@ -148,7 +148,7 @@ def test_the_psins_recording_drifts_as_its_mean_sensor_errors(run_cli):
     accel_bias = recording.increments[:, 3:].mean(axis=0) / dt - ideal.specific_force_m_s2.mean(axis=0)
     np.testing.assert_allclose(np.degrees(gyro_bias) * 3600, [1.86, -1.16, 0.14], atol=0.01)
     model = navigate(recording.trajectory, 300.0, imu_rate=recording.imu_rate, output_step=10.0,
-                     sensor_errors=SensorErrors(gyro_bias=gyro_bias, accel_bias=accel_bias))
+                     sensor_errors=ConstantSensorErrors(gyro_bias=gyro_bias, accel_bias=accel_bias))
     horizontal = math.hypot(model.position_error_north_m[-1], model.position_error_east_m[-1])
     assert data["final_horizontal_position_error_m"] == pytest.approx(horizontal, rel=0.06)
     assert data["final_position_error_east_m"] == pytest.approx(model.position_error_east_m[-1], rel=0.03)

@@ -17,7 +17,7 @@ from schuler.imu.spec import preset
 from schuler.memory import MemoryBudgetExceeded
 from schuler.navigate import imu_noise
 from schuler.navigate.api import SYSTEM
-from schuler.navigate.errors import InitialErrors, SensorErrors
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors
 from schuler.navigate.evaluation import NOISE_MEMBERS, OUTPUTS, PARAMETERS, setup
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.trajectory import GreatCircle, Stationary
@@ -65,7 +65,7 @@ def test_the_system_runs_the_library_with_the_values_given():
                       initial_errors=InitialErrors(**{k: [values.get(k, 0.0)] for k in (
                           "position_error_north", "position_error_east", "velocity_error_north",
                           "velocity_error_east", "roll_error", "pitch_error", "heading_error")}),
-                      sensor_errors=SensorErrors(gyro_bias=[[values[f"gyro_bias_{a}"] for a in "xyz"]],
+                      sensor_errors=ConstantSensorErrors(gyro_bias=[[values[f"gyro_bias_{a}"] for a in "xyz"]],
                                                  accel_bias=[[values["accel_bias_x"], 0.0, values["accel_bias_z"]]]))
     histories = result.histories["navigate_errors"]
     for name in ("position_error_north_m", "velocity_error_east_m_s", "heading_error_rad", "height_error_m"):
@@ -172,7 +172,8 @@ def test_the_nominal_imu_case_takes_every_constant_at_one_sigma():
     result = SYSTEM.run(imu="tactical", **QUICK)
     constants = imu_noise.representative_constants(model, 1, [0.0, 0.0, -9.8])
     direct = navigate(Stationary(latitude=math.radians(45.0)), 600.0, imu_rate=10.0, output_step=60.0,
-                      sensor_errors=SensorErrors(**constants.as_dict()), initial_errors=InitialErrors(roll_error=[0.0]))
+                      sensor_errors=ConstantSensorErrors(**constants.as_dict()),
+                      initial_errors=InitialErrors(roll_error=[0.0]))
     np.testing.assert_array_equal(result.histories["navigate_errors"]["position_error_east_m"],
                                   direct.position_error_east_m[0])
     assert result.imu == model.name
@@ -182,7 +183,7 @@ def test_the_nominal_imu_case_takes_every_constant_at_one_sigma():
     assert constants.gyro_misalignment[0, 0, 1] == pytest.approx(0.5e-3) and constants.gyro_misalignment[0, 1, 1] == 0
     # the consumer grade's 3 % scale factors and 20 mrad misalignments stay within the library's limits when drawn
     consumer = imu_noise.drawn_constants(preset("consumer"), 0, np.arange(2000))
-    SensorErrors(**consumer.as_dict())
+    ConstantSensorErrors(**consumer.as_dict())
 
 
 def test_g_sensitivity_enters_with_the_specific_force():

@@ -10,7 +10,7 @@ import pytest
 
 from schuler.core.earth import STANDARD_GRAVITY, gravity_height_coefficient, somigliana_gravity
 from schuler.exceptions import SimulationError
-from schuler.navigate.errors import InitialErrors, SensorErrors
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.trajectory import Stationary
 from schuler.navigate.validity import VALID_HEIGHTS, ModelValidityWarning
@@ -78,7 +78,7 @@ def test_a_batch_names_the_member_that_left_the_domain():
     accel[1, 2] = STANDARD_GRAVITY
     with pytest.raises(SimulationError, match=r"fell below -3,189 km .* at t = 739 s \(member 11\)"):
         navigate(Stationary(latitude=LATITUDE), 3600.0, imu_rate=1.0, output_step=60.0, vertical_channel="free",
-                 sensor_errors=SensorErrors(accel_bias=accel), member_ids=[10, 11, 12])
+                 sensor_errors=ConstantSensorErrors(accel_bias=accel), member_ids=[10, 11, 12])
 
 
 def test_a_batch_counts_the_members_past_the_gravity_model():
@@ -86,7 +86,7 @@ def test_a_batch_counts_the_members_past_the_gravity_model():
     accel[1:, 2] = 1e-5 * STANDARD_GRAVITY
     with pytest.warns(ModelValidityWarning, match=r"\(2 of 3 members, member 1 first\)"):
         result = navigate(Stationary(latitude=LATITUDE), 4800.0, imu_rate=10.0, output_step=60.0,
-                          vertical_channel="free", sensor_errors=SensorErrors(accel_bias=accel))
+                          vertical_channel="free", sensor_errors=ConstantSensorErrors(accel_bias=accel))
     assert len(result.warnings) == 1 and np.all(np.isfinite(result.height_error_m))
     assert result.height_error_m[0, -1] > VALID_HEIGHTS[0] > result.height_error_m[1, -1]
 
@@ -94,7 +94,7 @@ def test_a_batch_counts_the_members_past_the_gravity_model():
 def test_the_platform_mechanization_stops_too():
     with pytest.raises(SimulationError, match="fell below -3,189 km"):
         navigate(Stationary(latitude=LATITUDE), 3600.0, imu_rate=1.0, output_step=60.0, mode="platform",
-                 vertical_channel="free", sensor_errors=SensorErrors(accel_bias=[0.0, 0.0, STANDARD_GRAVITY]))
+                 vertical_channel="free", sensor_errors=ConstantSensorErrors(accel_bias=[0.0, 0.0, STANDARD_GRAVITY]))
 
 
 def test_a_run_inside_the_models_is_silent():

@@ -43,21 +43,23 @@ PARAMETERS = ParameterSet((
     Parameter("latitude", "deg", 45.0, "Latitude of the start point.", minimum=-80, maximum=80),
     Parameter("longitude", "deg", 0.0, "Longitude of the start point.", minimum=-180, maximum=360),
     Parameter("height", "m", 0.0, "Height of the mission above the ellipsoid.", minimum=-500, maximum=20000),
-    Parameter("calibration", "", "pulse", "Gyro calibration: pulse (system 3, gyros only) or multi-position "
+    Parameter("calibration", "", "pulse", "Gyro calibration: pulse (schuler calibrate, gyros only) or multi-position "
               "(gyro and accelerometer biases, accelerometer scale factors).", choices=CALIBRATIONS, kind="choice"),
     Parameter("calibration_duration", "s", 600.0, "Time over which the calibration averages.",
               minimum=1, maximum=86400),
     Parameter("pulse_relative_error", "%", 0.34, "Relative error of the pulse method's drift (the source's 0.34 %).",
               minimum=0, maximum=100),
     Parameter("alignment", "", "kalman", "Alignment: kalman (strapdown fine alignment), strapdown-gyrocompass "
-              "(analytic, from the averaged rates and forces), gyrocompass (system 4's physical gyrocompassing) "
-              "or ground-gyrocompass (north from system 5, levelling).",
+              "(analytic, from the averaged rates and forces), gyrocompass (schuler align's physical gyrocompassing) "
+              "or ground-gyrocompass (north from schuler north, levelling).",
               choices=ALIGNMENTS, kind="choice"),
     Parameter("alignment_duration", "s", 300.0, "Duration of the alignment at rest.", minimum=10, maximum=86400),
-    Parameter("gyrocompass_time_constant", "s", 30.0, "Time constant T of system 4's azimuth loop.",
+    Parameter("gyrocompass_time_constant", "s", 30.0, "Time constant T of schuler align's azimuth loop.",
               minimum=1, maximum=3600),
-    Parameter("gyrocompass_damping", "", 0.8, "Damping ratio of system 4's azimuth loop.", minimum=0.1, maximum=10),
-    Parameter("north_reference_error", "arcsec", 10.0, "1-sigma heading error of the ground gyrocompass (system 5).",
+    Parameter("gyrocompass_damping", "", 0.8, "Damping ratio of schuler align's azimuth loop.", minimum=0.1,
+              maximum=10),
+    Parameter("north_reference_error", "arcsec", 10.0,
+              "1-sigma heading error of the ground gyrocompass (schuler north).",
               minimum=0, maximum=36000),
     Parameter("trajectory", "", "cruise", "Mission: stationary, cruise (a geodesic at the speed), flight "
               "(take-off run, two 90-deg turns) or drive (a car's: four stops, 10 m/s in town, 20 m/s on the road, "

@@ -7,7 +7,7 @@ initial errors are the same linear map of its draws as in the covariance
 analysis (:func:`schuler.mission.stages.initial_state_map`), turned into
 roll, pitch and heading errors of the computed attitude
 C_computed = exp(-[phi x]) C_true. Its sensors carry the drawn biases and
-scale factors (:class:`schuler.navigate.errors.SensorErrors`) and white noise of
+scale factors (:class:`schuler.navigate.errors.ConstantSensorErrors`) and white noise of
 the error model's angle and velocity random walks per axis
 (:class:`BlockWhiteNoise`). The strapdown INS then runs along the trajectory
 (:func:`schuler.navigate.mechanization.navigate`), batched over members.
@@ -38,7 +38,7 @@ from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.core.random import RandomStreams
 from schuler.mission.setup import CONSTANT_SOURCES, MissionSetup
 from schuler.mission.stages import alignment_noise, initial_state_map
-from schuler.navigate.errors import InitialErrors, SensorErrors
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.results import NavigationResult
 
@@ -234,7 +234,7 @@ def run_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate: 
             values = np.clip(values, -SCALE_FACTOR_LIMIT, SCALE_FACTOR_LIMIT)
         return values
 
-    sensors = SensorErrors(gyro_bias=triad("gyro_bias"), accel_bias=triad("accel_bias"),
+    sensors = ConstantSensorErrors(gyro_bias=triad("gyro_bias"), accel_bias=triad("accel_bias"),
                            gyro_scale_factor=triad("gyro_scale_factor"),
                            accel_scale_factor=triad("accel_scale_factor"))
     noisy = np.any(setup.gyro_random_walk) or np.any(setup.accel_random_walk)

@@ -2,7 +2,7 @@
 
 There is no published mission to reproduce: the rows hold the closed forms
 each stage follows (Groves 2013 for strapdown levelling and gyrocompassing,
-the KPI manual's (1.21) for system 4) beside what the mission's linear map and
+the KPI manual's (1.21) for schuler align) beside what the mission's linear map and
 covariance analysis compute from the same inputs, and the budget's invariants.
 
 Constants: WGS-84 (schuler.core.earth), Earth rate 7.292115e-5 rad/s,
@@ -82,13 +82,15 @@ def reproduce() -> Reproduction:
     budget = covariance_budget(mission)
     shares = budget.shares()
     rows.append(compare("sum of the shares of the final horizontal position variance", sum(shares.values()), "1",
-                        printed="1", where="issue 18: shares add up to the total", tolerance=Tolerance(0.0, 1e-9)))
+                        printed="1", where="the budget's definition: shares add up to the total",
+                        tolerance=Tolerance(0.0, 1e-9)))
     dominant = max(shares, key=lambda name: shares[name])
     without = covariance_budget(mission, disabled=(dominant,))
     removed = 1.0 - without.horizontal()[-1].sum() / budget.horizontal()[-1].sum()
     rows.append(compare(f"variance removed by switching off the dominant source ({dominant})", removed, "1",
                         printed=f"its share {shares[dominant]:.6f}", value=shares[dominant],
-                        where="issue 18: switching off a source removes its share", tolerance=Tolerance(1e-9)))
+                        where="the budget's definition: switching off a source removes its share",
+                        tolerance=Tolerance(1e-9)))
     return Reproduction(
         system="mission", source=SOURCE,
         constants="WGS-84; Earth rate 7.292115e-5 rad/s; g = 9.80665 m/s^2 in the levelling",

@@ -11,7 +11,7 @@ The life of the instrument, in the order the stages happen:
 1. **Calibration** leaves a residual gyro bias per axis (and, for the
    multi-position method, residual accelerometer biases and scale factors):
 
-   * ``pulse`` (system 3, alternating torque pulses, gyros only): the drift is
+   * ``pulse`` (schuler calibrate, alternating torque pulses, gyros only): the drift is
      measured with the method's relative error rho (the source's 0.34 %) and
      the angle-random-walk floor of averaging over the calibration time T_c:
      sigma_b^2 = (rho b)^2 + N_g^2 / T_c. Accelerometer biases and all scale

@@ -38,7 +38,7 @@ Heading (psi_D; the heading error is -phi_D):
   terms are the same too. The methods differ beyond this model: the
   analytic alignment takes disturbances (sway) into its averages, which a
   Kalman filter with a motion model rejects.
-* ``gyrocompass`` (system 4, physical gyrocompassing of a platform under the
+* ``gyrocompass`` (schuler align, physical gyrocompassing of a platform under the
   control law (1.6)): the steady state (1.21) of the KPI manual, azimuth error
   delta = Dw_xi / (U cos phi) + c_Gamma Dw_z / (c_a U cos phi) with the platform
   drifts Dw_xi = epsilon_E and Dw_z = -epsilon_D (drift = -bias, z up), psi_D =
@@ -46,7 +46,7 @@ Heading (psi_D; the heading error is -phi_D):
   (1.19) driven by the white drift and accelerometer noise (Lyapunov equation
   A P + P A^T + B Q B^T = 0). The duration must cover the loop's settling time
   5 / h (KPI manual, after (1.25)).
-* ``ground-gyrocompass`` (system 5 gives north): the heading error is the
+* ``ground-gyrocompass`` (schuler north gives north): the heading error is the
   ground gyrocompass's own error (source ``north_reference``), independent of
   the IMU's gyros; the platform is levelled as above.
 
@@ -60,7 +60,7 @@ References
 K. R. Britting, *Inertial Navigation Systems Analysis*, Wiley, 1971.
 P. D. Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd ed.,
 Artech House, 2013.
-A. V. Meleshko, "Physical gyrocompassing of a semi-analytic INS", KPI laboratory manual (system 4's source).
+A. V. Meleshko, "Physical gyrocompassing of a semi-analytic INS", KPI laboratory manual (schuler align's source).
 """
 
 from __future__ import annotations
@@ -119,7 +119,7 @@ def _levelling(nabla: np.ndarray, gravity: float) -> tuple[np.ndarray, np.ndarra
 
 
 def gyrocompass_gains(setup: MissionSetup) -> tuple[float, float]:
-    """c_Gamma, c_a (1/s) of system 4's loop from its time constant and damping (KPI manual, Sec. 2).
+    """c_Gamma, c_a (1/s) of schuler align's loop from its time constant and damping (KPI manual, Sec. 2).
 
     Parameters
     ----------

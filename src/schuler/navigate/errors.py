@@ -26,7 +26,7 @@ the IMU layer's error models provide the same method.
 
 Examples
 --------
->>> errors = SensorErrors(gyro_bias=[[1e-7, 0, 0], [2e-7, 0, 0]])
+>>> errors = ConstantSensorErrors(gyro_bias=[[1e-7, 0, 0], [2e-7, 0, 0]])
 >>> errors.members
 2
 >>> noise = WhiteNoise(angle_random_walk=1e-5, velocity_random_walk=1e-4, seed=3)
@@ -162,14 +162,14 @@ class InitialErrors:
 
 
 MAX_SCALE_FACTOR = 0.5
-"""Largest |scale-factor error| of :class:`SensorErrors` (dimensionless)."""
+"""Largest |scale-factor error| of :class:`ConstantSensorErrors` (dimensionless)."""
 
 MAX_MISALIGNMENT = 0.2
-"""Largest |misalignment| of :class:`SensorErrors`, rad."""
+"""Largest |misalignment| of :class:`ConstantSensorErrors`, rad."""
 
 
 @dataclass(frozen=True)
-class SensorErrors:
+class ConstantSensorErrors:
     """Constant sensor errors, body axes, SI (bias = measured - true), shared or one per member.
 
     Parameters

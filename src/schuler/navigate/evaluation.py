@@ -51,7 +51,7 @@ from schuler.memory import budget, require
 from schuler.navigate import imu_noise
 from schuler.navigate.channels import DISPLAY_UNITS, ERROR_CHANNELS, suffix
 from schuler.navigate.drive import drive
-from schuler.navigate.errors import InitialErrors, SensorErrors
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors
 from schuler.navigate.mechanization import (
     MODES,
     NOISE_BLOCK_BYTES,
@@ -302,7 +302,7 @@ def _trajectory(name: str, case: Case) -> tuple[object, float]:
     return GreatCircle(**start, speed=speed, duration=duration), duration
 
 
-def member_errors(cases: Cases, shared: Setup, specific_force) -> tuple[InitialErrors, SensorErrors]:
+def member_errors(cases: Cases, shared: Setup, specific_force) -> tuple[InitialErrors, ConstantSensorErrors]:
     """Each case's initial and constant sensor errors, with its random draws when ``cases.random`` is set.
 
     Parameters
@@ -318,7 +318,7 @@ def member_errors(cases: Cases, shared: Setup, specific_force) -> tuple[InitialE
 
     Returns
     -------
-    InitialErrors, SensorErrors
+    InitialErrors, ConstantSensorErrors
         One entry per case (computed - true; bias = measured - true, body axes, SI).
     """
     initial = {name: cases.float(name) for name in _INITIAL_SIGMAS}
@@ -338,7 +338,7 @@ def member_errors(cases: Cases, shared: Setup, specific_force) -> tuple[InitialE
         constants = drawn.as_dict()
         gyro = gyro + constants.pop("gyro_bias")
         accel = accel + constants.pop("accel_bias")
-    return InitialErrors(**initial), SensorErrors(gyro_bias=gyro, accel_bias=accel, **constants)
+    return InitialErrors(**initial), ConstantSensorErrors(gyro_bias=gyro, accel_bias=accel, **constants)
 
 
 def _noise_model(shared: Setup, cases: Cases) -> ErrorModel | None:

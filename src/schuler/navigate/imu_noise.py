@@ -5,7 +5,7 @@ An :class:`~schuler.imu.error_model.ErrorModel` (a grade preset or a spec file,
 in two parts, body axes (the platform's own axes in the platform mode):
 
 * the **constant errors** of a member, turn-on bias b, scale factors S and
-  misalignment M, become its :class:`~schuler.navigate.errors.SensorErrors`
+  misalignment M, become its :class:`~schuler.navigate.errors.ConstantSensorErrors`
   rows, which the time loops apply exactly to the true increments whatever
   the trajectory does (measured = (I + S + M) true + b dt);
 * the **random processes**, white noise N, flicker B, Gauss-Markov, rate random
@@ -159,7 +159,7 @@ def state_bytes(model: ErrorModel, interval: float) -> int:
 
 @dataclass(frozen=True)
 class MemberConstants:
-    """Constant sensor errors of N members, SI, body axes (as :class:`~schuler.navigate.errors.SensorErrors`).
+    """Constant sensor errors of N members, SI, body axes (as :class:`~schuler.navigate.errors.ConstantSensorErrors`).
 
     ``gyro_bias`` includes G f0 where the noise source does not add it (the nominal case).
     """

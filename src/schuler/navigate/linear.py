@@ -25,7 +25,7 @@ import numpy as np
 
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.exceptions import InvalidParameter
-from schuler.navigate.errors import SensorErrors
+from schuler.navigate.errors import ConstantSensorErrors
 from schuler.navigate.results import NavigationResult
 from schuler.navigation_errors.three_d import propagate_along
 
@@ -81,7 +81,7 @@ def psi_states(result: NavigationResult) -> np.ndarray:
     return np.concatenate([np.stack([north, east], axis=-1), dv[..., :2], psi], axis=-1)
 
 
-def linear_reference(result: NavigationResult, sensor_errors: SensorErrors | None = None,
+def linear_reference(result: NavigationResult, sensor_errors: ConstantSensorErrors | None = None,
                      earth_rate: float = EARTH_RATE) -> LinearComparison:
     """Propagate the WGS-84 psi-angle model beside a nonlinear run (first-order check).
 
@@ -90,7 +90,7 @@ def linear_reference(result: NavigationResult, sensor_errors: SensorErrors | Non
     result : NavigationResult
         From :func:`~schuler.navigate.mechanization.navigate` with
         ``record_interval_means=True`` and vertical channel ``off`` or ``free``.
-    sensor_errors : SensorErrors, optional
+    sensor_errors : ConstantSensorErrors, optional
         The run's sensor errors; the linear model takes the biases
         (nabla = C_b^n b_a, epsilon = -C_b^n b_g with the step's mean C_b^n; the
         platform's sensors sit in NED).
@@ -107,7 +107,7 @@ def linear_reference(result: NavigationResult, sensor_errors: SensorErrors | Non
     if result.vertical_channel == "baro":
         raise InvalidParameter("vertical_channel", "the linear model has no baro loop: use 'off' or 'free'")
     nonlinear = psi_states(result)
-    sensor_errors = sensor_errors or SensorErrors()
+    sensor_errors = sensor_errors or ConstantSensorErrors()
     K = result.t_s.size - 1
     if result.mode == "platform":
         rotation = np.broadcast_to(np.eye(3), (K, 3, 3))

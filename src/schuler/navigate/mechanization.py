@@ -61,7 +61,7 @@ from schuler.core.attitude import (
 from schuler.core.earth import EARTH_RATE, radii_of_curvature, somigliana_gravity
 from schuler.exceptions import InvalidParameter, SimulationError
 from schuler.navigate import _kernels, _loops
-from schuler.navigate.errors import InitialErrors, SensorErrors, SensorNoise
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors, SensorNoise
 from schuler.navigate.results import NavigationResult, TruthSamples
 from schuler.navigate.truth import DEFAULT_CHUNK, TruthGenerator
 from schuler.navigate.validity import ModelValidityWarning, domain_message, validity_messages
@@ -122,7 +122,8 @@ def _check_choice(name: str, value: str, choices: tuple[str, ...]) -> int:
     return choices.index(value)
 
 
-def _members(initial_errors: InitialErrors, sensor_errors: SensorErrors, member_ids) -> tuple[int | None, np.ndarray]:
+def _members(initial_errors: InitialErrors, sensor_errors: ConstantSensorErrors,
+             member_ids) -> tuple[int | None, np.ndarray]:
     sizes = {name: n for name, n in (("initial_errors", initial_errors.members),
                                       ("sensor_errors", sensor_errors.members),
                                       ("member_ids", None if member_ids is None else np.size(member_ids)))
@@ -250,7 +251,7 @@ class _IntervalMeans:
 
 def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_step: float = 10.0,
              mode: str = "strapdown", vertical_channel: str = "off", initial_errors: InitialErrors | None = None,
-             sensor_errors: SensorErrors | None = None, noise: SensorNoise | None = None, member_ids=None,
+             sensor_errors: ConstantSensorErrors | None = None, noise: SensorNoise | None = None, member_ids=None,
              earth_rate: float = EARTH_RATE, coriolis_compensation: bool = True,
              centripetal_compensation: bool = True, earth_rate_latitude: str = "computed",
              azimuth_reference: bool = False, baro_error: float = 0.0,
@@ -272,7 +273,7 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
     vertical_channel : {"free", "off", "baro"}
     initial_errors : InitialErrors, optional
         Errors of the initial state (default none).
-    sensor_errors : SensorErrors, optional
+    sensor_errors : ConstantSensorErrors, optional
         Constant sensor errors (default an ideal IMU).
     noise : SensorNoise, optional
         Additive increment noise (e.g. :class:`~schuler.navigate.errors.WhiteNoise`).
@@ -332,7 +333,7 @@ def navigate(trajectory, duration: float, *, imu_rate: float = 100.0, output_ste
     vertical_code = _VERTICAL_CODES[VERTICAL_CHANNELS[_check_choice("vertical_channel", vertical_channel,
                                                                     VERTICAL_CHANNELS)]]
     initial_errors = initial_errors or InitialErrors()
-    sensor_errors = sensor_errors or SensorErrors()
+    sensor_errors = sensor_errors or ConstantSensorErrors()
     generator = TruthGenerator(trajectory, duration, imu_rate, earth_rate)
     recorded = _recorded(recorded_increments, generator.n_samples, mode)
     every = output_interval(output_step, imu_rate)

@@ -46,7 +46,7 @@ from schuler.gyro_vertical.model import GyroVertical
 from schuler.gyro_vertical.quasi_steady import quasi_steady_response
 from schuler.gyro_vertical.reproduction import worked_example
 from schuler.gyro_vertical.trajectory import GreatCircleTrajectory, SpeedProfile
-from schuler.navigate.errors import InitialErrors, SensorErrors
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.trajectory import GreatCircle, WaypointProfile
 from schuler.navigation_errors.reproduction import FLIGHT_TIME, MAGNITUDES, SPEED
@@ -156,7 +156,8 @@ def bollay_error_sources(imu_rate: float = 10.0, output_step: float = 10.0, eart
     accel_bias = np.stack([accelerometer * one_hot[2], zeros, zeros], axis=1)
     gyro_bias = np.stack([zeros, -drift * one_hot[3], zeros], axis=1)
     run = navigate(profile, FLIGHT_TIME, imu_rate=imu_rate, output_step=output_step, initial_errors=initial,
-                   sensor_errors=SensorErrors(gyro_bias=gyro_bias, accel_bias=accel_bias), earth_rate=earth_rate)
+                   sensor_errors=ConstantSensorErrors(gyro_bias=gyro_bias, accel_bias=accel_bias),
+                   earth_rate=earth_rate)
     t = run.t_s
     channel = np.vstack([run.position_error_east_m[:4], run.position_error_north_m[4:]])
     R_E = float(transverse_radius(0.0))
