@@ -108,6 +108,15 @@ def zoh_discretize(A: np.ndarray, B: np.ndarray, dt) -> tuple[np.ndarray, np.nda
     return phi[..., :n, :n], phi[..., :n, n:]
 
 
+TAYLOR_ORDER = 12
+"""Most terms of the Taylor series of :func:`discretise_noise` after scaling: with the scaled step's norm at most
+:data:`TAYLOR_RADIUS`, the first term left out is below 0.25^13 / 13! = 2.4e-18 of the terms kept (fewer terms
+where the norm is smaller: the first left out below 1e-17)."""
+
+TAYLOR_RADIUS = 0.25
+"""Largest 1-norm of F dt / 2^s over which :func:`discretise_noise` sums its series before doubling s times."""
+
+
 def discretise_noise(F: np.ndarray, noise_input: np.ndarray, dt) -> tuple[np.ndarray, np.ndarray]:
     """Exact transition matrix and process noise of x' = F x + w over dt (Van Loan's block exponential).
 
@@ -130,26 +139,62 @@ def discretise_noise(F: np.ndarray, noise_input: np.ndarray, dt) -> tuple[np.nda
 
     Notes
     -----
-    M = expm([[-F, G Q_c G^T], [0, F^T]] dt) = [[M11, M12], [0, M22]] gives Phi = M22^T
-    and Q = Phi M12 (Van Loan 1978, Sec. 4).
+    This is the exponential of Van Loan's block matrix [[-F, W], [0, F^T]] dt (Van Loan, "Computing
+    integrals involving the matrix exponential", IEEE Trans. Automatic Control 23(3), 1978), taken by scaling
+    and squaring on its two blocks instead of the 2n x 2n matrix: over h = dt / 2^s, with ||F h||_1 <=
+    :data:`TAYLOR_RADIUS`, Phi_h = sum (F h)^k / k! and Q_h = sum h^(k+1) / (k+1)! L^k(W) with
+    L(X) = F X + X F^T (the series of Q' = F Q + Q F^T + W, Q(0) = 0), both to :data:`TAYLOR_ORDER`, on F
+    balanced by one exact diagonal similarity for the batch (:func:`balance`); then s doublings
+    Q_2h = Phi_h Q_h Phi_h^T + Q_h, Phi_2h = Phi_h^2. Every product is a stacked n x n matrix product (no
+    loop over a batch in Python, where scipy's ``expm`` loops): three n x n products a doubling instead of
+    one of 2n x 2n, and within 1e-13 of ``expm`` on the block matrix (tests). W must be symmetric.
 
     Examples
     --------
     >>> Phi, Q = discretise_noise(np.array([[0.0, 1.0], [0.0, 0.0]]), np.diag([0.0, 2.0]), 3.0)
-    >>> Phi.tolist(), Q.round(12).tolist()   # q dt^3/3, q dt^2/2, q dt for a random walk integrated once
+    >>> Phi.round(12).tolist(), Q.round(12).tolist()   # q dt^3/3, q dt^2/2, q dt for a random walk integrated once
     ([[1.0, 3.0], [0.0, 1.0]], [[18.0, 9.0], [9.0, 6.0]])
     """
     F = np.asarray(F, dtype=float)
-    noise_input = np.asarray(noise_input, dtype=float)
-    n = F.shape[-1]
-    M = np.zeros((*np.broadcast_shapes(F.shape[:-2], noise_input.shape[:-2]), 2 * n, 2 * n))
-    M[..., :n, :n] = -F
-    M[..., :n, n:] = noise_input
-    M[..., n:, n:] = np.swapaxes(F, -1, -2)
-    E = scipy.linalg.expm(M * dt)
-    Phi = np.swapaxes(E[..., n:, n:], -1, -2)
-    Q = Phi @ E[..., :n, n:]
+    W = np.asarray(noise_input, dtype=float)
+    shape = np.broadcast_shapes(F.shape, W.shape)
+    n = shape[-1]
+    # balanced first (one exact diagonal similarity for the batch): the norm, so the doublings, shrink by orders
+    # for error states of mixed units (metres beside radians)
+    F, scale = balance(np.broadcast_to(F, shape).reshape(-1, n, n))
+    F = F.reshape(shape)
+    W = np.broadcast_to(W, shape) / np.multiply.outer(scale, scale)
+    norm = float(np.max(np.sum(np.abs(F), axis=-2), initial=0.0)) * dt
+    doublings = max(0, math.ceil(math.log2(norm / TAYLOR_RADIUS))) if norm > TAYLOR_RADIUS else 0
+    h = dt / 2.0**doublings
+    A = F * h
+    Phi = np.broadcast_to(np.eye(n), shape).copy()
+    power = Phi.copy()
+    term = W * h  # h^(k+1)/(k+1)! L^k(W), k = 0
+    Q = term.copy()
+    for k in range(1, _series_order(norm / 2.0**doublings) + 1):
+        power = power @ A / k
+        Phi += power
+        half = A @ term  # F h C: L(C) h = F h C + (F h C)^T, C symmetric
+        term = (half + np.swapaxes(half, -1, -2)) / (k + 1)
+        Q += term
+    for _ in range(doublings):
+        Q = Phi @ Q @ np.swapaxes(Phi, -1, -2) + Q
+        Phi = Phi @ Phi
+    Phi = Phi * (scale[:, None] / scale[None, :])
+    Q = Q * np.multiply.outer(scale, scale)
     return Phi, 0.5 * (Q + np.swapaxes(Q, -1, -2))
+
+
+def _series_order(norm: float) -> int:
+    """Terms of the series for a scaled step of 1-norm ``norm`` (<= :data:`TAYLOR_RADIUS`): the first left out
+    below 1e-17 of the sum (at most :data:`TAYLOR_ORDER`)."""
+    term = 1.0
+    for k in range(1, TAYLOR_ORDER + 1):
+        term *= norm / (k + 1)
+        if term <= 1e-17:
+            return k
+    return TAYLOR_ORDER
 
 
 def uniform_step(t: np.ndarray) -> float | None:
