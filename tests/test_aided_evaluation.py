@@ -62,9 +62,9 @@ def test_the_outage_sigma_describes_the_members_drift():
     predicted = stats["outage_horizontal_error_sigma_m"].mean
     assert predicted > 1.0
     from schuler.aided import analysis
-    from schuler.aided.evaluation import _group
+    from schuler.aided.evaluation import _simulated_group
 
-    run, errors, outages = _group(AIDED.case(**SHORT), np.arange(64), RandomStreams(2))
+    run, errors, outages = _simulated_group(AIDED.case(**SHORT), np.arange(64), RandomStreams(2))
     (drift,) = analysis.outage_drift(run, errors, outages)
     assert drift.horizontal_error_sigma_m == pytest.approx(predicted, rel=0.02)
     assert drift.horizontal_error_end_m == pytest.approx(drift.horizontal_error_sigma_m, rel=0.15)
