@@ -250,3 +250,11 @@ def test_a_monte_carlo_on_files_is_refused(noisy, run_cli):
 
 def test_the_example_configuration_is_complete():
     assert "antlever" in example_configuration() and "corrtime" in example_configuration()
+
+
+def test_a_gap_in_the_imu_stamps_is_refused(noisy, run_cli, tmp_path):
+    paths, _ = noisy
+    lines = paths["imu"].read_text().splitlines()
+    path = tmp_path / "imu.txt"
+    path.write_text("\n".join(lines[:1000] + lines[1010:]) + "\n")  # 10 samples lost: 0.1 s
+    _refused(_run(run_cli, paths, record=path), "--record", "sample 1001", "off the uniform grid")

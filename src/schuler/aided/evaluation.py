@@ -399,10 +399,11 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
                       extras=run_extras(run, errors, outages), units={"inside": "1", "band": "1"})
 
 
-def _sigma_rows(run, t_s: np.ndarray) -> np.ndarray:
-    """The stored covariance in force at each time: the last one stored at or before it."""
+def _variances(run, t_s: np.ndarray) -> np.ndarray:
+    """Position, velocity and psi variances in force at each time (the last covariance stored), shape (n, 9)."""
     rows = np.maximum(np.searchsorted(run.covariance_t_s, t_s + 1e-9) - 1, 0)
-    return run.covariance[0][rows]
+    # the diagonal first: the full matrices at every IMU epoch would be 300,000 x 21 x 21 doubles
+    return np.diagonal(run.covariance[0], axis1=1, axis2=2)[:, :9][rows]
 
 
 def error_histories(run, errors) -> Histories:
@@ -416,7 +417,7 @@ def error_histories(run, errors) -> Histories:
         Its errors against the truth (None: the 1-sigma alone).
     """
     t_s = run.t_s if errors is None else errors.t_s
-    P = _sigma_rows(run, t_s)
+    variance = _variances(run, t_s)
     channels = {}
     if errors is not None:
         channels = {
@@ -425,8 +426,9 @@ def error_histories(run, errors) -> Histories:
             "velocity_north_error_m_s": errors.velocity[0, :, 0], "velocity_east_error_m_s": errors.velocity[0, :, 1],
             "velocity_down_error_m_s": errors.velocity[0, :, 2], "heading_error_rad": errors.heading[0]}
     channels.update({
-        "north_sigma_m": np.sqrt(P[:, 0, 0]), "east_sigma_m": np.sqrt(P[:, 1, 1]), "down_sigma_m": np.sqrt(P[:, 2, 2]),
-        "horizontal_sigma_m": np.sqrt(P[:, 0, 0] + P[:, 1, 1]), "heading_sigma_rad": np.sqrt(P[:, 8, 8])})
+        "north_sigma_m": np.sqrt(variance[:, 0]), "east_sigma_m": np.sqrt(variance[:, 1]),
+        "down_sigma_m": np.sqrt(variance[:, 2]), "horizontal_sigma_m": np.sqrt(variance[:, 0] + variance[:, 1]),
+        "heading_sigma_rad": np.sqrt(variance[:, 8])})
     units = {name: "rad" if name.endswith("_rad") else "m/s" if name.endswith("_m_s") else "m" for name in channels}
     return Histories(t_s, channels, units)
 
@@ -450,7 +452,7 @@ def navigation_histories(run) -> Histories:
     """
     solution = run.solution[0]
     attitude = euler_from_quaternion(solution[:, 6:10])
-    sigma = np.sqrt(np.diagonal(_sigma_rows(run, run.t_s)[:, :9, :9], axis1=1, axis2=2))
+    sigma = np.sqrt(_variances(run, run.t_s))
     values = np.column_stack([solution[:, :6], attitude, sigma])
     return Histories(run.t_s, {name: values[:, k] for k, name in enumerate(NAVIGATION_CHANNELS)},
                      dict(NAVIGATION_CHANNELS))
