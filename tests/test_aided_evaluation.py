@@ -89,7 +89,7 @@ def test_the_command_writes_the_histories_the_figures_and_the_json_names_scripts
     assert set(data["nees"]) == {"position", "velocity", "attitude"} and "band" in data["nis"]
     files = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
     assert files == ["aided_errors.csv", "aided_errors.png", "aided_errors.svg", "aided_outage_drift.png",
-                     "aided_outage_drift.svg"]
+                     "aided_outage_drift.svg", "navigation.csv", "navigation.nav"]
     python = AIDED.run(duration=300.0, outage_start="2 min")
     assert python.position_error_horizontal_rms_m == pytest.approx(data["position_error_horizontal_rms_m"], rel=1e-12)
 
