@@ -62,9 +62,9 @@ def test_the_outage_sigma_describes_the_members_drift():
     predicted = stats["outage_horizontal_error_sigma_m"].mean
     assert predicted > 1.0
     from schuler.aided import analysis
-    from schuler.aided.evaluation import _group
+    from schuler.aided.evaluation import _simulated_group
 
-    run, errors, outages = _group(AIDED.case(**SHORT), np.arange(64), RandomStreams(2))
+    run, errors, outages = _simulated_group(AIDED.case(**SHORT), np.arange(64), RandomStreams(2))
     (drift,) = analysis.outage_drift(run, errors, outages)
     assert drift.horizontal_error_sigma_m == pytest.approx(predicted, rel=0.02)
     assert drift.horizontal_error_end_m == pytest.approx(drift.horizontal_error_sigma_m, rel=0.15)
@@ -89,7 +89,7 @@ def test_the_command_writes_the_histories_the_figures_and_the_json_names_scripts
     assert set(data["nees"]) == {"position", "velocity", "attitude"} and "band" in data["nis"]
     files = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
     assert files == ["aided_errors.csv", "aided_errors.png", "aided_errors.svg", "aided_outage_drift.png",
-                     "aided_outage_drift.svg"]
+                     "aided_outage_drift.svg", "navigation.csv", "navigation.nav"]
     python = AIDED.run(duration=300.0, outage_start="2 min")
     assert python.position_error_horizontal_rms_m == pytest.approx(data["position_error_horizontal_rms_m"], rel=1e-12)
 

@@ -17,5 +17,11 @@ The data it reads:
 - :mod:`~schuler.aided.gnss`  GNSS epochs: the typed record, its simulation from a truth (noise, lever arm,
   latency), outages scheduled or detected;
 - :mod:`~schuler.aided.epochs`  the truth at any times between IMU samples, and the simulated odometer and
-  barometer.
+  barometer;
+- :mod:`~schuler.aided.files`  a run on files: the recording, GNSS, reference and configuration read and checked,
+  KF-GINS's filter model and start.
+
+The system (``schuler aided``): :mod:`~schuler.aided.evaluation` (parameters, outputs, ``evaluate``),
+:mod:`~schuler.aided.outputs` (the result with its navigation, ``navigation.nav`` and ``navigation.csv``),
+:mod:`~schuler.aided.plots`, :mod:`~schuler.aided.reproduction`, :mod:`~schuler.aided.api`.
 """

@@ -18,6 +18,7 @@ Navigation*, Wiley, 2001, Sec. 5.4.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -147,36 +148,40 @@ def _rms(values) -> float:
     return float(np.sqrt(np.mean(np.square(values))))
 
 
-def outage_drift(run: FilterRun, run_errors: Errors, outages) -> list[OutageDrift]:
+def outage_drift(run: FilterRun, run_errors: Errors | None, outages) -> list[OutageDrift]:
     """How far the solution drifted in each outage, beside the filter's own 1-sigma at its end.
 
     Parameters
     ----------
     run : FilterRun
         The run (its covariances give the predicted 1-sigma).
-    run_errors : Errors
-        Its errors against the truth.
+    run_errors : Errors or None
+        Its errors against the truth; None without a truth (the error fields are then NaN).
     outages : sequence of (start, duration)
         The outages, s.
     """
     drifts = []
+    t_s = run.t_s if run_errors is None else run_errors.t_s
     for start, duration in outages:
         end = start + duration
-        inside = (run_errors.t_s > start) & (run_errors.t_s <= end + 1e-9)
+        inside = (t_s > start) & (t_s <= end + 1e-9)
         if not inside.any():
             continue
         # the outage's end, as stored: the last covariance strictly before the epoch that ends it (the covariance
         # stored at that epoch is already updated), and the errors at that same time
         index = max(int(np.searchsorted(run.covariance_t_s, end - 1e-9)) - 1, 0)
-        last = min(int(np.searchsorted(run_errors.t_s, run.covariance_t_s[index] - 1e-9)), run_errors.t_s.size - 1)
         P = run.covariance[:, index]
+        sigma = _rms(np.sqrt(P[:, 0, 0] + P[:, 1, 1]))
+        if run_errors is None:
+            drifts.append(OutageDrift(float(start), float(duration), math.nan, math.nan, math.nan, math.nan, sigma))
+            continue
+        last = min(int(np.searchsorted(run_errors.t_s, run.covariance_t_s[index] - 1e-9)), run_errors.t_s.size - 1)
         drifts.append(OutageDrift(
             float(start), float(duration),
             _rms(run_errors.horizontal[:, inside].max(axis=1)),
             _rms(np.abs(run_errors.position[:, inside, 2]).max(axis=1)),
             _rms(np.abs(run_errors.heading[:, inside]).max(axis=1)),
-            _rms(run_errors.horizontal[:, last]),
-            _rms(np.sqrt(P[:, 0, 0] + P[:, 1, 1]))))
+            _rms(run_errors.horizontal[:, last]), sigma))
     return drifts
 
 

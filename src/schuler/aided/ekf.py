@@ -346,7 +346,8 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
                gnss: GnssRecord | Sequence[GnssRecord], *,
                t0: float = 0.0, lever_arm=(0.0, 0.0, 0.0), covariance_interval: float = 1.0,
                use_velocity: bool = True, gate: float = kalman.DEFAULT_GATE, output_every: int = 1,
-               initial_sensor_errors: np.ndarray | None = None, earth_rate: float = EARTH_RATE) -> FilterRun:
+               initial_sensor_errors: np.ndarray | None = None, initial_sensor_sigma: np.ndarray | None = None,
+               earth_rate: float = EARTH_RATE) -> FilterRun:
     """Filter a batch of members' IMU increments with GNSS fixes (module docstring).
 
     Parameters
@@ -377,6 +378,9 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         IMU samples per stored solution (1: every IMU epoch).
     initial_sensor_errors : ndarray, shape (12,), optional
         Initial estimates b_g (rad/s), b_a (m/s^2), s_g, s_a compensated from the start.
+    initial_sensor_sigma : ndarray, shape (6,) or (12,), optional
+        1-sigma of the sensor-error states at the start (rad/s, m/s^2, then the scale factors, 1); default the
+        model's (:meth:`~schuler.aided.error_state.FilterModel.initial_sigma`; KF-GINS's ``initbgstd`` ... differ).
     earth_rate : float
         Omega, rad/s.
 
@@ -406,7 +410,10 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         guess = np.asarray(initial_sensor_errors, dtype=float)
         navigator.gyro_bias[:], navigator.accel_bias[:] = guess[0:3], guess[3:6]
         navigator.gyro_scale[:], navigator.accel_scale[:] = guess[6:9], guess[9:12]
-    sigma0 = np.concatenate([start.position_sigma, start.velocity_sigma, start.attitude_sigma, model.initial_sigma()])
+    sensor_sigma = model.initial_sigma() if initial_sensor_sigma is None else np.asarray(initial_sensor_sigma, float)
+    if sensor_sigma.shape != (n - 9,):
+        raise InvalidParameter("initial_sensor_sigma", f"needs {n - 9} values for {n} states, got {sensor_sigma.shape}")
+    sigma0 = np.concatenate([start.position_sigma, start.velocity_sigma, start.attitude_sigma, sensor_sigma])
     P = np.broadcast_to(np.diag(sigma0**2), (members, n, n)).copy()
     accumulator = _Accumulator(members)
     point = navigator.point(accumulator)

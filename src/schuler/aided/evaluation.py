@@ -14,15 +14,30 @@ noiseless GNSS; a run without Monte Carlo is member 0 of its seed.
 
 The filter starts at the true solution with a 1-sigma of 1 m, 0.1 m/s, and
 0.1, 0.1, 1 deg (roll, pitch, heading psi): the case of a prior alignment.
+
+With ``record``, ``gnss_file``, ``reference`` or ``kf_gins_config`` set the case
+runs on files instead (:mod:`schuler.aided.files`: times as in the data, the
+outages the GNSS gaps, the errors against the reference or NaN without one);
+the drive's own parameters (``duration``, ``latitude``, ``imu_rate``,
+``gnss_rate``, ``gnss_latency``, ``nominal``) do not apply there. The options a
+file can also set (``imu``, ``lever_arm_*``, ``gnss_sigma_*``, ``aiding``, the
+outages) are "not set" by default, so that one given wins over the file.
+
+Besides the error histories (``aided_errors``) every run keeps its navigation
+solution with the filter's 1-sigma at every IMU epoch (``navigation``:
+:mod:`schuler.aided.outputs` writes it as ``navigation.nav`` and
+``navigation.csv``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
-from schuler.aided import analysis
+from schuler.aided import analysis, files
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import filter_model
 from schuler.aided.gnss import schedule_outages, simulate_gnss
@@ -32,12 +47,22 @@ from schuler.exceptions import InvalidParameter
 from schuler.imu.instrument import resolve_model
 from schuler.imu.simulate import ImuSimulator
 from schuler.memory import require
-from schuler.navigate.drive import drive
-from schuler.navigate.truth import ideal_imu, sample_count
+from schuler.navigate.attitude import euler_from_quaternion
+from schuler.navigate.drive import GroundVehicleProfile, drive
+from schuler.navigate.truth import IdealImu, ideal_imu, sample_count
 from schuler.params import Case, Parameter, ParameterSet
 
 AIDING = ("gnss-position", "gnss-velocity")
 """The measurements ``aiding`` may name."""
+
+SIMULATED_SIGMA = (0.5, 0.5, 1.0)
+"""Simulated GNSS position 1-sigma when not set, north, east, down, m."""
+
+SIMULATED_VELOCITY_SIGMA = 0.05
+"""Simulated GNSS velocity 1-sigma when not set, each axis, m/s."""
+
+SIMULATED_OUTAGE_START = 600.0
+"""Start of a simulated drive's first outage when not set, s."""
 
 START_SIGMA = (1.0, 0.1, (math.radians(0.1), math.radians(0.1), math.radians(1.0)))
 """The filter's initial 1-sigma: position (m, each axis), velocity (m/s), psi (rad: north, east, down)."""
@@ -46,32 +71,47 @@ PARAMETERS = ParameterSet((
     Parameter("duration", "s", 1500.0, "Length of the drive (stops, turns, town and road speeds).",
               minimum=300.0, maximum=4 * 3600.0),
     Parameter("latitude", "deg", 30.5, "Latitude of the drive's start.", minimum=-80.0, maximum=80.0),
-    Parameter("imu", "", "tactical", "IMU: a grade (navigation, tactical, industrial, consumer), a TOML spec file "
-              "or a recording whose identified noise terms are used.", kind="text"),
+    Parameter("imu", "", None, "IMU: a grade (navigation, tactical, industrial, consumer), a TOML spec file "
+              "or a recording whose identified noise terms are used (not set: tactical; with --kf-gins-config its "
+              "imunoise).", kind="text"),
     Parameter("imu_rate", "Hz", 100.0, "IMU sample rate.", minimum=10.0, maximum=1000.0),
     Parameter("gnss_rate", "Hz", 1.0, "GNSS epoch rate.", minimum=0.01, maximum=20.0),
-    Parameter("gnss_sigma_north", "m", 0.5, "GNSS position 1-sigma, north.", minimum=0.0, exclusive_minimum=True,
-              maximum=1e3),
-    Parameter("gnss_sigma_east", "m", 0.5, "GNSS position 1-sigma, east.", minimum=0.0, exclusive_minimum=True,
-              maximum=1e3),
-    Parameter("gnss_sigma_down", "m", 1.0, "GNSS position 1-sigma, down.", minimum=0.0, exclusive_minimum=True,
-              maximum=1e3),
-    Parameter("gnss_velocity_sigma", "m/s", 0.05, "GNSS velocity 1-sigma, each axis.", minimum=0.0,
-              exclusive_minimum=True, maximum=100.0),
-    Parameter("lever_arm_x", "m", 0.0, "IMU to GNSS antenna, body x (forward).", minimum=-50.0, maximum=50.0),
-    Parameter("lever_arm_y", "m", 0.0, "IMU to GNSS antenna, body y (right).", minimum=-50.0, maximum=50.0),
-    Parameter("lever_arm_z", "m", 0.0, "IMU to GNSS antenna, body z (down).", minimum=-50.0, maximum=50.0),
+    Parameter("gnss_sigma_north", "m", None, f"GNSS position 1-sigma, north (not set: {SIMULATED_SIGMA[0]:g} m "
+              "simulated; a file's own).", minimum=0.0, exclusive_minimum=True, maximum=1e3),
+    Parameter("gnss_sigma_east", "m", None, f"GNSS position 1-sigma, east (not set: {SIMULATED_SIGMA[1]:g} m "
+              "simulated; a file's own).", minimum=0.0, exclusive_minimum=True, maximum=1e3),
+    Parameter("gnss_sigma_down", "m", None, f"GNSS position 1-sigma, down (not set: {SIMULATED_SIGMA[2]:g} m "
+              "simulated; a file's own).", minimum=0.0, exclusive_minimum=True, maximum=1e3),
+    Parameter("gnss_velocity_sigma", "m/s", None, "GNSS velocity 1-sigma, each axis (not set: "
+              f"{SIMULATED_VELOCITY_SIGMA:g} m/s simulated; a file's own).", minimum=0.0, exclusive_minimum=True,
+              maximum=100.0),
+    Parameter("lever_arm_x", "m", None, "IMU to GNSS antenna, body x (forward) (not set: 0; with --kf-gins-config "
+              "its antlever).", minimum=-50.0, maximum=50.0),
+    Parameter("lever_arm_y", "m", None, "IMU to GNSS antenna, body y (right) (not set: 0, or antlever).",
+              minimum=-50.0, maximum=50.0),
+    Parameter("lever_arm_z", "m", None, "IMU to GNSS antenna, body z (down) (not set: 0, or antlever).",
+              minimum=-50.0, maximum=50.0),
     Parameter("gnss_latency", "s", 0.0, "Time between a fix's validity and its time tag.", minimum=0.0,
               maximum=1.0),
-    Parameter("outage_start", "s", 600.0, "Start of the first GNSS outage.", minimum=0.0),
+    Parameter("outage_start", "s", None, f"Start of the first GNSS outage (not set: {SIMULATED_OUTAGE_START:g} s "
+              "on a simulated drive; none on files, whose outages are their gaps; times as in the data).",
+              minimum=0.0),
     Parameter("outage_duration", "s", 60.0, "Length of each GNSS outage (0: none).", minimum=0.0),
     Parameter("outage_every", "s", None, "Time from one outage's start to the next's (not set: one outage).",
               minimum=0.0, exclusive_minimum=True),
-    Parameter("aiding", "", "gnss-position,gnss-velocity", "Measurements used, comma-separated: "
-              + ", ".join(AIDING) + ".", kind="text"),
-    Parameter("covariance_interval", "s", 1.0, "Covariance propagation step (a whole number of IMU intervals).",
-              minimum=0.0, exclusive_minimum=True, maximum=60.0),
+    Parameter("aiding", "", None, "Measurements used, comma-separated: " + ", ".join(AIDING) + " (not set: both; "
+              "with --kf-gins-config gnss-position, KF-GINS's model).", kind="text"),
+    Parameter("covariance_interval", "s", 1.0, "Covariance propagation step (a whole number of IMU intervals; on "
+              "files rounded to one).", minimum=0.0, exclusive_minimum=True, maximum=60.0),
     Parameter("nominal", "", False, "Ideal sensors and noiseless GNSS (every random term zero).", kind="flag"),
+    Parameter("record", "", None, "IMU data file: KF-GINS increments (.txt and any other suffix), or the IMU "
+              "layer's CSV, Parquet or PSINS .imu (not set: a simulated drive).", kind="text"),
+    Parameter("gnss_file", "", None, "GNSS file in KF-GINS's format (7 columns, or 13 with velocities).",
+              kind="text"),
+    Parameter("reference", "", None, "Reference navigation in KF-GINS's format (11 columns): the truth of the "
+              "errors, and the start without --kf-gins-config (not set: errors null).", kind="text"),
+    Parameter("kf_gins_config", "", None, "KF-GINS YAML configuration (its paths relative to its folder, then to "
+              "the working directory); options given here win over it.", kind="text"),
 ), owner="aided")
 
 OUTPUTS = (
@@ -90,17 +130,19 @@ SAMPLE_BYTES = 6 * 8 * 3 + 10 * 8 + 3 * 3 * 8
 solution (10) and its three error histories (3 x 3)."""
 
 
-def aiding_of(text: str) -> tuple[bool, bool]:
+def aiding_of(text: str | None, default: str = "gnss-position,gnss-velocity") -> tuple[bool, bool]:
     """Which GNSS measurements ``aiding`` names: (position, velocity); refuses an unknown one with a suggestion.
 
     Parameters
     ----------
-    text : str
-        Comma-separated names of :data:`AIDING`.
+    text : str or None
+        Comma-separated names of :data:`AIDING`; None: ``default``.
+    default : str
+        The measurements used when ``text`` is None.
     """
     import difflib
 
-    names = [name.strip() for name in str(text).split(",") if name.strip()]
+    names = [name.strip() for name in str(default if text is None else text).split(",") if name.strip()]
     for name in names:
         if name not in AIDING:
             hint = difflib.get_close_matches(name, AIDING, n=1)
@@ -112,17 +154,30 @@ def aiding_of(text: str) -> tuple[bool, bool]:
 
 
 def outages_of(case: Case) -> tuple[tuple[float, float], ...]:
-    """The case's scheduled outages inside the drive, (start, duration) pairs, s.
+    """A simulated case's scheduled outages inside the drive, (start, duration) pairs, s.
 
     Parameters
     ----------
     case : Case
-        A validated case (SI: ``outage_start``, ``outage_duration``, ``outage_every``, ``duration`` in s).
+        A validated case (SI: ``outage_start`` (None: :data:`SIMULATED_OUTAGE_START`), ``outage_duration``,
+        ``outage_every``, ``duration`` in s).
     """
-    if case["outage_duration"] <= 0 or case["outage_start"] >= case["duration"]:
+    start = SIMULATED_OUTAGE_START if case["outage_start"] is None else case["outage_start"]
+    if case["outage_duration"] <= 0 or start >= case["duration"]:
         return ()
-    return schedule_outages(case["outage_start"], case["outage_duration"], case["outage_every"],
-                            end=case["duration"])
+    return schedule_outages(start, case["outage_duration"], case["outage_every"], end=case["duration"])
+
+
+def lever_arm(case: Case) -> tuple[float, float, float]:
+    """A simulated case's lever arm, m (an axis not set: 0).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (``lever_arm_x|y|z`` in m or None).
+    """
+    return tuple(0.0 if case[name] is None else float(case[name])  # type: ignore[return-value]
+                 for name in ("lever_arm_x", "lever_arm_y", "lever_arm_z"))
 
 
 def member_bytes(case: Case) -> int:
@@ -144,36 +199,121 @@ def _start(path, members: int) -> Start:
                  np.repeat(q0, members, 0), np.full(3, position), np.full(3, velocity), np.asarray(attitude))
 
 
-def _group(case: Case, members: np.ndarray, streams):
-    """One group of members of the same case: the filter run, its errors and the outages."""
+@dataclass(frozen=True, eq=False)
+class SimulatedInputs:
+    """What a simulated case's members are filtered from (SI; times from the drive's start).
+
+    Attributes
+    ----------
+    path : GroundVehicleProfile
+        The drive (:func:`schuler.navigate.drive.drive`).
+    truth : IdealImu
+        Its truth and ideal increments at every IMU sample.
+    increments : ndarray, shape (N, n, 6)
+        Each member's measured dtheta (rad) and dv (m/s).
+    gnss : list of GnssRecord
+        Each member's GNSS epochs (outages removed).
+    outages : tuple of (float, float)
+        The scheduled outages, (start, duration), s.
+    lever_arm : tuple of float
+        IMU to antenna, body axes, m.
+    use_velocity : bool
+        Whether the GNSS velocities are simulated and used.
+    """
+
+    path: GroundVehicleProfile
+    truth: IdealImu
+    increments: np.ndarray
+    gnss: list
+    outages: tuple[tuple[float, float], ...]
+    lever_arm: tuple[float, float, float]
+    use_velocity: bool
+
+
+def simulated_inputs(case: Case, members: np.ndarray, streams) -> SimulatedInputs:
+    """The drive, each member's IMU data and GNSS epochs of a simulated case (module docstring).
+
+    Parameters
+    ----------
+    case : Case
+        A validated simulated case (SI).
+    members : ndarray of int
+        Member numbers (the addresses of the random draws).
+    streams : RandomStreams or None
+        Where the IMU errors and the GNSS noise come from; None (or ``nominal``): none.
+    """
     _, use_velocity = aiding_of(case["aiding"])
-    require(member_bytes(case) * members.size, f"{members.size} members of this aided run", "--duration or --imu-rate")
     path = drive(latitude=case["latitude"], duration=case["duration"])
     truth = ideal_imu(path, case["duration"], case["imu_rate"])
     dt = truth.interval_s
     ideal = np.concatenate([truth.angle_increment_rad, truth.velocity_increment_m_s], axis=1)
-    model = resolve_model(case["imu"])
     noisy = streams is not None and not case["nominal"]
     if noisy:
-        simulator = ImuSimulator(model, dt, true_gyro_rad_s=truth.angle_increment_rad / dt,
+        simulator = ImuSimulator(resolve_model(_imu(case)), dt, true_gyro_rad_s=truth.angle_increment_rad / dt,
                                  true_accel_m_s2=truth.velocity_increment_m_s / dt, seed=streams.seed)
         gyro, accel = simulator.window(members, 0, ideal.shape[0])
         increments = np.concatenate([gyro, accel], axis=-1) * dt
     else:
         increments = np.broadcast_to(ideal, (members.size,) + ideal.shape)
-    sigma = (case["gnss_sigma_north"], case["gnss_sigma_east"], case["gnss_sigma_down"])
-    lever = (case["lever_arm_x"], case["lever_arm_y"], case["lever_arm_z"])
-    outages = outages_of(case)
+    sigma = tuple(fallback if case[name] is None else case[name] for name, fallback in
+                  zip(("gnss_sigma_north", "gnss_sigma_east", "gnss_sigma_down"), SIMULATED_SIGMA))
+    velocity_sigma = SIMULATED_VELOCITY_SIGMA if case["gnss_velocity_sigma"] is None else case["gnss_velocity_sigma"]
+    lever, outages = lever_arm(case), outages_of(case)
     gnss = [simulate_gnss(path, case["duration"], imu_rate=case["imu_rate"], gnss_rate=case["gnss_rate"],
-                          position_sigma=sigma, velocity_sigma=(case["gnss_velocity_sigma"],) * 3 if use_velocity
-                          else None, lever_arm=lever, latency=case["gnss_latency"], outages=outages,
+                          position_sigma=sigma, velocity_sigma=(velocity_sigma,) * 3 if use_velocity else None,
+                          lever_arm=lever, latency=case["gnss_latency"], outages=outages,
                           streams=streams if noisy else None, member=int(m)) for m in members]
-    run = run_filter(increments, dt, _start(path, members.size), filter_model(model), gnss, lever_arm=lever,
-                     covariance_interval=case["covariance_interval"], use_velocity=use_velocity)
+    return SimulatedInputs(path, truth, increments, gnss, outages, lever, use_velocity)
+
+
+def _imu(case: Case) -> str:
+    return "tactical" if case["imu"] is None else case["imu"]
+
+
+def _simulated_group(case: Case, members: np.ndarray, streams):
+    """One group of members of the same simulated case: the filter run, its errors and the outages."""
+    require(member_bytes(case) * members.size, f"{members.size} members of this aided run", "--duration or --imu-rate")
+    data = simulated_inputs(case, members, streams)
+    run = run_filter(data.increments, data.truth.interval_s, _start(data.path, members.size),
+                     filter_model(resolve_model(_imu(case))), data.gnss, lever_arm=data.lever_arm,
+                     covariance_interval=case["covariance_interval"], use_velocity=data.use_velocity)
+    truth = data.truth
     true = analysis.Truth(truth.latitude_rad, truth.longitude_rad, truth.height_m, truth.velocity_ned_m_s,
                           truth.quaternion)
-    errors = analysis.errors(run, _at(true, run.t_s, truth.t_s))
-    return run, errors, outages
+    return run, analysis.errors(run, _at(true, run.t_s, truth.t_s)), data.outages
+
+
+def _file_group(case: Case, members: np.ndarray):
+    """A case on files (one member: the data have no random terms of their own).
+
+    Returns the run where the reference covers it, its errors (None without a reference), the outages and the whole
+    run.
+    """
+    if members.size > 1:
+        raise InvalidParameter("monte_carlo", "a run on files has no random terms: every member would be the same")
+    inputs = files.read_inputs(case)
+    config = inputs.configuration
+    kfgins_model = config is not None and case["imu"] is None
+    _, use_velocity = aiding_of(case["aiding"], "gnss-position" if config is not None else
+                                "gnss-position,gnss-velocity")
+    if kfgins_model:
+        assert config is not None
+        model, initial, sigma = files.kfgins_model(config)
+    else:
+        model, initial, sigma = filter_model(resolve_model(_imu(case))), None, None
+    dt = inputs.interval_s
+    steps = max(round(case["covariance_interval"] / dt), 1)  # a whole number of the data's IMU intervals
+    run = run_filter(inputs.increments, dt, files.start_of(inputs, START_SIGMA), model, inputs.gnss, t0=inputs.t0_s,
+                     lever_arm=files.lever_arm_of(case, config), covariance_interval=steps * dt,
+                     use_velocity=use_velocity, initial_sensor_errors=initial, initial_sensor_sigma=sigma)
+    if inputs.reference is None:
+        return run, None, inputs.outages, run
+    kept, latitude, longitude, height, velocity, quaternion = files.reference_at(inputs.reference, run.t_s)
+    if not kept.any():
+        raise InvalidParameter("reference", "no output time falls inside the reference's span")
+    inside = dataclasses.replace(run, t_s=run.t_s[kept], solution=run.solution[:, kept])
+    return inside, analysis.errors(inside, analysis.Truth(latitude, longitude, height, velocity, quaternion)), \
+        inputs.outages, run
 
 
 def _at(truth: analysis.Truth, t_s: np.ndarray, grid: np.ndarray) -> analysis.Truth:
@@ -188,27 +328,34 @@ def _rms(values: np.ndarray) -> np.ndarray:
 
 
 def _summaries(run, errors, outages) -> dict[str, np.ndarray]:
-    drifts = [analysis.outage_drift(_member(run, m), _member(errors, m), outages) for m in range(run.solution.shape[0])]
-    worst = np.array([max((d.horizontal_error_max_m for d in member), default=math.nan) for member in drifts])
-    sigma = np.array([max(member, key=lambda d: d.horizontal_error_max_m).horizontal_error_sigma_m if member
-                      else math.nan for member in drifts])
-    velocity = np.hypot(errors.velocity[..., 0], errors.velocity[..., 1])
-    return {
-        "position_error_horizontal_rms_m": _rms(errors.horizontal),
-        "position_error_horizontal_max_m": errors.horizontal.max(axis=-1),
-        "position_error_vertical_rms_m": _rms(errors.position[..., 2]),
-        "velocity_error_horizontal_rms_m_s": _rms(velocity),
-        "heading_error_rms_rad": _rms(errors.heading),
-        "outage_horizontal_error_max_m": worst,
-        "outage_horizontal_error_sigma_m": sigma,
-        "rejected_measurements": run.rejected.astype(float),
-    }
+    members = run.solution.shape[0]
+    drifts = [analysis.outage_drift(_member(run, m), None if errors is None else _member(errors, m), outages)
+              for m in range(members)]
+
+    def largest(member):
+        return max(member, key=lambda d: d.horizontal_error_max_m if errors is not None
+                   else d.horizontal_error_sigma_m)
+
+    worst = np.array([largest(member).horizontal_error_max_m if member else math.nan for member in drifts])
+    sigma = np.array([largest(member).horizontal_error_sigma_m if member else math.nan for member in drifts])
+    summary = {name: np.full(members, math.nan) for name in (
+        "position_error_horizontal_rms_m", "position_error_horizontal_max_m", "position_error_vertical_rms_m",
+        "velocity_error_horizontal_rms_m_s", "heading_error_rms_rad")}
+    if errors is not None:
+        velocity = np.hypot(errors.velocity[..., 0], errors.velocity[..., 1])
+        summary.update({
+            "position_error_horizontal_rms_m": _rms(errors.horizontal),
+            "position_error_horizontal_max_m": errors.horizontal.max(axis=-1),
+            "position_error_vertical_rms_m": _rms(errors.position[..., 2]),
+            "velocity_error_horizontal_rms_m_s": _rms(velocity),
+            "heading_error_rms_rad": _rms(errors.heading),
+        })
+    return {**summary, "outage_horizontal_error_max_m": worst, "outage_horizontal_error_sigma_m": sigma,
+            "rejected_measurements": run.rejected.astype(float)}
 
 
 def _member(value, m: int):
     """Member ``m`` alone of a filter run or of its errors (leading axis kept, length 1)."""
-    import dataclasses
-
     fields = {}
     for f in dataclasses.fields(value):
         item = getattr(value, f.name)
@@ -225,76 +372,130 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
     ----------
     cases : Cases
         A batch of validated cases (SI); ``cases.random`` draws the IMU errors and GNSS noise of member
-        ``cases.members[i]`` (None: the nominal case).
+        ``cases.members[i]`` (None: the nominal case). A case on files (:mod:`schuler.aided.files`) is one member.
     histories : bool
-        Whether to return the first case's error histories, 1-sigma envelopes, outages and consistency.
+        Whether to return the first case's error histories, 1-sigma envelopes, navigation solution, outages and
+        consistency.
     """
     outputs = {output.name: np.full(len(cases), math.nan) for output in OUTPUTS}
     kept = None
     for index, group in cases.groups(*[p.name for p in PARAMETERS]):
         case = group.case(0)
-        run, errors, outages = _group(case, group.members, cases.random)
+        if files.is_file_case(case):
+            run, errors, outages, full = _file_group(case, group.members)
+        else:
+            run, errors, outages = _simulated_group(case, group.members, cases.random)
+            full = run
         for name, values in _summaries(run, errors, outages).items():
             outputs[name][index] = values
         if histories and kept is None and 0 in index:
-            kept = (case, _member(run, 0), _member(errors, 0), outages)
+            # the navigation at every IMU epoch (full), the errors where the reference covers the run (run)
+            kept = (_member(run, 0), None if errors is None else _member(errors, 0), outages, _member(full, 0))
     if not histories or kept is None:
         return Evaluation(outputs)
-    case, run, errors, outages = kept
-    return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors)},
+    run, errors, outages, full = kept
+    return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors),
+                                          "navigation": navigation_histories(full)},
                       extras=run_extras(run, errors, outages), units={"inside": "1", "band": "1"})
 
 
+def _variances(run, t_s: np.ndarray) -> np.ndarray:
+    """Position, velocity and psi variances in force at each time (the last covariance stored), shape (n, 9)."""
+    rows = np.maximum(np.searchsorted(run.covariance_t_s, t_s + 1e-9) - 1, 0)
+    # the diagonal first: the full matrices at every IMU epoch would be 300,000 x 21 x 21 doubles
+    return np.diagonal(run.covariance[0], axis1=1, axis2=2)[:, :9][rows]
+
+
 def error_histories(run, errors) -> Histories:
-    """One member's errors and the filter's 1-sigma of each, at every output time (SI).
+    """One member's errors and the filter's 1-sigma of each, at every output time (SI; no errors without a truth).
 
     Parameters
     ----------
     run : FilterRun
         A filter run of one member.
-    errors : analysis.Errors
-        Its errors against the truth.
+    errors : analysis.Errors or None
+        Its errors against the truth (None: the 1-sigma alone).
     """
-    rows = np.maximum(np.searchsorted(run.covariance_t_s, errors.t_s + 1e-9) - 1, 0)
-    P = run.covariance[0][rows]
-    channels = {
-        "north_error_m": errors.position[0, :, 0], "east_error_m": errors.position[0, :, 1],
-        "down_error_m": errors.position[0, :, 2], "horizontal_error_m": errors.horizontal[0],
-        "velocity_north_error_m_s": errors.velocity[0, :, 0], "velocity_east_error_m_s": errors.velocity[0, :, 1],
-        "velocity_down_error_m_s": errors.velocity[0, :, 2], "heading_error_rad": errors.heading[0],
-        "north_sigma_m": np.sqrt(P[:, 0, 0]), "east_sigma_m": np.sqrt(P[:, 1, 1]), "down_sigma_m": np.sqrt(P[:, 2, 2]),
-        "horizontal_sigma_m": np.sqrt(P[:, 0, 0] + P[:, 1, 1]), "heading_sigma_rad": np.sqrt(P[:, 8, 8]),
-    }
+    t_s = run.t_s if errors is None else errors.t_s
+    variance = _variances(run, t_s)
+    channels = {}
+    if errors is not None:
+        channels = {
+            "north_error_m": errors.position[0, :, 0], "east_error_m": errors.position[0, :, 1],
+            "down_error_m": errors.position[0, :, 2], "horizontal_error_m": errors.horizontal[0],
+            "velocity_north_error_m_s": errors.velocity[0, :, 0], "velocity_east_error_m_s": errors.velocity[0, :, 1],
+            "velocity_down_error_m_s": errors.velocity[0, :, 2], "heading_error_rad": errors.heading[0]}
+    channels.update({
+        "north_sigma_m": np.sqrt(variance[:, 0]), "east_sigma_m": np.sqrt(variance[:, 1]),
+        "down_sigma_m": np.sqrt(variance[:, 2]), "horizontal_sigma_m": np.sqrt(variance[:, 0] + variance[:, 1]),
+        "heading_sigma_rad": np.sqrt(variance[:, 8])})
     units = {name: "rad" if name.endswith("_rad") else "m/s" if name.endswith("_m_s") else "m" for name in channels}
-    return Histories(errors.t_s, channels, units)
+    return Histories(t_s, channels, units)
+
+
+NAVIGATION_CHANNELS = {
+    "latitude_rad": "rad", "longitude_rad": "rad", "height_m": "m", "velocity_north_m_s": "m/s",
+    "velocity_east_m_s": "m/s", "velocity_down_m_s": "m/s", "roll_rad": "rad", "pitch_rad": "rad", "yaw_rad": "rad",
+    "north_sigma_m": "m", "east_sigma_m": "m", "down_sigma_m": "m", "velocity_north_sigma_m_s": "m/s",
+    "velocity_east_sigma_m_s": "m/s", "velocity_down_sigma_m_s": "m/s", "psi_north_sigma_rad": "rad",
+    "psi_east_sigma_rad": "rad", "psi_down_sigma_rad": "rad"}
+"""The ``navigation`` histories: the solution and the filter's 1-sigma of position, velocity and psi (NED)."""
+
+
+def navigation_histories(run) -> Histories:
+    """One member's navigation solution and the filter's 1-sigma at every output time (SI).
+
+    Parameters
+    ----------
+    run : FilterRun
+        A filter run of one member.
+    """
+    solution = run.solution[0]
+    attitude = euler_from_quaternion(solution[:, 6:10])
+    sigma = np.sqrt(_variances(run, run.t_s))
+    values = np.column_stack([solution[:, :6], attitude, sigma])
+    return Histories(run.t_s, {name: values[:, k] for k, name in enumerate(NAVIGATION_CHANNELS)},
+                     dict(NAVIGATION_CHANNELS))
 
 
 def run_extras(run, errors, outages) -> dict:
     """The JSON-safe results beside the outputs: each outage's drift, NEES and NIS consistency, rejected epochs.
 
+    Without a truth (``errors`` None) the error keys are None and the filter's 1-sigma remain.
+
     Parameters
     ----------
     run : FilterRun
         A filter run of one member.
-    errors : analysis.Errors
+    errors : analysis.Errors or None
         Its errors against the truth.
     outages : sequence of (float, float)
         The outages, (start, duration), s.
     """
+    import scipy.stats
+
     drifts = analysis.outage_drift(run, errors, outages)
-    check = analysis.consistency(run, errors)
     accepted = run.accepted[0]
     nis = run.nis[0][accepted]
     dof = run.residual.shape[-1]
-    import scipy.stats
-
     low, high = scipy.stats.chi2.ppf([0.005, 0.995], dof)
+    if errors is not None:
+        check = analysis.consistency(run, errors)
+        nees = {name: {"inside": check.inside[name], "band": list(check.band)} for name in check.inside}
+    else:
+        band = list(scipy.stats.chi2.ppf([0.005, 0.995], 3))
+        nees = {name: {"inside": None, "band": band} for name in analysis.GROUPS}
+
+    def number(value):
+        return None if math.isnan(value) else value
+
     return {
         "outages": [{"start_s": d.start_s, "duration_s": d.duration_s,
-                     "horizontal_error_max_m": d.horizontal_error_max_m, "vertical_error_max_m": d.vertical_error_max_m,
-                     "heading_error_max_rad": d.heading_error_max_rad,
+                     "horizontal_error_max_m": number(d.horizontal_error_max_m),
+                     "vertical_error_max_m": number(d.vertical_error_max_m),
+                     "heading_error_max_rad": number(d.heading_error_max_rad),
                      "horizontal_error_sigma_m": d.horizontal_error_sigma_m} for d in drifts],
-        "nees": {name: {"inside": check.inside[name], "band": list(check.band)} for name in check.inside},
+        "nees": nees,
         "nis": {"inside": float(np.mean((nis >= low) & (nis <= high))) if nis.size else None,
                 "band": [float(low), float(high)]},
     }

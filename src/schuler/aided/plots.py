@@ -13,8 +13,14 @@ def _outage_spans(axis, outages, scale: float = 1.0 / 60.0) -> None:
         axis.axvspan(start * scale, (start + duration) * scale, color="0.85", lw=0)
 
 
+PLOTTED_POINTS = 4000
+"""Points drawn per curve at most: a 200-Hz run is thinned to a stride (the figure shows minutes, not samples)."""
+
+
 def error_envelopes(histories, outages):
     """North, east, down and heading errors of one member with the filter's +-3-sigma (outages shaded).
+
+    Without a truth (no error channels) the envelopes alone are drawn.
 
     Parameters
     ----------
@@ -25,21 +31,26 @@ def error_envelopes(histories, outages):
     """
     import matplotlib.pyplot as plt
 
-    minutes = histories.time / 60.0
+    stride = max(1, int(np.ceil(histories.time.size / PLOTTED_POINTS)))
+    origin = histories.time[0] if histories.time.size else 0.0  # seconds of week on files: minutes from the start
+    minutes = (histories.time[::stride] - origin) / 60.0
     fig, axes = plt.subplots(4, 1, sharex=True, figsize=(8, 8.5))
     rows = [("north_error_m", "north_sigma_m", "north [m]", 1.0), ("east_error_m", "east_sigma_m", "east [m]", 1.0),
             ("down_error_m", "down_sigma_m", "down [m]", 1.0),
             ("heading_error_rad", "heading_sigma_rad", "heading [deg]", float(to_unit(1.0, "deg")))]
+    shifted = [{**o, "start_s": o["start_s"] - origin} for o in outages]
     for axis, (error, sigma, label, scale) in zip(axes, rows):
-        _outage_spans(axis, outages)
-        envelope = 3 * histories[sigma] * scale
+        _outage_spans(axis, shifted)
+        envelope = 3 * histories[sigma][::stride] * scale
         axis.fill_between(minutes, -envelope, envelope, color="tab:blue", alpha=0.2, lw=0, label="+-3 sigma")
-        axis.plot(minutes, histories[error] * scale, color="tab:red", lw=0.8, label="error")
+        if error in histories:
+            axis.plot(minutes, histories[error][::stride] * scale, color="tab:red", lw=0.8, label="error")
         axis.set_ylabel(label)
         axis.grid(True, alpha=0.3)
     axes[0].legend(loc="upper right", fontsize=9)
-    axes[0].set_title("Aided INS: errors and the filter's +-3-sigma (GNSS outages shaded)")
-    axes[-1].set_xlabel("time [min]")
+    truth = "errors and " if "north_error_m" in histories else ""
+    axes[0].set_title(f"Aided INS: {truth}the filter's +-3-sigma (GNSS outages shaded)")
+    axes[-1].set_xlabel("time from the start [min]")
     fig.tight_layout()
     return fig
 
@@ -56,9 +67,12 @@ def outage_drift(outages):
 
     fig, axis = plt.subplots(figsize=(7, 3.5))
     x = np.arange(len(outages))
-    axis.bar(x - 0.2, [o["horizontal_error_max_m"] for o in outages], 0.4, label="largest horizontal error")
+    if all(o["horizontal_error_max_m"] is not None for o in outages):
+        axis.bar(x - 0.2, [o["horizontal_error_max_m"] for o in outages], 0.4, label="largest horizontal error")
     axis.bar(x + 0.2, [o["horizontal_error_sigma_m"] for o in outages], 0.4, label="filter 1-sigma at the end")
-    axis.set_xticks(x, [f"{o['start_s'] / 60:.0f} min, {o['duration_s']:.0f} s" for o in outages])
+    # a simulated drive's times count from its start; a file's are seconds of week, shown as they are
+    axis.set_xticks(x, [(f"{o['start_s'] / 60:.0f} min" if o["start_s"] < 86_400 else f"{o['start_s']:.0f} s")
+                        + f", {o['duration_s']:.0f} s" for o in outages])
     axis.set_ylabel("horizontal [m]")
     axis.set_title("Drift through each GNSS outage")
     axis.legend(fontsize=9)
