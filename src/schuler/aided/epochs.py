@@ -243,7 +243,7 @@ def body_rate(trajectory, t) -> np.ndarray:
 
     Parameters
     ----------
-    trajectory
+    trajectory : Trajectory
         An object with ``kinematics(t) -> (velocity (n, 3), q_bn (n, 4))``.
     t : array_like, shape (n,)
         Times, s.
@@ -265,7 +265,7 @@ def truth_at(trajectory, duration: float, t, *, imu_rate: float = 100.0, earth_r
 
     Parameters
     ----------
-    trajectory
+    trajectory : Trajectory
         A trajectory of :mod:`schuler.navigate.trajectory` (or :func:`schuler.navigate.drive.drive`).
     duration : float
         s, a whole number of IMU intervals.
@@ -394,7 +394,7 @@ def simulate_odometer(trajectory, duration: float, *, imu_rate: float = 100.0, r
 
     Parameters
     ----------
-    trajectory
+    trajectory : Trajectory
         A trajectory of :mod:`schuler.navigate.trajectory`.
     duration : float
         s.
@@ -439,7 +439,7 @@ def simulate_barometer(trajectory, duration: float, *, imu_rate: float = 100.0, 
 
     Parameters
     ----------
-    trajectory
+    trajectory : Trajectory
         A trajectory of :mod:`schuler.navigate.trajectory`.
     duration : float
         s.

@@ -42,12 +42,12 @@ from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import filter_model
 from schuler.aided.gnss import schedule_outages, simulate_gnss
 from schuler.contract import Cases, Evaluation, Output
+from schuler.core.attitude import euler_from_quaternion
 from schuler.core.response import Histories
 from schuler.exceptions import InvalidParameter
 from schuler.imu.instrument import resolve_model
 from schuler.imu.simulate import ImuSimulator
 from schuler.memory import require
-from schuler.navigate.attitude import euler_from_quaternion
 from schuler.navigate.drive import GroundVehicleProfile, drive
 from schuler.navigate.truth import IdealImu, ideal_imu, sample_count
 from schuler.params import Case, Parameter, ParameterSet

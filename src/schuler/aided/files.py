@@ -47,9 +47,9 @@ from schuler.aided.ekf import Start
 from schuler.aided.error_state import ErrorProcess, FilterModel
 from schuler.aided.gnss import GnssRecord, detect_outages, schedule_outages
 from schuler.aided.kfgins_configuration import KfGinsConfiguration, read_configuration
+from schuler.core.attitude import quaternion_from_euler
 from schuler.exceptions import InvalidParameter
 from schuler.imu.record import ImuRecord
-from schuler.navigate.attitude import quaternion_from_euler
 
 FILE_PARAMETERS = ("record", "gnss_file", "reference", "kf_gins_config")
 """The parameters that make a case a run on files."""

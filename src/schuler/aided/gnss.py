@@ -155,7 +155,7 @@ class GnssRecord:
 
         Parameters
         ----------
-        keep : ndarray of bool, shape (n,)
+        keep : sequence of bool, shape (n,)
             Which epochs to keep.
 
         Returns
@@ -333,7 +333,7 @@ def gnss_truth(trajectory, duration: float, *, imu_rate: float = 100.0, gnss_rat
 
     Parameters
     ----------
-    trajectory
+    trajectory : Trajectory
         A trajectory of :mod:`schuler.navigate.trajectory`.
     duration : float
         s, a whole number of IMU intervals.
@@ -411,7 +411,7 @@ def simulate_gnss(trajectory, duration: float, *, imu_rate: float = 100.0, gnss_
 
     Parameters
     ----------
-    trajectory
+    trajectory : Trajectory
         A trajectory of :mod:`schuler.navigate.trajectory`.
     duration, latency, time_offset : float
         s (see :func:`gnss_truth`).

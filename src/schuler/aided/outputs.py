@@ -133,9 +133,9 @@ def write_simulated_files(case, folder, *, seed: int = 0, week_start: float = 0.
     from schuler.aided.evaluation import lever_arm, simulated_inputs
     from schuler.aided.kfgins import write_gnss, write_imu
     from schuler.aided.kfgins_configuration import example_configuration
+    from schuler.core.attitude import euler_from_quaternion
     from schuler.core.random import RandomStreams
     from schuler.imu.record import ImuRecord
-    from schuler.navigate.attitude import euler_from_quaternion
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
