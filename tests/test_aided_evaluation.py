@@ -41,7 +41,7 @@ def test_a_run_is_member_zero_of_its_seed_and_its_outputs_follow_its_histories()
     assert outage["horizontal_error_max_m"] == pytest.approx(horizontal[inside].max(), rel=1e-12)
     assert result.outage_horizontal_error_max_m == outage["horizontal_error_max_m"]
     assert set(result.nees) == {"position", "velocity", "attitude"}
-    assert sorted(result.figures()) == ["aided_errors", "aided_outage_drift"]
+    assert sorted(result.figures()) == ["aided_errors", "aided_innovations", "aided_outage_drift"]
 
 
 def test_members_draw_their_own_errors_the_same_in_any_batch():
@@ -88,7 +88,8 @@ def test_the_command_writes_the_histories_the_figures_and_the_json_names_scripts
                                        "heading_error_max_rad", "horizontal_error_sigma_m"}
     assert set(data["nees"]) == {"position", "velocity", "attitude"} and "band" in data["nis"]
     files = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
-    assert files == ["aided_errors.csv", "aided_errors.png", "aided_errors.svg", "aided_outage_drift.png",
+    assert files == ["aided_errors.csv", "aided_errors.png", "aided_errors.svg", "aided_innovations.csv",
+                     "aided_innovations.png", "aided_innovations.svg", "aided_outage_drift.png",
                      "aided_outage_drift.svg", "navigation.csv", "navigation.nav"]
     python = AIDED.run(duration=300.0, outage_start="2 min")
     assert python.position_error_horizontal_rms_m == pytest.approx(data["position_error_horizontal_rms_m"], rel=1e-12)
@@ -99,3 +100,15 @@ def test_bad_input_is_one_line_and_exit_2(run_cli):
     assert out.code == 2 and out.stderr.count("\n") == 1 and "aiding" in out.stderr
     out = run_cli("aided", "run", "--duration", "300", "--imu", "no-such-grade")
     assert out.code == 2 and "neither a grade" in out.stderr
+
+
+def test_the_innovations_over_their_sigma_are_unit_normal_and_drawn():
+    # a filter whose model matches the simulation: each normalised GNSS residual has variance 1 (270 epochs x 6
+    # components; the sample variance of 1,620 unit normals is within +-10 % at 4 sigma, correlations aside)
+    result = AIDED.run(**SHORT)
+    innovations = result.histories["aided_innovations"]
+    components = [name for name in innovations.channels if name.endswith("_normalised")]
+    assert len(components) == 6 and innovations.time.size > 200
+    values = np.concatenate([innovations[name] for name in components])
+    assert np.var(values) == pytest.approx(1.0, rel=0.1)
+    assert "aided_innovations" in result.figures()

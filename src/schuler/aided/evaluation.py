@@ -395,7 +395,8 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
         return Evaluation(outputs)
     run, errors, outages, full = kept
     return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors),
-                                          "navigation": navigation_histories(full)},
+                                          "navigation": navigation_histories(full),
+                                          "aided_innovations": innovation_histories(run)},
                       extras=run_extras(run, errors, outages), units={"inside": "1", "band": "1"})
 
 
@@ -431,6 +432,27 @@ def error_histories(run, errors) -> Histories:
         "heading_sigma_rad": np.sqrt(variance[:, 8])})
     units = {name: "rad" if name.endswith("_rad") else "m/s" if name.endswith("_m_s") else "m" for name in channels}
     return Histories(t_s, channels, units)
+
+
+INNOVATION_COMPONENTS = ("position_north", "position_east", "position_down", "velocity_north", "velocity_east",
+                         "velocity_down")
+"""The GNSS residual's components in the order of the filter's measurement (velocities where they are used)."""
+
+
+def innovation_histories(run) -> Histories:
+    """One member's GNSS innovations at each epoch: each component over its predicted 1-sigma, the NIS, accepted.
+
+    Parameters
+    ----------
+    run : FilterRun
+        A filter run of one member.
+    """
+    residual, sigma = run.residual[0], run.residual_sigma[0]
+    channels = {f"{name}_normalised": residual[:, k] / sigma[:, k]
+                for k, name in enumerate(INNOVATION_COMPONENTS[:residual.shape[1]])}
+    channels["nis"] = run.nis[0]
+    channels["accepted"] = run.accepted[0].astype(float)
+    return Histories(run.epoch_t_s, channels, {name: "1" for name in channels})
 
 
 NAVIGATION_CHANNELS = {

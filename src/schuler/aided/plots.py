@@ -81,6 +81,45 @@ def outage_drift(outages):
     return fig
 
 
+def innovations(histories, outages):
+    """Each GNSS residual over the filter's predicted 1-sigma at every epoch, with +-3 (rejected epochs marked).
+
+    A consistent filter keeps about 99.7 % of the points inside the band; a drift of the points or a band
+    crossed often says the filter's Q or R is wrong (the NIS of the JSON counts it).
+
+    Parameters
+    ----------
+    histories : Histories
+        ``aided_innovations`` of a run (plain numbers).
+    outages : list of dict
+        The run's outages (``start_s``, ``duration_s``, s).
+    """
+    import matplotlib.pyplot as plt
+
+    origin = histories.time[0] if histories.time.size else 0.0
+    minutes = (histories.time - origin) / 60.0
+    groups = [name for name in ("position", "velocity") if f"{name}_north_normalised" in histories]
+    fig, axes = plt.subplots(len(groups), 1, sharex=True, figsize=(8, 2.8 * len(groups) + 0.6), squeeze=False)
+    rejected = histories["accepted"] < 0.5
+    shifted = [{**o, "start_s": o["start_s"] - origin} for o in outages]
+    for axis, group in zip(axes[:, 0], groups):
+        _outage_spans(axis, shifted)
+        for axis_name, colour in (("north", "tab:blue"), ("east", "tab:orange"), ("down", "tab:green")):
+            values = histories[f"{group}_{axis_name}_normalised"]
+            axis.plot(minutes, values, ".", ms=2, color=colour, label=axis_name)
+            if rejected.any():
+                axis.plot(minutes[rejected], values[rejected], "x", color="k", ms=5)
+        axis.axhline(3.0, color="grey", lw=0.8, ls="--")
+        axis.axhline(-3.0, color="grey", lw=0.8, ls="--", label="+-3")
+        axis.set_ylabel(f"GNSS {group} residual / sigma")
+        axis.grid(True, alpha=0.3)
+    axes[0, 0].legend(loc="upper right", fontsize=8, ncol=4)
+    axes[0, 0].set_title("Innovations over their predicted 1-sigma" + (" (x: rejected)" if rejected.any() else ""))
+    axes[-1, 0].set_xlabel("time from the start [min]")
+    fig.tight_layout()
+    return fig
+
+
 def figures(result) -> dict:
     """The figures of an aided run (``{}`` for results without histories).
 
@@ -96,4 +135,6 @@ def figures(result) -> dict:
     drawn = {"aided_errors": error_envelopes(histories["aided_errors"], outages)}
     if outages:
         drawn["aided_outage_drift"] = outage_drift(outages)
+    if "aided_innovations" in histories and histories["aided_innovations"].time.size:
+        drawn["aided_innovations"] = innovations(histories["aided_innovations"], outages)
     return drawn
