@@ -1,7 +1,7 @@
 """Figures of the ground gyrocompass: fit and residuals, misfit map, error against time, record, histogram.
 
 Each function draws one matplotlib figure from values in SI (angles shown in
-arcmin or arcsec) and returns it; :mod:`.files` names them and the system's
+arcmin or arcsec) and returns it; :mod:`schuler.ground_gyrocompass.files` names them and the system's
 writer saves them.
 """
 
@@ -33,7 +33,7 @@ def plot_fit(estimate):
     ----------
     estimate : NorthEstimate or RecordFit
         A fit with its record: ``time`` s, ``observed`` and ``residuals`` rad, ``unknowns``, ``method`` and
-        ``north_dms`` (:class:`~.estimate.NorthEstimate`, :class:`~.files.RecordFit`).
+        ``north_dms`` (:class:`~.estimate.NorthEstimate`, :class:`~schuler.ground_gyrocompass.files.RecordFit`).
 
     Returns
     -------
