@@ -1,7 +1,8 @@
 """The ground gyrocompass's own commands: ``north identify RECORD`` and ``north simulate -o FILE``.
 
 Both take SI values (and paths) and return a result that draws its figures
-(:func:`~schuler.ground_gyrocompass.files.identification_figures`, :func:`~schuler.ground_gyrocompass.files.record_figures`); the
+(:func:`~schuler.ground_gyrocompass.files.identification_figures`,
+:func:`~schuler.ground_gyrocompass.files.record_figures`); the
 files they read and write are handled here, never in the command line: records are CSV files with columns
 ``t_s`` (s since the rotor's release) and ``alpha_rad`` (the observed coordinate,
 rad: alpha - alpha0 for the relative reading of Fedorov, Kikot and Shtefan (2020),
