@@ -354,5 +354,28 @@ def write_dataframe_csv(frame, path) -> Path:
         The file.
     """
     with atomic_path(path) as tmp:
-        frame.to_csv(tmp, index=False)
+        if all(dtype.kind in "iuf" for dtype in frame.dtypes):
+            _write_numeric_csv(frame, tmp)
+        else:
+            frame.to_csv(tmp, index=False)
     return Path(path)
+
+
+def _write_numeric_csv(frame, path) -> None:
+    """Write an all-numeric table as pandas would, through Arrow's CSV writer.
+
+    pandas formats every value in Python (about 8 s for 300,000 rows of 30 columns); Arrow's C++ writer
+    does it in about 1 s with the same shortest round-trip digits and empty fields for NaN. The header
+    goes through the standard library's writer so that it is quoted only where a name needs it, as pandas
+    does.
+    """
+    import csv
+
+    import pyarrow as pa
+    import pyarrow.csv as pa_csv
+
+    with open(path, "w", newline="", encoding="utf-8") as stream:
+        csv.writer(stream, lineterminator="\n").writerow([str(name) for name in frame.columns])
+    with open(path, "ab") as stream:
+        pa_csv.write_csv(pa.Table.from_pandas(frame, preserve_index=False), stream,
+                         pa_csv.WriteOptions(include_header=False))
