@@ -75,10 +75,9 @@ class Cases:
         """
         values = {}
         for name, value in case.items():
-            if value is None:
-                values[name] = np.full(n, None, dtype=object)
-            elif isinstance(value, str):
-                values[name] = np.full(n, value, dtype=object)
+            if value is None or isinstance(value, (str, tuple)):  # a tuple is one value (a list of intervals)
+                values[name] = np.empty(n, dtype=object)
+                values[name].fill(value)
             else:
                 values[name] = np.full(n, value)
         return cls(values, **kwargs)

@@ -24,7 +24,7 @@ import difflib
 import math
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
@@ -345,6 +345,80 @@ class Parameter:
         parts.append(f"[default: {self.default_text()}]")
         return " ".join(parts)
 
+
+
+@dataclass(frozen=True)
+class IntervalsParameter(Parameter):
+    """A list of time intervals, each ``(start, duration)``: GNSS outages scheduled one by one.
+
+    Written on the command line as ``start:duration`` pairs separated by commas
+    (``"400:60, 1000:90"``, bare numbers in :attr:`~Parameter.unit`, or each with
+    its unit: ``"400 s:1.5 min"``); in a scenario or from Python as a list of pairs
+    (``[[400, 60], [1000, 90]]``); ``"none"`` or an empty list for no interval. The
+    value is a tuple of ``(start_s, duration_s)`` float pairs in SI, sorted by start;
+    a duration <= 0 or two intervals that overlap are refused.
+
+    Examples
+    --------
+    >>> IntervalsParameter("outages", "s", None, "Outages.").parse("400:60, 100 s:1 min")
+    ((100.0, 60.0), (400.0, 60.0))
+    """
+
+    kind: Any = "text"
+    pairs: ClassVar[bool] = True
+    """A scenario writes the value as a list of pairs (scalar parameters have none)."""
+
+    def check(self, value, label: str | None = None):
+        label = label or self.name
+        if value is None or isinstance(value, str):
+            return None if value is None else self.parse(value, label)
+        return self._pairs(value, label, lambda x: self._si(x, label, si=True))
+
+    def parse(self, value, label: str | None = None):
+        label = label or self.name
+        if isinstance(value, str):
+            text = value.strip()
+            if text.lower() in ("", "none"):
+                return ()
+            value = [item.split(":") for item in text.split(",")]
+        return self._pairs(value, label, lambda x: self._si(x, label, si=False))
+
+    def _si(self, x, label: str, *, si: bool) -> float:
+        if isinstance(x, str):
+            return float(parse_quantity(x.strip(), self.unit, name=label))
+        if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
+            raise InvalidParameter(label, f"{x!r} is not a number")
+        return float(x) if si else float(from_unit(float(x), self.unit))
+
+    def _pairs(self, value, label: str, to_si) -> tuple[tuple[float, float], ...]:
+        try:
+            items = list(value)
+        except TypeError:
+            raise InvalidParameter(label, f"{value!r} is not a list of (start, duration) pairs") from None
+        pairs = []
+        for item in items:
+            shown = ":".join(item) if isinstance(item, list) and all(isinstance(x, str) for x in item) else item
+            if isinstance(item, str) or not hasattr(item, "__len__") or len(item) != 2:
+                raise InvalidParameter(label, f"{shown!r} is not a (start, duration) pair; write start:duration, "
+                                              "e.g. 400:60")
+            start, duration = (to_si(x) for x in item)
+            if not (math.isfinite(start) and math.isfinite(duration)) or duration <= 0:
+                raise InvalidParameter(label, f"{shown!r}: the start must be finite and the duration > 0")
+            pairs.append((start, duration))
+        pairs.sort()
+        for (start, duration), (following, _) in zip(pairs, pairs[1:]):
+            if following < start + duration:
+                raise InvalidParameter(label, f"the interval at {following:g} s starts before the one at {start:g} s "
+                                              f"ends ({start + duration:g} s)")
+        return tuple(pairs)
+
+    def check_array(self, values, label: str | None = None) -> np.ndarray:
+        out = np.empty(1, dtype=object)
+        out[0] = self.check(values, label)
+        return out
+
+    def help_text(self) -> str:
+        return f"{self.help} [default: {self.default_text()}]"
 
 class Case(Mapping):
     """One validated case: every parameter of a system in SI, and which of them were given.

@@ -40,7 +40,7 @@ import numpy as np
 from schuler.aided import analysis, files
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import filter_model
-from schuler.aided.gnss import schedule_outages, simulate_gnss
+from schuler.aided.gnss import scheduled_outages, simulate_gnss
 from schuler.contract import Cases, Evaluation, Output
 from schuler.core.attitude import euler_from_quaternion
 from schuler.core.response import Histories
@@ -50,7 +50,7 @@ from schuler.imu.simulate import ImuSimulator
 from schuler.memory import require
 from schuler.navigate.drive import GroundVehicleProfile, drive
 from schuler.navigate.truth import IdealImu, ideal_imu, sample_count
-from schuler.params import Case, Parameter, ParameterSet
+from schuler.params import Case, IntervalsParameter, Parameter, ParameterSet
 
 AIDING = ("gnss-position", "gnss-velocity")
 """The measurements ``aiding`` may name."""
@@ -99,6 +99,9 @@ PARAMETERS = ParameterSet((
     Parameter("outage_duration", "s", 60.0, "Length of each GNSS outage (0: none).", minimum=0.0),
     Parameter("outage_every", "s", None, "Time from one outage's start to the next's (not set: one outage).",
               minimum=0.0, exclusive_minimum=True),
+    IntervalsParameter("outages", "s", None, "GNSS outages one by one, start:duration pairs (400:60,1000:90; "
+                       "a scenario writes [[400, 60], [1000, 90]]; none: no outage); replaces the three options "
+                       "above."),
     Parameter("aiding", "", None, "Measurements used, comma-separated: " + ", ".join(AIDING) + " (not set: both; "
               "with --kf-gins-config gnss-position, KF-GINS's model).", kind="text"),
     Parameter("covariance_interval", "s", 1.0, "Covariance propagation step (a whole number of IMU intervals; on "
@@ -112,7 +115,8 @@ PARAMETERS = ParameterSet((
               "errors, and the start without --kf-gins-config (not set: errors null).", kind="text"),
     Parameter("kf_gins_config", "", None, "KF-GINS YAML configuration (its paths relative to its folder, then to "
               "the working directory); options given here win over it.", kind="text"),
-), owner="aided")
+), owner="aided", exclusive=(("outages", "outage_start"), ("outages", "outage_duration"),
+                               ("outages", "outage_every")))
 
 OUTPUTS = (
     Output("position_error_horizontal_rms_m", "m", "", "RMS of the horizontal position error"),
@@ -159,13 +163,10 @@ def outages_of(case: Case) -> tuple[tuple[float, float], ...]:
     Parameters
     ----------
     case : Case
-        A validated case (SI: ``outage_start`` (None: :data:`SIMULATED_OUTAGE_START`), ``outage_duration``,
-        ``outage_every``, ``duration`` in s).
+        A validated case (SI: ``outages``, else ``outage_start`` (None: :data:`SIMULATED_OUTAGE_START`),
+        ``outage_duration``, ``outage_every``; ``duration`` in s).
     """
-    start = SIMULATED_OUTAGE_START if case["outage_start"] is None else case["outage_start"]
-    if case["outage_duration"] <= 0 or start >= case["duration"]:
-        return ()
-    return schedule_outages(start, case["outage_duration"], case["outage_every"], end=case["duration"])
+    return scheduled_outages(case, case["duration"], SIMULATED_OUTAGE_START)
 
 
 def lever_arm(case: Case) -> tuple[float, float, float]:

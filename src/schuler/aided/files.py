@@ -45,7 +45,7 @@ import numpy as np
 from schuler.aided import kfgins
 from schuler.aided.ekf import Start
 from schuler.aided.error_state import ErrorProcess, FilterModel
-from schuler.aided.gnss import GnssRecord, detect_outages, schedule_outages
+from schuler.aided.gnss import GnssRecord, detect_outages, scheduled_outages
 from schuler.aided.kfgins_configuration import KfGinsConfiguration, read_configuration
 from schuler.core.attitude import quaternion_from_euler
 from schuler.exceptions import InvalidParameter
@@ -243,11 +243,6 @@ def _sigmas(gnss: GnssRecord, case) -> GnssRecord:
     return replace(gnss, position_sigma_m=position, velocity_sigma_m_s=velocity)
 
 
-def _scheduled(case, t0: float, end: float):
-    """The outages the options schedule, in the data's times (none unless an outage option is given)."""
-    if case["outage_start"] is None or not case["outage_duration"]:
-        return ()
-    return schedule_outages(case["outage_start"], case["outage_duration"], case["outage_every"], end=end)
 
 
 def read_inputs(case) -> FileInputs:
@@ -274,7 +269,7 @@ def read_inputs(case) -> FileInputs:
     kfgins.check_overlap(imu, gnss, gnss_name)
     t0, rows = _span(imu, config)
     end = t0 + rows.size * imu.sample_interval_s
-    scheduled = _scheduled(case, t0, end)
+    scheduled = scheduled_outages(case, end)
     if scheduled:
         gnss = gnss.without(scheduled)
     inside = (gnss.t_s > t0) & (gnss.t_s <= end + 1e-9)

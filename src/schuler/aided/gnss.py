@@ -255,6 +255,27 @@ def schedule_outages(start: float, duration: float, every: float | None = None,
     return tuple((float(start + k * every), duration) for k in range(count))
 
 
+
+def scheduled_outages(case, end: float, default_start: float | None = None) -> tuple[tuple[float, float], ...]:
+    """The outages a case schedules, before ``end``: its ``outages`` list, else ``outage_start`` repeated.
+
+    Parameters
+    ----------
+    case : Mapping
+        A validated case of ``schuler aided`` (SI: ``outages`` as (start, duration) pairs or None,
+        ``outage_start`` (None: ``default_start``), ``outage_duration``, ``outage_every``, s).
+    end : float
+        The data's end, s: no outage starts at or after it.
+    default_start : float, optional
+        Start of the first outage when ``outage_start`` is not set, s (None: no outage).
+    """
+    if case["outages"] is not None:
+        return tuple(pair for pair in case["outages"] if pair[0] < end)
+    start = default_start if case["outage_start"] is None else case["outage_start"]
+    if start is None or not case["outage_duration"] or start >= end:
+        return ()
+    return schedule_outages(start, case["outage_duration"], case["outage_every"], end=end)
+
 def in_outages(t_s, outages) -> np.ndarray:
     """Whether each time falls inside an outage (start <= t < start + duration).
 

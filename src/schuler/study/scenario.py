@@ -375,7 +375,8 @@ def scenario_model(system: System) -> type[ScenarioTables]:
     """
     parameters = {spec.name: spec for spec in system.parameters}
     # (type, default) pairs built at run time: pydantic reads them, a type checker cannot
-    fields: dict[str, Any] = {name: (Value | None, None) for name in parameters}
+    fields: dict[str, Any] = {name: ((list[tuple[Value, Value]] | StrictStr | None) if getattr(spec, "pairs", False)
+                                     else Value | None, None) for name, spec in parameters.items()}
     parameters_table = create_model(
         f"{system.name}_parameters", __config__=_STRICT, __validators__=_validators(parameters, fields), **fields
     )
