@@ -427,3 +427,18 @@ def test_a_member_leaving_the_equations_domain_is_refused_in_one_line(short_driv
     deep = dataclasses.replace(start, height=np.array([-4.0e6]))
     with pytest.raises(SimulationError, match="fell below -3,189 km"):
         run_filter(increments_of(imu)[:400], 1.0 / RATE, deep, tactical_model(), gnss_from(imu, np.array([1.0])))
+
+
+def test_the_sensor_states_start_at_their_own_sigma_not_the_processes(short_drive):
+    """KF-GINS's initbgstd ... differ from gbstd ...: the first covariance holds the initial 1-sigma given."""
+    path, imu = short_drive
+    model = tactical_model()
+    initial = 3.0 * model.initial_sigma()
+    no_fix = GnssRecord(np.array([1e9]), np.zeros(1), np.zeros(1), np.zeros(1), np.ones((1, 3)))
+    run = run_filter(increments_of(imu)[:400], 1.0 / RATE, start_of(path), model, no_fix, initial_sensor_sigma=initial)
+    np.testing.assert_allclose(np.sqrt(np.diag(run.covariance[0, 0]))[9:], initial, rtol=1e-12)
+    # and the Gauss-Markov processes still pull them toward their steady sigma, by exp(-2 t / T) in variance
+    t = run.covariance_t_s[-1] - run.covariance_t_s[0]
+    decay = math.exp(-2.0 * t / model.gyro_bias.correlation_time)
+    expected = initial[0] ** 2 * decay + model.gyro_bias.sigma[0] ** 2 * (1.0 - decay)
+    assert run.covariance[0, -1, 9, 9] == pytest.approx(expected, rel=1e-6)

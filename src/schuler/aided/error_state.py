@@ -40,7 +40,7 @@ analysis", *IEEE Transactions on Aerospace and Electronic Systems* AES-11(4), 19
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -262,6 +262,64 @@ def filter_model(error_model: ErrorModel, bias: str = "gauss-markov", correlatio
                        ErrorProcess("constant", gyro.scale_factor) if with_scale else None,
                        ErrorProcess("constant", accel.scale_factor) if with_scale else None)
 
+
+
+def overridden(model: FilterModel, *, angle_random_walk=None, velocity_random_walk=None, gyro_bias_sigma=None,
+               accel_bias_sigma=None, bias: str | None = None, correlation_time: float | None = None) -> FilterModel:
+    """``model`` with the values a user states explicitly in place of those derived from the IMU's error model.
+
+    Each argument left None keeps the model's own. A bias sigma is the 1-sigma of the initial value
+    (constant, random walk) or the steady 1-sigma (Gauss-Markov). A bias changed to ``random-walk``, or
+    a random walk given a new ``correlation_time``, is driven with the density sqrt(2 sigma^2 / T) of
+    the Gauss-Markov process of that sigma and time (as :func:`filter_model` builds it).
+
+    Parameters
+    ----------
+    model : FilterModel
+        The model derived from the IMU layer (:func:`filter_model`, or KF-GINS's configuration).
+    angle_random_walk : float or array_like, shape (3,), optional
+        N_g, rad/sqrt(s).
+    velocity_random_walk : float or array_like, shape (3,), optional
+        N_a, m/s/sqrt(s).
+    gyro_bias_sigma : float or array_like, shape (3,), optional
+        Gyro bias 1-sigma, rad/s.
+    accel_bias_sigma : float or array_like, shape (3,), optional
+        Accelerometer bias 1-sigma, m/s^2.
+    bias : str, optional
+        Bias model of both triads: ``gauss-markov``, ``random-walk`` or ``constant``.
+    correlation_time : float, optional
+        T of both triads' Gauss-Markov (or random-walk spread) model, s.
+
+    Examples
+    --------
+    >>> from schuler.imu.spec import preset
+    >>> model = overridden(filter_model(preset("tactical")), angle_random_walk=np.radians(0.5) / 60, bias="constant")
+    >>> round(float(np.degrees(model.angle_random_walk[0]) * 60), 6), model.gyro_bias.kind   # deg/sqrt(h)
+    (0.5, 'constant')
+    """
+    if bias is not None and bias not in KINDS:
+        raise InvalidParameter("bias", f"{bias!r} is not a model; choose from {', '.join(KINDS)}")
+
+    def process(old: ErrorProcess, sigma) -> ErrorProcess:
+        if sigma is None and bias is None and correlation_time is None:
+            return old
+        kind = bias or old.kind
+        sigma = old.sigma if sigma is None else sigma
+        time = correlation_time if correlation_time is not None else \
+            old.correlation_time if np.isfinite(old.correlation_time) else DEFAULT_CORRELATION_TIME
+        if kind == "gauss-markov":
+            return ErrorProcess(kind, sigma, correlation_time=time)
+        if kind == "random-walk":
+            keep = old.kind == "random-walk" and correlation_time is None
+            walk = old.random_walk if keep else np.sqrt(2.0 * np.asarray(sigma, dtype=float) ** 2 / time)
+            return ErrorProcess(kind, sigma, random_walk=walk)
+        return ErrorProcess(kind, sigma)
+
+    return replace(
+        model,
+        angle_random_walk=model.angle_random_walk if angle_random_walk is None else angle_random_walk,
+        velocity_random_walk=model.velocity_random_walk if velocity_random_walk is None else velocity_random_walk,
+        gyro_bias=process(model.gyro_bias, gyro_bias_sigma), accel_bias=process(model.accel_bias, accel_bias_sigma))
 
 def system_matrix(model: FilterModel, point: NavigationPoint, earth_rate: float = EARTH_RATE) -> np.ndarray:
     """F of the error state at a navigation point (module docstring), shape ([N,] n, n).

@@ -39,7 +39,7 @@ import numpy as np
 
 from schuler.aided import analysis, files
 from schuler.aided.ekf import Start, run_filter
-from schuler.aided.error_state import filter_model
+from schuler.aided.error_state import KINDS, FilterModel, filter_model, overridden
 from schuler.aided.gnss import scheduled_outages, simulate_gnss
 from schuler.contract import Cases, Evaluation, Output
 from schuler.core.attitude import euler_from_quaternion
@@ -106,6 +106,18 @@ PARAMETERS = ParameterSet((
               "with --kf-gins-config gnss-position, KF-GINS's model).", kind="text"),
     Parameter("covariance_interval", "s", 1.0, "Covariance propagation step (a whole number of IMU intervals; on "
               "files rounded to one).", minimum=0.0, exclusive_minimum=True, maximum=60.0),
+    Parameter("filter_angle_random_walk", "deg/sqrt(h)", None, "The filter's gyro angle random walk, in place of "
+              "the IMU model's (not set: the IMU's N; with --kf-gins-config its arw).", minimum=0.0, maximum=100.0),
+    Parameter("filter_velocity_random_walk", "m/s/sqrt(h)", None, "The filter's velocity random walk, in place of "
+              "the IMU model's (not set: the IMU's N; with --kf-gins-config its vrw).", minimum=0.0, maximum=100.0),
+    Parameter("filter_gyro_bias", "deg/h", None, "The filter's gyro bias 1-sigma (steady for a Gauss-Markov model) "
+              "(not set: from the IMU's bias terms; with --kf-gins-config its gbstd).", minimum=0.0, maximum=1e4),
+    Parameter("filter_accel_bias", "mg", None, "The filter's accelerometer bias 1-sigma (not set: from the IMU's "
+              "bias terms; with --kf-gins-config its abstd).", minimum=0.0, maximum=1e3),
+    Parameter("filter_bias_model", "", None, "The filter's bias model (not set: gauss-markov, the IMU's "
+              "correlation time).", kind="choice", choices=KINDS),
+    Parameter("filter_correlation_time", "h", None, "T of the filter's Gauss-Markov biases (not set: the IMU's "
+              "longest; with --kf-gins-config its corrtime).", minimum=0.0, exclusive_minimum=True, maximum=1e3),
     Parameter("nominal", "", False, "Ideal sensors and noiseless GNSS (every random term zero).", kind="flag"),
     Parameter("record", "", None, "IMU data file: KF-GINS increments (.txt and any other suffix), or the IMU "
               "layer's CSV, Parquet or PSINS .imu (not set: a simulated drive).", kind="text"),
@@ -155,6 +167,24 @@ def aiding_of(text: str | None, default: str = "gnss-position,gnss-velocity") ->
     if "gnss-position" not in names:
         raise InvalidParameter("aiding", "gnss-position is needed (velocity alone leaves the position unobserved)")
     return True, "gnss-velocity" in names
+
+
+def assumed(case: Case, model: FilterModel) -> FilterModel:
+    """The filter's IMU model with the ``filter_*`` values the case states in place of the derived ones.
+
+    Parameters
+    ----------
+    case : Case
+        A validated case (SI: ``filter_angle_random_walk`` rad/sqrt(s), ``filter_velocity_random_walk``
+        m/s/sqrt(s), ``filter_gyro_bias`` rad/s, ``filter_accel_bias`` m/s^2, ``filter_bias_model``,
+        ``filter_correlation_time`` s; None keeps the model's).
+    model : FilterModel
+        The model derived from the IMU (or from KF-GINS's configuration).
+    """
+    return overridden(model, angle_random_walk=case["filter_angle_random_walk"],
+                      velocity_random_walk=case["filter_velocity_random_walk"],
+                      gyro_bias_sigma=case["filter_gyro_bias"], accel_bias_sigma=case["filter_accel_bias"],
+                      bias=case["filter_bias_model"], correlation_time=case["filter_correlation_time"])
 
 
 def outages_of(case: Case) -> tuple[tuple[float, float], ...]:
@@ -276,7 +306,7 @@ def _simulated_group(case: Case, members: np.ndarray, streams):
     require(member_bytes(case) * members.size, f"{members.size} members of this aided run", "--duration or --imu-rate")
     data = simulated_inputs(case, members, streams)
     run = run_filter(data.increments, data.truth.interval_s, _start(data.path, members.size),
-                     filter_model(resolve_model(_imu(case))), data.gnss, lever_arm=data.lever_arm,
+                     assumed(case, filter_model(resolve_model(_imu(case)))), data.gnss, lever_arm=data.lever_arm,
                      covariance_interval=case["covariance_interval"], use_velocity=data.use_velocity)
     truth = data.truth
     true = analysis.Truth(truth.latitude_rad, truth.longitude_rad, truth.height_m, truth.velocity_ned_m_s,
@@ -302,6 +332,7 @@ def _file_group(case: Case, members: np.ndarray):
         model, initial, sigma = files.kfgins_model(config)
     else:
         model, initial, sigma = filter_model(resolve_model(_imu(case))), None, None
+    model = assumed(case, model)
     dt = inputs.interval_s
     steps = max(round(case["covariance_interval"] / dt), 1)  # a whole number of the data's IMU intervals
     run = run_filter(inputs.increments, dt, files.start_of(inputs, START_SIGMA), model, inputs.gnss, t0=inputs.t0_s,
