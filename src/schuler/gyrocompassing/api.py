@@ -22,6 +22,7 @@ from schuler.alignment.commands import ALIGN_COMPARE
 from schuler.contract import System
 from schuler.gyrocompassing.case import DEFAULT_DURATION
 from schuler.gyrocompassing.evaluation import FIDELITIES, OUTPUTS, PARAMETERS, evaluate, member_bytes
+from schuler.gyrocompassing.optimal_run import OPTIMAL, optimal
 from schuler.gyrocompassing.reproduction import report, reproduce
 from schuler.gyrocompassing.results import AlignmentRun, data_files, figures
 from schuler.imu.instrument import apply_options, instrument_options
@@ -59,7 +60,7 @@ SYSTEM = System(
     result_type=AlignmentRun,
     report=report,
     fidelities=FIDELITIES,
-    actions=(ALIGN_COMPARE,),
+    actions=(ALIGN_COMPARE, OPTIMAL),
     random_terms=True,
     member_bytes=member_bytes,
     member_seconds=member_seconds,
@@ -68,4 +69,4 @@ SYSTEM = System(
     instrument_parameters=instrument_options("align"),
 )
 
-__all__ = ["SYSTEM"]
+__all__ = ["SYSTEM", "optimal"]
