@@ -134,9 +134,10 @@ def noise_from_imu(model, window_s: float = 600.0, correlation_time: float | Non
 def loop_model(noise: LoopNoise, latitude: float, earth_rate: float = EARTH_RATE, gravity: float = STANDARD_GRAVITY):
     """A, C, Q, R and the constant-drift input G of the loop (1.19) with Gauss-Markov drift states.
 
-    x = (beta, delta, b_xi, b_z): beta' = U_eta delta - b_xi, delta' = b_z, b' = -b / tau, plus white noise
-    of PSD Q = diag(N^2, N_z^2, 2 sigma^2 / tau + K^2, 2 sigma_z^2 / tau + K_z^2); z = beta + eps_beta, PSD
-    R = (N_a / g)^2.
+    x = (beta, delta, b_xi / U_eta, b_z / U_eta) (the drifts as the azimuth they are worth, rad):
+    beta' = U_eta (delta - x_3), delta' = U_eta x_4, x_3,4' = -x_3,4 / tau, plus white noise of PSD
+    Q = diag(N^2, N_z^2, (2 sigma^2 / tau + K^2) / U_eta^2, (2 sigma_z^2 / tau + K_z^2) / U_eta^2);
+    z = beta + eps_beta, PSD R = (N_a / g)^2.
 
     Parameters
     ----------
@@ -156,12 +157,13 @@ def loop_model(noise: LoopNoise, latitude: float, earth_rate: float = EARTH_RATE
     """
     U_eta = float(horizontal_earth_rate(latitude, earth_rate))
     tau = noise.correlation_time
-    A = np.array([[0.0, U_eta, -1.0, 0.0], [0.0, 0.0, 0.0, 1.0], [0.0, 0.0, -1.0 / tau, 0.0],
+    # the drift states in rad of azimuth (b / U_eta) keep P's entries of one size: the Riccati solutions stay exact
+    A = np.array([[0.0, U_eta, -U_eta, 0.0], [0.0, 0.0, 0.0, U_eta], [0.0, 0.0, -1.0 / tau, 0.0],
                   [0.0, 0.0, 0.0, -1.0 / tau]])
     C = np.array([[1.0, 0.0, 0.0, 0.0]])
     Q = np.diag([noise.gyro_noise**2, noise.gyro_noise_z**2,
-                 2.0 * noise.bias_sigma**2 / tau + noise.bias_random_walk**2,
-                 2.0 * noise.bias_sigma_z**2 / tau + noise.bias_random_walk_z**2])
+                 (2.0 * noise.bias_sigma**2 / tau + noise.bias_random_walk**2) / U_eta**2,
+                 (2.0 * noise.bias_sigma_z**2 / tau + noise.bias_random_walk_z**2) / U_eta**2])
     R = np.array([[(noise.accel_noise / gravity) ** 2]])
     G = np.array([[-1.0, 0.0], [0.0, 1.0], [0.0, 0.0], [0.0, 0.0]])
     return A, C, Q, R, G
@@ -188,7 +190,8 @@ def loop_accuracy(gain, noise: LoopNoise, latitude: float, earth_rate: float = E
     Parameters
     ----------
     gain : array_like, shape (4,) or (2,)
-        c_Gamma, c_a (1/s) and the gains of the drift states (1/s^2; not given: 0, the seed's loop).
+        c_Gamma, c_a and the gains of the drift states (b / U_eta, :func:`loop_model`), 1/s (not given: 0,
+        the seed's loop).
     noise : LoopNoise
         Sensor noise, SI.
     latitude : float
@@ -385,7 +388,7 @@ def gain_history(noise: LoopNoise, latitude: float, P0, t_s, earth_rate: float =
     latitude : float
         phi, rad.
     P0 : array_like, shape (4, 4)
-        Initial covariance of (beta, delta, b_xi, b_z), rad^2 and (rad/s)^2.
+        Initial covariance of the states of :func:`loop_model`, rad^2.
     t_s : array_like
         Times from 0, s.
     earth_rate : float
@@ -396,7 +399,7 @@ def gain_history(noise: LoopNoise, latitude: float, P0, t_s, earth_rate: float =
     Returns
     -------
     ndarray, shape (k, 4)
-        The gain at each time: 1/s (c_Gamma, c_a) and 1/s^2 (drift states).
+        The gain at each time, 1/s (c_Gamma, c_a, then the drift states of :func:`loop_model`).
     """
     A, C, Q, R, _ = loop_model(noise, latitude, earth_rate, gravity)
     P = riccati_solution(A, C, Q, R, P0, t_s)

@@ -19,6 +19,7 @@ import numpy as np
 from schuler.contract import Action
 from schuler.exceptions import InvalidParameter
 from schuler.gyrocompassing import optimal as model
+from schuler.gyrocompassing.analytic import horizontal_earth_rate
 from schuler.params import Parameter, ParameterSet
 from schuler.results import Result, json_safe, write_result
 from schuler.units import to_unit
@@ -76,7 +77,7 @@ class OptimalAlignment(Result):
     gains: dict[str, Any] = field(default_factory=dict, repr=False)
 
     units: ClassVar[dict[str, str]] = {"time_constant_s": "s", "damping": "1", "c_gamma": "1/s", "c_a": "1/s",
-                                       "bias_gains": "1/s^2", "settling_time_s": "s"}
+                                       "bias_gains": "1/s", "settling_time_s": "s"}
 
     def render(self):
         from rich.table import Table
@@ -173,8 +174,10 @@ def optimal(imu: str = "tactical", latitude: float = math.radians(50.0), time_co
     T = np.geomspace(3.0, 3e4, 81)
     errors = model.accuracy_versus_time_constant(noise, latitude, T, damping)
     t = np.linspace(0.0, duration, 721)
-    P0 = np.diag([initial_tilt_sigma**2, initial_azimuth_sigma**2, noise.bias_sigma**2 + noise.drift_east**2,
-                  noise.bias_sigma_z**2 + noise.drift_z**2])
+    U_eta = horizontal_earth_rate(latitude)
+    P0 = np.diag([initial_tilt_sigma**2, initial_azimuth_sigma**2,
+                  (noise.bias_sigma**2 + noise.drift_east**2) / U_eta**2,
+                  (noise.bias_sigma_z**2 + noise.drift_z**2) / U_eta**2])
     gains = model.gain_history(noise, latitude, P0, t)
     result = OptimalAlignment(
         imu=str(imu), latitude_rad=latitude, noise=dataclasses.asdict(noise), seed=_loop(seed), optimal=_loop(best),
