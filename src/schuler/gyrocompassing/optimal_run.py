@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from schuler.contract import Action
+from schuler.core.earth import STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
 from schuler.gyrocompassing import optimal as model
 from schuler.gyrocompassing.analytic import horizontal_earth_rate
@@ -52,7 +53,7 @@ LOOP_KEYS = ("time_constant_s", "damping", "c_gamma", "c_a", "azimuth_error_sigm
 """The keys of ``seed`` and ``optimal`` in the JSON."""
 
 
-def _loop(accuracy: model.LoopAccuracy) -> dict[str, float]:
+def _loop(accuracy: model.LoopAccuracy) -> dict[str, Any]:
     data = dataclasses.asdict(accuracy)
     return {key: data[key] for key in LOOP_KEYS} | {"bias_gains": list(accuracy.bias_gains)}
 
@@ -69,8 +70,8 @@ class OptimalAlignment(Result):
     imu: str
     latitude_rad: float
     noise: dict[str, float]
-    seed: dict[str, float]
-    optimal: dict[str, float]
+    seed: dict[str, Any]
+    optimal: dict[str, Any]
     seed_optimal_for: dict[str, float] | None
     best_time_constant_s: float
     sweep: dict[str, Any] = field(default_factory=dict, repr=False)
@@ -165,9 +166,10 @@ def optimal(imu: str = "tactical", latitude: float = math.radians(50.0), time_co
     best = model.optimal_accuracy(noise, latitude)
     try:
         q_beta, q_delta = model.noise_for_gains(seed.c_gamma, seed.c_a, latitude)
-        r = (noise.accel_noise / 9.80665) ** 2
+        r = (noise.accel_noise / STANDARD_GRAVITY) ** 2
         optimal_for = {"q_beta_over_r": q_beta, "q_delta_over_r": q_delta,
-                       "gyro_noise_rad_sqrt_s": math.sqrt(q_beta * r), "gyro_noise_z_rad_sqrt_s": math.sqrt(q_delta * r)}
+                       "gyro_noise_rad_sqrt_s": math.sqrt(q_beta * r),
+                       "gyro_noise_z_rad_sqrt_s": math.sqrt(q_delta * r)}
     except InvalidParameter:
         optimal_for = None
     best_T = model.best_time_constant(noise, latitude, damping, bounds=(1.0, 1e5))
@@ -221,7 +223,7 @@ def figures(result: Result) -> dict[str, Any]:
     fig.tight_layout()
     fig2, ax2 = plt.subplots(figsize=(8, 4.2))
     t, gain = np.asarray(result.gains["t_s"]), np.asarray(result.gains["gain"])
-    steady = np.array([result.optimal["c_gamma"], result.optimal["c_a"], *result.optimal["bias_gains"]])
+    steady = np.array([result.optimal["c_gamma"], result.optimal["c_a"], *list(result.optimal["bias_gains"])])
     labels = ("c_Gamma", "c_a", "drift gain, east", "drift gain, z")
     for k, label in enumerate(labels):
         if steady[k] != 0:
