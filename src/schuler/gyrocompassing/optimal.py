@@ -144,7 +144,7 @@ def loop_model(noise: LoopNoise, latitude: float, earth_rate: float = EARTH_RATE
     noise : LoopNoise
         Sensor noise, SI.
     latitude : float
-        phi, rad (U_eta = U cos phi; near the poles :class:`InvalidParameter`).
+        phi, rad (U_eta = U cos phi; near the poles :class:`schuler.exceptions.InvalidParameter`).
     earth_rate : float
         U, rad/s.
     gravity : float
