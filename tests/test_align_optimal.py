@@ -62,7 +62,7 @@ def test_seed_design_optimal_for_and_below_the_return_difference_bound():
 def test_constant_drift_error_of_the_seed_is_equation_1_21():
     seed = model.seed_accuracy(TACTICAL, LATITUDE)
     U_eta = EARTH_RATE * math.cos(LATITUDE)
-    expected = seed.c_gamma / (seed.c_a * U_eta) * TACTICAL.drift_z + TACTICAL.drift_east / U_eta
+    expected = math.hypot(seed.c_gamma / (seed.c_a * U_eta) * TACTICAL.drift_z, TACTICAL.drift_east / U_eta)
     assert seed.azimuth_error_bias_rad == pytest.approx(expected, rel=1e-10)
     assert seed.settling_time_s == pytest.approx(5 * 30.0 / 0.8, rel=1e-12)  # 5 / h, h = zeta / T
 

@@ -10,7 +10,8 @@ C = [1, 0] and K = (c_Gamma, c_a): A - K C has the characteristic polynomial p^2
 b (states 3 and 4 of x, correlation time tau: the bias instability B as sigma = B / 0.9294 and the
 IMU's Gauss-Markov terms, driven also by its rate random walk K) and a constant part c (the residual
 after calibration, :func:`schuler.imu.system_inputs.align_inputs`), whose error is added
-deterministically: e_ss = -(A - K C)^-1 G c, which for the seed's gains is (1.21),
+deterministically: e_ss = -(A - K C)^-1 G c for each drift, the two combined as independent 1-sigma
+offsets; for the seed's gains the terms are those of (1.21),
 delta_y = (c_Gamma / (c_a U_eta)) Delta omega_dz + Delta omega_dxi / U_eta (spec 07: a constant east
 drift makes the Riccati equation degenerate, as it cannot be told from azimuth). The accelerometer's
 white noise (velocity random walk N_a) is the measurement noise, PSD r = (N_a / g)^2.
@@ -207,7 +208,8 @@ def loop_accuracy(gain, noise: LoopNoise, latitude: float, earth_rate: float = E
     K[:given.size] = given
     P = loop_error_covariance(A, K[:, None], C, Q, R)
     closed = A - K[:, None] @ C
-    bias = -np.linalg.solve(closed, G @ np.array([noise.drift_east, noise.drift_z]))
+    # each drift's steady error on its own, combined as independent 1-sigma offsets (their signs are unknown)
+    bias = np.hypot(*(-np.linalg.solve(closed, G * np.array([noise.drift_east, noise.drift_z]))).T)
     # without drift gains the drift states are the process's own, not the loop's: their poles are left out
     poles = np.linalg.eigvals(closed if np.any(K[2:]) else closed[:2, :2])
     T, zeta = design_from_gains(K[0], K[1], latitude, earth_rate)

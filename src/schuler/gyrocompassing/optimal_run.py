@@ -90,7 +90,7 @@ class OptimalAlignment(Result):
         shown = {"time_constant_s": ("T", "s", "{:.5g}"), "damping": ("zeta", "", "{:.4g}"),
                  "c_gamma": ("c_Gamma", "1/s", "{:.4g}"), "c_a": ("c_a", "1/s", "{:.4g}"),
                  "azimuth_error_sigma_rad": ("azimuth error, noise 1-sigma", "arcmin", "{:.4g}"),
-                 "azimuth_error_bias_rad": ("azimuth error, constant drift", "arcmin", "{:.4g}"),
+                 "azimuth_error_bias_rad": ("azimuth error, constant drifts (RSS)", "arcmin", "{:.4g}"),
                  "settling_time_s": ("settling time", "s", "{:.5g}")}
         for key, (label, unit, form) in shown.items():
             values = [self.seed[key], self.optimal[key]]
@@ -203,10 +203,10 @@ def figures(result: Result) -> dict[str, Any]:
     sweep = result.sweep
     T = np.asarray(sweep["time_constant_s"])
     sigma = np.asarray(to_unit(np.asarray(sweep["azimuth_error_sigma_rad"]), "arcmin"))
-    bias = np.abs(np.asarray(to_unit(np.asarray(sweep["azimuth_error_bias_rad"]), "arcmin")))
+    bias = np.asarray(to_unit(np.asarray(sweep["azimuth_error_bias_rad"]), "arcmin"))
     fig, ax = plt.subplots(figsize=(8, 4.2))
     ax.loglog(T, sigma, label="noise 1-sigma (Lyapunov)")
-    ax.loglog(T, bias, "--", label="constant drift (1.21)")
+    ax.loglog(T, bias, "--", label="constant drifts (1.21), RSS")
     ax.loglog(T, np.hypot(sigma, bias), "k", label="total")
     best = result.best_time_constant_s
     best_row = model.seed_accuracy(model.LoopNoise(**result.noise), result.latitude_rad, best,
@@ -227,10 +227,11 @@ def figures(result: Result) -> dict[str, Any]:
     labels = ("c_Gamma", "c_a", "drift gain, east", "drift gain, z")
     for k, label in enumerate(labels):
         if steady[k] != 0:
-            ax2.plot(t[1:], gain[1:, k] / steady[k], label=label)
+            ax2.plot(t[1:], np.abs(gain[1:, k] / steady[k]), label=label)
     ax2.axhline(1.0, color="k", lw=0.8)
     ax2.set_xscale("log")
-    ax2.set(xlabel="time, s", ylabel="K(t) / K steady", title="Time-varying Kalman gain over the alignment")
+    ax2.set_yscale("log")
+    ax2.set(xlabel="time, s", ylabel="|K(t) / K steady|", title="Time-varying Kalman gain over the alignment")
     ax2.grid(True, which="both", alpha=0.3)
     ax2.legend(fontsize=8)
     fig2.tight_layout()
