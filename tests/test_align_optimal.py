@@ -133,3 +133,15 @@ def test_bad_input_exits_2_with_one_line(run_cli, args):
     out = run_cli("align", "optimal", *args)
     assert out.code == 2
     assert len(out.stderr.strip().splitlines()) == 1
+
+
+def test_a_spec_sheet_sets_the_noise_and_explicit_options_win(run_cli, tmp_path):
+    spec = tmp_path / "imu.toml"
+    spec.write_text('[gyro]\nrandom_walk = "0.01 deg/sqrt(h)"\nbias_instability = "0.01 deg/h"\n'
+                    '[accel]\nrandom_walk = "20 ug/sqrt(Hz)"\n')
+    noise = run_cli("align", "optimal", "--imu", str(spec), "--json").json()["noise"]
+    assert noise["gyro_noise"] == pytest.approx(math.radians(0.01) / 60, rel=1e-12)  # deg/sqrt(h) -> rad/sqrt(s)
+    assert noise["accel_noise"] == pytest.approx(20e-6 * STANDARD_GRAVITY, rel=1e-12)
+    assert noise["bias_sigma"] == pytest.approx(math.radians(0.01) / 3600 / 0.9294, rel=1e-3)
+    given = run_cli("align", "optimal", "--imu", str(spec), "--accel-noise", "40", "--json").json()["noise"]
+    assert given["accel_noise"] == pytest.approx(2 * noise["accel_noise"], rel=1e-12)
