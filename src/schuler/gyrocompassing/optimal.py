@@ -50,6 +50,9 @@ from schuler.gyrocompassing.analytic import design_from_gains, gains_from_design
 GAUSS_MARKOV_PEAK_RATIO = 1.893
 """tau / T at the Allan-deviation peak of a first-order Gauss-Markov process (:mod:`schuler.imu.error_model`)."""
 
+MAX_STEP_POLES = 20.0
+"""Longest step of the time-varying gain's solution, in time constants of the loop's fastest pole."""
+
 SETTLING_FACTOR = 5.0
 """Settling time = this / the slowest pole's decay rate (the KPI manual's t = 5 / h)."""
 
@@ -404,5 +407,12 @@ def gain_history(noise: LoopNoise, latitude: float, P0, t_s, earth_rate: float =
         The gain at each time, 1/s (c_Gamma, c_a, then the drift states of :func:`loop_model`).
     """
     A, C, Q, R, _ = loop_model(noise, latitude, earth_rate, gravity)
-    P = riccati_solution(A, C, Q, R, P0, t_s)
+    t = np.asarray(t_s, dtype=float).ravel()
+    if t.size == 0 or t[0] < 0 or np.any(np.diff(t) < 0):
+        raise InvalidParameter("t_s", "times must be increasing from 0 s")
+    # steps longer than a few time constants of the fastest pole overflow the exact step: solve on a finer grid
+    fastest = float(np.max(np.abs(steady_state_gain(A, C, Q, R).poles)))
+    step = MAX_STEP_POLES / fastest
+    fine = np.unique(np.concatenate([t, np.arange(0.0, t[-1], step)]))
+    P = riccati_solution(A, C, Q, R, P0, fine)[np.searchsorted(fine, t)]
     return P[:, :, 0] / R[0, 0]

@@ -40,7 +40,7 @@ OPTIMAL_PARAMETERS = ParameterSet((
     Parameter("correlation_time", "s", None, "tau of the Gauss-Markov drift (not set: from the IMU).", minimum=0,
               exclusive_minimum=True, maximum=1e8),
     Parameter("duration", "s", "2 h", "Alignment over which the time-varying gain is drawn.", minimum=10,
-              maximum=1e7),
+              maximum=1e6),
     Parameter("initial_azimuth_sigma", "deg", 5.0, "1-sigma azimuth error at the start of the time-varying "
               "filter.", minimum=0, exclusive_minimum=True, maximum=30),
     Parameter("initial_tilt_sigma", "arcmin", 3.0, "1-sigma level error at its start.", minimum=0,
