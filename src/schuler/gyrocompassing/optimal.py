@@ -7,7 +7,7 @@ is the fixed-gain form x_hat' = A x_hat + K (z - C x_hat) of an estimator of the
 x = (beta, delta) from the level accelerometer z = beta + eps_beta, with A = [[0, U_eta], [0, 0]],
 C = [1, 0] and K = (c_Gamma, c_a): A - K C has the characteristic polynomial p^2 + c_Gamma p + c_a U_eta of
 (1.20). The gyro drifts are split into white noise (angle random walk N, PSD N^2), a Gauss-Markov part
-b (states 3 and 4 of x, correlation time tau: the bias instability B as sigma = B / 0.9294 and the
+b (states 3 and 4 of x as b / U_eta, correlation time tau: the bias instability B as sigma = B / 0.9294 and the
 IMU's Gauss-Markov terms, driven also by its rate random walk K) and a constant part c (the residual
 after calibration, :func:`schuler.imu.system_inputs.align_inputs`), whose error is added
 deterministically: e_ss = -(A - K C)^-1 G c for each drift, the two combined as independent 1-sigma
