@@ -196,11 +196,19 @@ def riccati_solution(A, C, Q, R, P0, t_s) -> np.ndarray:
     A, C, Q, R = _system(A, C, Q, R)
     n = A.shape[0]
     t = _times(t_s)
+    P = np.atleast_2d(np.asarray(P0, dtype=float)).copy()
+    # an exact diagonal change of state units, x = S x~ with S = sqrt(P0_ii + Q_ii 1 s): states of very different
+    # sizes (radians beside m/s beside rad/s biases) keep X well conditioned (1e-15 instead of 1e-6 relative)
+    scale = np.sqrt(np.abs(np.diag(P)) + np.abs(np.diag(Q)) * 1.0)
+    scale = np.where(scale > 0, scale, 1.0)
+    A = A * scale[None, :] / scale[:, None]
+    C = C * scale[None, :]
+    Q = Q / np.multiply.outer(scale, scale)
+    P = P / np.multiply.outer(scale, scale)
     CRC = C.T @ scipy.linalg.solve(R, C, assume_a="pos")
     hamiltonian = np.block([[-A.T, CRC], [(Q + Q.T) / 2, A]])
     # a step is cut so that no mode of the Hamiltonian grows by more than e^4 over a piece: X stays regular
     rate = float(np.max(np.abs(np.linalg.eigvals(hamiltonian))))
-    P = np.atleast_2d(np.asarray(P0, dtype=float)).copy()
     out = np.empty((t.size, n, n))
     previous = 0.0
     cache: dict[float, np.ndarray] = {}
@@ -218,7 +226,7 @@ def riccati_solution(A, C, Q, R, P0, t_s) -> np.ndarray:
             P = (P + P.T) / 2
         out[k] = P
         previous = time
-    return out
+    return out * np.multiply.outer(scale, scale)
 
 
 def _joint_loop(A, K, C, Q, R) -> tuple[np.ndarray, np.ndarray]:
