@@ -465,7 +465,7 @@ def noise_ratios_for_gain(A, C, K, noise_inputs) -> np.ndarray:
         raise InvalidParameter("gain", "the loop A - K C is not stable: no Kalman filter has these gains")
     a = np.poly(A)
     delta = np.poly(A - K @ C)
-    target = np.polysub(np.polymul(delta, _mirrored(delta)), np.polymul(a, _mirrored(a)))
+    target: np.ndarray = np.polysub(np.polymul(delta, _mirrored(delta)), np.polymul(a, _mirrored(a)))
     basis = []
     for g in G.T:
         numerator = np.polysub(np.poly(A - np.outer(g, C[0])), a)
@@ -479,7 +479,8 @@ def noise_ratios_for_gain(A, C, K, noise_inputs) -> np.ndarray:
     scale = np.maximum(np.max(np.abs(M), axis=1), size * 1e-12) + 1e-300
     ratios = np.linalg.lstsq(M / scale[:, None], target / scale, rcond=None)[0]
     tolerance = 1e-8 * (size + np.abs(M) @ np.abs(ratios))
-    if np.any(np.abs(M @ ratios - target) > tolerance) or np.any(ratios < -1e-9 * max(1e-300, float(np.max(np.abs(ratios))))):
+    negative = ratios < -1e-9 * max(1e-300, float(np.max(np.abs(ratios))))
+    if np.any(np.abs(M @ ratios - target) > tolerance) or np.any(negative):
         raise InvalidParameter("gain", f"the gains {K.ravel().tolist()} are optimal for no noise of this model: the "
                                        "return-difference condition |1 + L(jw)| >= 1 fails")
     return np.clip(ratios, 0.0, None)

@@ -21,6 +21,14 @@ from __future__ import annotations
 
 from schuler.contract import System
 from schuler.gyro_vertical.actions import FRICTION
+from schuler.gyro_vertical.evaluation import (
+    FIDELITIES,
+    OUTPUTS,
+    PARAMETERS,
+    evaluate,
+    member_bytes,
+    output_points,
+)
 from schuler.gyro_vertical.optimal import (
     OPTIMAL,
     level_gains,
@@ -29,14 +37,6 @@ from schuler.gyro_vertical.optimal import (
     level_period_damping,
     optimal,
     vertical_loop,
-)
-from schuler.gyro_vertical.evaluation import (
-    FIDELITIES,
-    OUTPUTS,
-    PARAMETERS,
-    evaluate,
-    member_bytes,
-    output_points,
 )
 from schuler.gyro_vertical.reproduction import report, reproduce
 from schuler.gyro_vertical.results import VerticalResult, data_files, figures

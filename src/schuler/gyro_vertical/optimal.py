@@ -93,7 +93,7 @@ def bias_process(errors: SensorErrors, axis: int) -> tuple[float, float]:
     errors : SensorErrors
         One triad's errors, SI (rad/s or m/s^2).
     axis : int
-        Body axis, 0 x, 1 y, 2 z.
+        Body axis index, 0 x, 1 y, 2 z.
 
     Examples
     --------
@@ -235,7 +235,7 @@ def level_noise_ratios(tilt_gain: float, velocity_gain: float, gravity: float,
     Parameters
     ----------
     tilt_gain : float
-        K_beta, 1/m.
+        K_beta, rad/s per m/s (1/m).
     velocity_gain : float
         K_v, 1/s.
     gravity, radius : float
@@ -275,7 +275,7 @@ def level_period_damping(tilt_gain: float, velocity_gain: float, gravity: float,
     Parameters
     ----------
     tilt_gain : float
-        K_beta, 1/m (below 1 / R).
+        K_beta, rad/s per m/s (1/m; below 1 / R).
     velocity_gain : float
         K_v, 1/s.
     gravity, radius : float

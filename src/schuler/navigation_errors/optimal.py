@@ -86,7 +86,7 @@ def bias_psd(errors: SensorErrors, axis: int) -> float:
     errors : SensorErrors
         The accelerometer triad's errors, SI.
     axis : int
-        Body axis, 0 x, 1 y, 2 z.
+        Body axis index, 0 x, 1 y, 2 z.
 
     Examples
     --------
