@@ -156,10 +156,16 @@ def loop_error_covariance(A, K, C, Q, R) -> np.ndarray:
     A, C, Q, R = _system(A, C, Q, R)
     K = np.atleast_2d(np.asarray(K, dtype=float)).reshape(A.shape[0], C.shape[0])
     closed = A - K @ C
-    if np.max(np.linalg.eigvals(closed).real) >= 0:
-        raise InvalidParameter("gain", "the loop A - K C is not stable: it has no steady error")
+    poles = np.linalg.eigvals(closed)
+    # a pole within rounding of the axis is no steady state either: its Lyapunov solution is rounding noise
+    if np.max(poles.real) >= -1e-12 * max(float(np.max(np.abs(poles))), 1e-300):
+        raise InvalidParameter("gain", "the loop A - K C is not stable (or within rounding of it): it has no "
+                                       "steady error")
     P = scipy.linalg.solve_continuous_lyapunov(closed, -(Q + K @ R @ K.T))
-    return (P + P.T) / 2
+    P = (P + P.T) / 2
+    if not np.all(np.isfinite(P)) or np.linalg.eigvalsh(P).min() < -1e-9 * np.abs(P).max():
+        raise InvalidParameter("gain", "the loop is too close to unstable for a steady error covariance")
+    return P
 
 
 def riccati_solution(A, C, Q, R, P0, t_s) -> np.ndarray:
