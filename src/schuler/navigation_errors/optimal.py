@@ -15,9 +15,9 @@ measured as z = delta_h + n (the barometric height, white noise of 1-sigma ``bar
 ``baro_interval``, PSD r = sigma^2 dt): its error x_hat - x obeys the loop's equations with the gain
 K = (k1, k2, k3) (the third state's error is b_hat - b). The accelerometer's white noise N_a (velocity
 random walk) drives delta_v'; its slow bias is a random walk (the loop's b_hat is an integrator), of PSD
-q_b that of the IMU's Gauss-Markov bias, 2 sigma^2 / T, plus K^2 (:func:`schuler.gyro_vertical` is not
-imported: :func:`bias_psd` maps the IMU here). As q_b falls to 0 the optimal k3 = sqrt(q_b / r) goes to 0
-(spec 07: a constant bias drives the integral gain to zero; the Riccati equation degenerates): the constant
+q_b that of the IMU's Gauss-Markov bias, 2 sigma^2 / T, plus K^2 (:func:`bias_psd`). As q_b falls to 0
+the optimal k3 = sqrt(q_b / r) goes to 0 (spec 07: a constant bias drives the integral gain to zero; the
+Riccati equation degenerates): the constant
 turn-on bias b0 and a constant barometric error are therefore added deterministically, by
 :func:`schuler.navigation_errors.vertical_channel.aided_steady_state_error` (third order: the barometer's
 error alone; second order, whose model has no bias state: (b0 + k2 delta_h_baro) / (k2 - 2 omega_s^2)).
