@@ -4,6 +4,8 @@ Source: Drozdovich, "On an inertial method of measuring velocities" (1959)
 (:data:`schuler.references.DROZDOVICH_1959`). The pieces:
 :mod:`~schuler.gyro_vertical.evaluation` (parameters, outputs, ``evaluate``),
 :mod:`~schuler.gyro_vertical.actions` (``friction``),
+:mod:`~schuler.gyro_vertical.optimal` (``optimal``: the seed beside the Kalman loop; its library functions
+are exported here),
 :mod:`~schuler.gyro_vertical.reproduction` (``reproduce``, ``report``),
 :mod:`~schuler.gyro_vertical.results` (the result types, ``figures`` and ``data_files``).
 
@@ -26,6 +28,15 @@ from schuler.gyro_vertical.evaluation import (
     evaluate,
     member_bytes,
     output_points,
+)
+from schuler.gyro_vertical.optimal import (
+    OPTIMAL,
+    level_gains,
+    level_gains_from_period,
+    level_noise_ratios,
+    level_period_damping,
+    optimal,
+    vertical_loop,
 )
 from schuler.gyro_vertical.reproduction import report, reproduce
 from schuler.gyro_vertical.results import VerticalResult, data_files, figures
@@ -62,10 +73,11 @@ SYSTEM = System(
     result_type=VerticalResult,
     report=report,
     fidelities=FIDELITIES,
-    actions=(FRICTION,),
+    actions=(FRICTION, OPTIMAL),
     member_bytes=member_bytes,
     member_seconds=member_seconds,
     guide="vertical",
 )
 
-__all__ = ["SYSTEM"]
+__all__ = ["SYSTEM", "level_gains", "level_gains_from_period", "level_noise_ratios", "level_period_damping", "optimal",
+           "vertical_loop"]

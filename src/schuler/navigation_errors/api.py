@@ -4,7 +4,8 @@ Source: Bollay (1966), "The Story of 84 Minutes" (:data:`schuler.references.BOLL
 The pieces: :mod:`~schuler.navigation_errors.evaluation` (``run``'s parameters,
 outputs, ``evaluate``), :mod:`~schuler.navigation_errors.reproduction`
 (``reproduce``, ``report``, the ``plot`` action), :mod:`~schuler.navigation_errors.actions`
-(``vertical``, ``period``), :mod:`~schuler.navigation_errors.three_d_run` (``three-d``)
+(``vertical``, ``period``), :mod:`~schuler.navigation_errors.three_d_run` (``three-d``),
+:mod:`~schuler.navigation_errors.optimal` (``optimal``: the baro loop's gains beside the Kalman filter's)
 and :mod:`~schuler.navigation_errors.files` (``figures``, ``data_files``).
 
 Examples
@@ -34,6 +35,7 @@ from schuler.navigation_errors.evaluation import (
     member_bytes,
 )
 from schuler.navigation_errors.files import data_files, figures
+from schuler.navigation_errors.optimal import OPTIMAL, baro_loop, optimal
 from schuler.navigation_errors.reproduction import (
     PLOT_PARAMETERS,
     plot,
@@ -62,6 +64,7 @@ ACTIONS = (
            "(-(gyro bias), deg/h), accelerometer biases in the level frame (measured - true), initial velocity "
            "and attitude errors; Schuler, Foucault and 24-hour modes. Figures and CSV with --out.", three_d,
            THREE_D_PARAMETERS),
+    OPTIMAL,
 )
 """The commands of ``schuler errors`` beyond ``run`` and ``reproduce``."""
 
@@ -102,4 +105,4 @@ SYSTEM = System(
     instrument_parameters=instrument_options("errors"),
 )
 
-__all__ = ["ACTIONS", "SYSTEM"]
+__all__ = ["ACTIONS", "SYSTEM", "baro_loop", "optimal"]
