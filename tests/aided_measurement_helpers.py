@@ -27,7 +27,10 @@ def truth(members: int = 3, seed: int = 1) -> Solution:
 
 
 def computed(true: Solution, dx: np.ndarray) -> Solution:
-    """The solution with error state dx (computed - true; C_hat = exp(-[psi x]) C; omega_hat = omega + b + diag(omega) s)."""
+    """The solution with error state dx (computed - true).
+
+    C_hat = exp(-[psi x]) C; omega_hat = omega + b + diag(omega) s.
+    """
     R_N, R_E = radii_of_curvature(true.latitude)
     h = true.height
     dr = dx[:, POSITION]
@@ -35,8 +38,9 @@ def computed(true: Solution, dx: np.ndarray) -> Solution:
     rate = true.angular_rate + dx[:, GYRO_BIAS]
     if dx.shape[1] >= 21:
         rate = rate + true.angular_rate * dx[:, GYRO_SCALE]
-    return Solution(true.latitude + dr[:, 0] / (R_N + h), true.longitude + dr[:, 1] / ((R_E + h) * np.cos(true.latitude)),
-                    h - dr[:, 2], true.velocity + dx[:, VELOCITY], C, rate)
+    longitude = true.longitude + dr[:, 1] / ((R_E + h) * np.cos(true.latitude))
+    return Solution(true.latitude + dr[:, 0] / (R_N + h), longitude, h - dr[:, 2], true.velocity + dx[:, VELOCITY], C,
+                    rate)
 
 
 def assert_first_order(h, true: Solution, H: np.ndarray, n: int, scales: np.ndarray, rel: float = 2e-3,

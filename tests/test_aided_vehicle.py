@@ -1,9 +1,9 @@
-"""The odometer and the non-holonomic constraint: H against h, the lever arm's and the mounting's signs, a round trip."""
+"""The odometer and the non-holonomic constraint: H against h, the lever arm's and mounting's signs, round trips."""
 
 import numpy as np
 import pytest
-from aided_measurement_helpers import assert_first_order, computed, model, truth
 
+from aided_measurement_helpers import assert_first_order, computed, model, truth
 from schuler.aided import kalman, measurements, sources
 
 ARM = np.array([-1.4, 0.6, 1.1])  # IMU to the rear wheel's contact point, body axes, m

@@ -1,9 +1,8 @@
 """Zero-velocity and zero-rate updates: H against h, the stop detector on the drive, a consumer IMU at a stop."""
 
 import numpy as np
-import pytest
-from aided_measurement_helpers import assert_first_order, model, truth
 
+from aided_measurement_helpers import assert_first_order, model, truth
 from schuler.aided import measurements, sources
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import filter_model

@@ -47,7 +47,6 @@ import numba
 import numpy as np
 
 from schuler.aided import kalman, measurements
-from schuler.aided.sources import Context, Source, SourceLog
 from schuler.aided.error_state import (
     ACCEL_BIAS,
     ACCEL_SCALE,
@@ -61,6 +60,7 @@ from schuler.aided.error_state import (
     transition,
 )
 from schuler.aided.gnss import GnssRecord
+from schuler.aided.sources import Context, Source, SourceLog
 from schuler.core.attitude import dcm_from_quaternion, quaternion_from_rotation_vector, quaternion_multiply
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.exceptions import InvalidParameter, SimulationError
@@ -489,8 +489,9 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         sensor_sigma = np.concatenate([np.asarray(initial_sensor_sigma, float).reshape(-1),
                                        sensor_sigma[sensor_sigma.size - aiding_states:]])
     if sensor_sigma.shape != (n - 9,):
+        given = sensor_sigma.size - aiding_states
         raise InvalidParameter("initial_sensor_sigma", f"needs {model.sensor_size - 9} values for "
-                                                       f"{model.sensor_size} states, got {sensor_sigma.size - aiding_states}")
+                                                       f"{model.sensor_size} states, got {given}")
     sigma0 = np.concatenate([start.position_sigma, start.velocity_sigma, start.attitude_sigma, sensor_sigma])
     P = np.broadcast_to(np.diag(sigma0**2), (members, n, n)).copy()
     accumulator = _Accumulator(members)

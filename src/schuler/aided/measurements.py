@@ -278,7 +278,7 @@ def vehicle(solution: Solution, lever_arm, mounting: np.ndarray, speed, model: F
     model : FilterModel
         The filter's states (an ``odometer_scale`` state enters row 0).
     rows : sequence of int
-        Components of v^v used: 0 the odometer, 1 and 2 the constraint.
+        Components of v^v used, each an index: 0 the odometer, 1 and 2 the constraint.
     odometer_scale : float or ndarray, shape (N,)
         s_hat_o compensated from the speed, dimensionless.
     earth_rate : float

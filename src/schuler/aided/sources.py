@@ -225,7 +225,7 @@ def vehicle_source(times: np.ndarray, speed: np.ndarray | None, model: FilterMod
     lever_arm : array_like, shape (3,)
         IMU to the wheel's contact point, body axes, m.
     mounting : ndarray, shape (3, 3)
-        C_b^v (:func:`schuler.aided.measurements.mounting_matrix`).
+        C_b^v (:func:`schuler.aided.measurements.mounting_matrix`), plain numbers.
     speed_sigma : float
         1-sigma of the odometer speed, m/s.
     constraint_sigma : float
