@@ -136,7 +136,7 @@ def simulated_sources(case: Case, path, increments: np.ndarray, interval: float,
     streams : RandomStreams or None
         The noise's source; None: noise-free data.
     model : FilterModel
-        The filter's model, with its aiding states (:func:`with_states`).
+        The filter's model, with its aiding states (:func:`schuler.aided.aiding.with_states`).
     """
     names = named(case["aiding"])
     duration, imu_rate = case["duration"], case["imu_rate"]

@@ -363,7 +363,7 @@ class _Navigator:
         return np.concatenate([self.gyro_bias, self.accel_bias, self.gyro_scale, self.accel_scale], axis=1)
 
     def context(self, accumulator: _Accumulator, model: FilterModel) -> Context:
-        """What the sources' residuals are formed from now (:class:`~schuler.aided.sources.Context`)."""
+        """What the sources' residuals are formed from now (:class:`schuler.aided.sources.Context`)."""
         elapsed = accumulator.elapsed
         rate = accumulator.angle / elapsed if elapsed > 0 else self.last_rate
         aiding = {name: self.aiding[:, k - model.sensor_size] for name, k in model.aiding_states().items()}
@@ -471,13 +471,15 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         raise InvalidParameter("sources", f"each source once and none named gnss, got {names}")
     every_source = [_gnss_source(epochs, lever_arm, velocity, n, earth_rate), *sources]
     inside_of, groups = _groups(every_source, t0, end)
+    n_cov = n_samples // every_cov + len(groups) + 1
+    n_out = n_samples // output_every
+    logged = sum(kept.size * (2 + 2 * source.components) for source, kept in zip(every_source, inside_of))
+    require(8.0 * members * (n_cov * (n * n + 12 + n - model.sensor_size) + (n_out + 1) * _kernels.OUTPUT_SIZE
+                             + logged), "the filter's stored solution, covariances and innovations",
+            "the duration, the members, the covariance interval, the output step or the aiding rates")
     logs = [SourceLog.empty(source.t[kept], members, source.components)
             for source, kept in zip(every_source, inside_of)]
     position_of = [{int(j): k for k, j in enumerate(kept)} for kept in inside_of]
-    n_cov = n_samples // every_cov + len(groups) + 1
-    n_out = n_samples // output_every
-    require(8.0 * members * (n_cov * (n * n + 12) + (n_out + 1) * _kernels.OUTPUT_SIZE), "the filter's stored "
-            "solution and covariances", "the duration, the members, the covariance interval or the output step")
     aiding_states = n - model.sensor_size
     navigator = _Navigator(start, increments, interval, t0, output_every, n_out, earth_rate, aiding_states)
     if initial_sensor_errors is not None:

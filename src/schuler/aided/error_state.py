@@ -16,7 +16,7 @@ next       1      s_o: residual odometer scale-factor error (optional, after the
 next       m      b_h: residual barometric height bias (optional, last)
 =========  =====  =====================================================================
 
-The aiding states (:attr:`FilterModel.odometer_scale`, :attr:`FilterModel.barometer_bias`) are
+The aiding states (``FilterModel.odometer_scale``, ``FilterModel.barometer_bias``) are
 appended after the 15 or 21 in that order, each only when modelled: 15 to 23 states. Like the
 sensor states they are the residual errors of the compensated measurement (speed / (1 + s_hat_o),
 height - b_hat_h), have no coupling in F but their own process, and are fed back s_hat += delta_s.
@@ -175,7 +175,7 @@ class FilterModel:
 
     @property
     def size(self) -> int:
-        """Number of error states: :attr:`sensor_size` and the aiding states (module docstring)."""
+        """Number of error states: ``sensor_size`` and the aiding states (module docstring)."""
         return self.sensor_size + len(self.aiding_states())
 
     def aiding_states(self) -> dict[str, int]:
@@ -197,7 +197,7 @@ class FilterModel:
         return np.concatenate([process.sigma for _, process in self.processes()])
 
     def names(self) -> tuple[str, ...]:
-        """The states' names in their order (:data:`STATE_NAMES`, then the aiding states')."""
+        """The states' names in their order (:data:`schuler.aided.error_state.STATE_NAMES`, then the aiding states')."""
         return STATE_NAMES[:self.sensor_size] + tuple(self.aiding_states())
 
 

@@ -19,8 +19,8 @@ The other measurements (spec 07, "Measurements"; the aiding states s_o and b_h o
   = b_g + diag(omega_ib) s_g + C_n^b [omega_ie x] psi, with C_hat_n^b = C_n^b (I + [psi x]);
 * vehicle frame (non-holonomic constraint and odometer): the wheel point at l_odo (body axes, from
   the IMU) moves at v^v = C_b^v (C_n^b v + omega_nb^b x l_odo), omega_nb^b = omega_ib^b - C_n^b omega_in^n,
-  C_b^v from the IMU's mounting angles (:func:`mounting_matrix`). The constraint is v^v_y = v^v_z = 0,
-  the odometer v^v_x = speed / (1 + s_hat_o) = v^v_x (1 + s_o). To first order
+  C_b^v from the IMU's mounting angles (:func:`schuler.aided.measurements.mounting_matrix`). The
+  constraint is v^v_y = v^v_z = 0, the odometer v^v_x = speed / (1 + s_hat_o) = v^v_x (1 + s_o). To first order
   delta_z = C_b^v C_n^b delta_v - C_b^v C_n^b [v x] psi - C_b^v [l_odo x] (b_g + diag(omega_ib) s_g)
   - speed_c s_o (odometer row); C_b^v C_n^b [omega_in x] psi (below 1e-4 m/s per rad per metre of
   arm) is left out of H, not out of h;
@@ -250,7 +250,7 @@ def wheel_velocity(solution: Solution, lever_arm, mounting: np.ndarray,
     lever_arm : array_like, shape (3,)
         IMU to the wheel's contact point, body axes, m.
     mounting : ndarray, shape (3, 3)
-        C_b^v (:func:`mounting_matrix`), plain numbers.
+        C_b^v (:func:`schuler.aided.measurements.mounting_matrix`), plain numbers.
     earth_rate : float
         Omega, rad/s.
     """

@@ -8,11 +8,11 @@ sources at one time are one stacked update (:func:`schuler.aided.kalman.stacked_
 * its ``name`` (the per-source counts of rejected epochs are keyed by it),
 * its epoch times ``t`` (s, the IMU's time scale, sorted),
 * ``measure(j, context)``: the residual (N, m), H ([N,] m, n) and R ([N,] m, m) of epoch j, from the
-  :class:`Context` (the solution, the compensated gyros' mean since the last event and the aiding states'
-  estimates).
+  :class:`schuler.aided.sources.Context` (the solution, the compensated gyros' mean since the last event
+  and the aiding states' estimates).
 
-Stops (zero velocity and zero rate) come from given intervals or from the IMU (:func:`detect_stops`: a
-windowed variance test of specific force and angular rate).
+Stops (zero velocity and zero rate) come from given intervals or from the IMU
+(:func:`schuler.aided.sources.detect_stops`: a windowed variance test of specific force and angular rate).
 
 References
 ----------
