@@ -57,3 +57,23 @@ def assert_first_order(h, true: Solution, H: np.ndarray, n: int, scales: np.ndar
         tolerance = rel * np.abs(analytic).max() + 1e-9
         assert np.allclose(numeric, analytic, rtol=0, atol=tolerance + 1e-9 * np.abs(numeric).max()), (k, numeric,
                                                                                                           analytic)
+
+
+def filtered_drive(values: dict, seed: int = 3):
+    """One tactical member filtered on a simulated case with its aiding: the run and the filter's model."""
+    from schuler.aided import aiding
+    from schuler.aided import evaluation as ev
+    from schuler.aided.ekf import run_filter
+    from schuler.aided.error_state import filter_model
+    from schuler.core.random import RandomStreams
+    from schuler.imu.instrument import resolve_model
+
+    case = ev.PARAMETERS.case(values)
+    streams = RandomStreams(seed)
+    data = ev.simulated_inputs(case, np.arange(1), streams)
+    fm = aiding.with_states(filter_model(resolve_model("tactical")), case)
+    extra = aiding.simulated_sources(case, data.path, data.increments, data.truth.interval_s, np.arange(1), streams,
+                                     fm)
+    run = run_filter(data.increments, data.truth.interval_s, ev._start(data.path, 1), fm, data.gnss,
+                     use_velocity=False, sources=extra)
+    return run, fm

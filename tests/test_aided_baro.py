@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from aided_measurement_helpers import assert_first_order, model, truth
+from aided_measurement_helpers import assert_first_order, filtered_drive, model, truth
 from schuler.aided import kalman, measurements, sources
 
 
@@ -78,22 +78,8 @@ def test_the_command_takes_every_aiding_and_counts_rejections_per_source(run_cli
 def test_barometer_bias_state_converges_on_the_drive():
     """A 6 m barometer bias beside GNSS on a 300-s tactical drive (seed 3): measured 5.92 m, 1-sigma 0.072 m
     (1.07 sigma off, one member); asserted within 2 sigma."""
-    from schuler.aided import aiding
-    from schuler.aided import evaluation as ev
-    from schuler.aided.ekf import run_filter
-    from schuler.aided.error_state import filter_model
-    from schuler.core.random import RandomStreams
-    from schuler.imu.instrument import resolve_model
-
-    case = ev.PARAMETERS.case({"duration": 300.0, "outage_start": 120.0, "aiding": "gnss-position,baro",
-                               "baro_bias": 6.0, "baro_bias_state": True})
-    streams = RandomStreams(3)
-    data = ev.simulated_inputs(case, np.arange(1), streams)
-    fm = aiding.with_states(filter_model(resolve_model("tactical")), case)
-    extra = aiding.simulated_sources(case, data.path, data.increments, data.truth.interval_s, np.arange(1), streams,
-                                     fm)
-    run = run_filter(data.increments, data.truth.interval_s, ev._start(data.path, 1), fm, data.gnss,
-                     use_velocity=False, sources=extra)
+    run, fm = filtered_drive({"duration": 300.0, "outage_start": 120.0, "aiding": "gnss-position,baro",
+                              "baro_bias": 6.0, "baro_bias_state": True})
     index = fm.aiding_states()["barometer_bias"]
     estimate, sigma = run.aiding_estimates[0, -1, 0], np.sqrt(run.covariance[0, -1, index, index])
     assert sigma < 0.3

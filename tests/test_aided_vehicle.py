@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from aided_measurement_helpers import assert_first_order, computed, model, truth
+from aided_measurement_helpers import assert_first_order, computed, filtered_drive, model, truth
 from schuler.aided import kalman, measurements, sources
 
 ARM = np.array([-1.4, 0.6, 1.1])  # IMU to the rear wheel's contact point, body axes, m
@@ -164,22 +164,8 @@ def test_nhc_and_odometer_bound_a_60_s_outage_below_gnss_only(grade, factor):
 def test_odometer_scale_state_converges_on_the_drive():
     """A 0.5 % odometer scale error beside GNSS on a 300-s tactical drive (seed 3, one member): measured estimate
     0.00517, 1-sigma 0.00020 (0.84 sigma off); asserted within its 1-sigma."""
-    from schuler.aided import aiding
-    from schuler.aided import evaluation as ev
-    from schuler.aided.ekf import run_filter
-    from schuler.aided.error_state import filter_model
-    from schuler.core.random import RandomStreams
-    from schuler.imu.instrument import resolve_model
-
-    case = ev.PARAMETERS.case({"duration": 300.0, "outage_start": 120.0, "aiding": "gnss-position,odometer,nhc",
-                               "odometer_scale_error": 0.005, "odometer_scale_state": True})
-    streams = RandomStreams(3)
-    data = ev.simulated_inputs(case, np.arange(1), streams)
-    fm = aiding.with_states(filter_model(resolve_model("tactical")), case)
-    extra = aiding.simulated_sources(case, data.path, data.increments, data.truth.interval_s, np.arange(1), streams,
-                                     fm)
-    run = run_filter(data.increments, data.truth.interval_s, ev._start(data.path, 1), fm, data.gnss,
-                     use_velocity=False, sources=extra)
+    run, fm = filtered_drive({"duration": 300.0, "outage_start": 120.0, "aiding": "gnss-position,odometer,nhc",
+                              "odometer_scale_error": 0.005, "odometer_scale_state": True})
     index = fm.aiding_states()["odometer_scale"]
     estimate, sigma = run.aiding_estimates[0, -1, 0], np.sqrt(run.covariance[0, -1, index, index])
     assert sigma < 5e-4
