@@ -19,11 +19,15 @@ so that the filter's bias and scale states are the residual errors (module
   in proportion to time (the rates taken constant over the sample), not by rounding it to a
   sample; the coning and sculling terms of the two parts are those of equal-rate halves, an
   error of second order in the increments;
+* measurements come from sources (:mod:`schuler.aided.sources`: GNSS, and optionally zero
+  velocity, zero rate, the vehicle's odometer and non-holonomic constraint, the barometer), each
+  with its epochs; epochs of several sources closer than 1e-9 s are one event;
 * at an epoch the residual of each measurement is formed from the solution (h_hat - z), gated
-  and applied (:func:`~schuler.aided.kalman.update`, Joseph form); the estimated errors are fed
+  and applied (:func:`~schuler.aided.kalman.update`, Joseph form; several sources at once:
+  :func:`~schuler.aided.kalman.stacked_update`, each gated on its own); the estimated errors are fed
   back, r <- r - delta_r, v <- v - delta_v, q_bn <- q(psi) q_bn (C <- exp([psi x]) C, since
-  C_hat = (I - [psi x]) C), b_hat <- b_hat + delta_b, s_hat <- s_hat + delta_s, and the error
-  state is reset to zero (P unchanged, first order).
+  C_hat = (I - [psi x]) C), b_hat <- b_hat + delta_b, s_hat <- s_hat + delta_s (the aiding
+  states' estimates likewise), and the error state is reset to zero (P unchanged, first order).
 
 References
 ----------
@@ -56,6 +60,7 @@ from schuler.aided.error_state import (
     transition,
 )
 from schuler.aided.gnss import GnssRecord
+from schuler.aided.sources import Context, Source, SourceLog
 from schuler.core.attitude import dcm_from_quaternion, quaternion_from_rotation_vector, quaternion_multiply
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.exceptions import InvalidParameter, SimulationError
@@ -165,6 +170,12 @@ class FilterRun:
         Residuals delta_z (m, then m/s for velocity).
     residual_sigma : ndarray, shape (N, k, m)
         Their predicted 1-sigma, sqrt(diag(S)).
+    n_states : int
+        Number of error states.
+    sources : dict of str to SourceLog
+        The other sources' epochs (``zupt``, ``zaru``, ``vehicle``, ``baro``), as the GNSS ones above.
+    aiding_estimates : ndarray, shape (N, n_cov, e)
+        The aiding states' estimates at the covariance times (odometer scale 1, barometer bias m; e may be 0).
     """
 
     t_s: np.ndarray
@@ -178,11 +189,17 @@ class FilterRun:
     residual: np.ndarray
     residual_sigma: np.ndarray
     n_states: int = field(default=21)
+    sources: dict = field(default_factory=dict)
+    aiding_estimates: np.ndarray | None = None
 
     @property
     def rejected(self) -> np.ndarray:
-        """Epochs the gate rejected, per member, shape (N,)."""
-        return np.sum(~self.accepted, axis=-1)
+        """Epochs the gate rejected, every source, per member, shape (N,)."""
+        return sum(self.rejected_by_source().values(), np.zeros(self.accepted.shape[0], dtype=int))
+
+    def rejected_by_source(self) -> dict[str, np.ndarray]:
+        """Epochs the gate rejected per source (``gnss`` first), per member, each shape (N,)."""
+        return {"gnss": np.sum(~self.accepted, axis=-1), **{name: log.rejected for name, log in self.sources.items()}}
 
 
 @dataclass
@@ -207,7 +224,7 @@ class _Navigator:
     """The members' strapdown states, advanced through compensated increments (module docstring)."""
 
     def __init__(self, start: Start, increments: np.ndarray, dt: float, t0: float, output_every: int,
-                 n_out: int, earth_rate: float):
+                 n_out: int, earth_rate: float, aiding_states: int = 0):
         n = start.members
         self.state = np.zeros((n, _kernels.STATE_SIZE))
         self.state[:, _kernels.LAT] = start.latitude
@@ -228,6 +245,7 @@ class _Navigator:
         self.accel_bias = np.zeros((n, 3))
         self.gyro_scale = np.zeros((n, 3))
         self.accel_scale = np.zeros((n, 3))
+        self.aiding = np.zeros((n, aiding_states))
         self.last_rate = np.zeros((n, 3))
         self._zeros_row = np.zeros((n, 12))
         self._dummy_out = np.zeros((n, 1, _kernels.OUTPUT_SIZE))
@@ -309,7 +327,7 @@ class _Navigator:
         return NavigationPoint(sol.latitude, sol.height, sol.velocity, sol.body_to_ned,
                                accumulator.velocity / elapsed, accumulator.angle / elapsed)
 
-    def correct(self, dx: np.ndarray, n_states: int) -> None:
+    def correct(self, dx: np.ndarray, model: FilterModel) -> None:
         """Feed the estimated errors back into the solution and the sensor compensation."""
         st = self.state
         lat, h = st[:, _kernels.LAT], st[:, _kernels.HGT]
@@ -327,13 +345,16 @@ class _Navigator:
         st[:, _kernels.QUAT:_kernels.QUAT + 4] = q / np.linalg.norm(q, axis=-1, keepdims=True)
         self.gyro_bias += dx[:, GYRO_BIAS]
         self.accel_bias += dx[:, ACCEL_BIAS]
-        if n_states == 21:
+        if model.sensor_size == 21:
             self.gyro_scale += dx[:, GYRO_SCALE]
             self.accel_scale += dx[:, ACCEL_SCALE]
+        self.aiding += dx[:, model.sensor_size:]
 
     def decay(self, model: FilterModel, elapsed: float) -> None:
         """Gauss-Markov estimates relax towards zero as the process's mean does."""
-        targets = [self.gyro_bias, self.accel_bias] + ([self.gyro_scale, self.accel_scale] if model.size == 21 else [])
+        targets = [self.gyro_bias, self.accel_bias] + ([self.gyro_scale, self.accel_scale]
+                                                       if model.sensor_size == 21 else [])
+        targets += [self.aiding[:, k:k + 1] for k in range(self.aiding.shape[1])]  # views: scaled in place
         for target, (_, process) in zip(targets, model.processes()):
             if process.decay_rate > 0:
                 target *= math.exp(-process.decay_rate * elapsed)
@@ -341,13 +362,55 @@ class _Navigator:
     def estimates(self) -> np.ndarray:
         return np.concatenate([self.gyro_bias, self.accel_bias, self.gyro_scale, self.accel_scale], axis=1)
 
+    def context(self, accumulator: _Accumulator, model: FilterModel) -> Context:
+        """What the sources' residuals are formed from now (:class:`schuler.aided.sources.Context`)."""
+        elapsed = accumulator.elapsed
+        rate = accumulator.angle / elapsed if elapsed > 0 else self.last_rate
+        aiding = {name: self.aiding[:, k - model.sensor_size] for name, k in model.aiding_states().items()}
+        return Context(self.solution(), rate, elapsed if elapsed > 0 else self.dt, aiding)
+
+
+def _gnss_source(epochs: _Epochs, lever_arm, velocity: bool, n: int, earth_rate: float) -> Source:
+    """The GNSS fixes as a source: position, and velocity where used, stacked in that order."""
+
+    def measure(epoch: int, context: Context):
+        solution = context.solution
+        residual, H = measurements.gnss_position(solution, lever_arm, epochs.latitude[:, epoch],
+                                                 epochs.longitude[:, epoch], epochs.height[:, epoch], n)
+        sigma = epochs.sigma[epoch]
+        if velocity:
+            assert epochs.velocity is not None and epochs.velocity_sigma is not None
+            v_res, v_H = measurements.gnss_velocity(solution, lever_arm, epochs.velocity[:, epoch], n, earth_rate)
+            residual = np.concatenate([residual, v_res], axis=1)
+            H = np.concatenate([H, v_H], axis=1)
+            sigma = np.concatenate([sigma, epochs.velocity_sigma[epoch]])
+        return residual, H, np.diag(sigma**2)
+
+    return Source("gnss", epochs.t, measure, 6 if velocity else 3)
+
+
+def _groups(sources: Sequence[Source], t0: float, end: float) -> tuple[list[np.ndarray], list[list[tuple[int, int]]]]:
+    """Each source's epochs inside (t0, end], and the events: (source, epoch) pairs less than 1e-9 s apart."""
+    inside = [np.flatnonzero((source.t > t0) & (source.t <= end + 1e-9)) for source in sources]
+    pairs = sorted(((float(source.t[j]), s, int(j)) for s, source in enumerate(sources) for j in inside[s]),
+                   key=lambda e: e[0])
+    groups: list[list[tuple[int, int]]] = []
+    first = -math.inf
+    for time, s, j in pairs:
+        if time - first < 1e-9 and all(s != other for other, _ in groups[-1]):
+            groups[-1].append((s, j))
+        else:
+            groups.append([(s, j)])
+            first = time
+    return inside, groups
+
 
 def run_filter(increments: np.ndarray, interval: float, start: Start, model: FilterModel,
                gnss: GnssRecord | Sequence[GnssRecord], *,
                t0: float = 0.0, lever_arm=(0.0, 0.0, 0.0), covariance_interval: float = 1.0,
                use_velocity: bool = True, gate: float = kalman.DEFAULT_GATE, output_every: int = 1,
                initial_sensor_errors: np.ndarray | None = None, initial_sensor_sigma: np.ndarray | None = None,
-               earth_rate: float = EARTH_RATE) -> FilterRun:
+               earth_rate: float = EARTH_RATE, sources: Sequence[Source] = ()) -> FilterRun:
     """Filter a batch of members' IMU increments with GNSS fixes (module docstring).
 
     Parameters
@@ -379,10 +442,13 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     initial_sensor_errors : ndarray, shape (12,), optional
         Initial estimates b_g (rad/s), b_a (m/s^2), s_g, s_a compensated from the start.
     initial_sensor_sigma : ndarray, shape (6,) or (12,), optional
-        1-sigma of the sensor-error states at the start (rad/s, m/s^2, then the scale factors, 1); default the
-        model's (:meth:`~schuler.aided.error_state.FilterModel.initial_sigma`; KF-GINS's ``initbgstd`` ... differ).
+        1-sigma of the sensor-error states at the start (rad/s, m/s^2, then the scale factors, 1; the aiding
+        states' follow from the model); default the model's
+        (:meth:`~schuler.aided.error_state.FilterModel.initial_sigma`; KF-GINS's ``initbgstd`` ... differ).
     earth_rate : float
         Omega, rad/s.
+    sources : sequence of Source
+        Aiding besides GNSS (:mod:`schuler.aided.sources`), each named once, none named ``gnss``.
 
     Returns
     -------
@@ -399,33 +465,45 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     every_cov = int(round(steps))
     end = t0 + n_samples * interval
     epochs = _Epochs.of(gnss, members)
-    t = epochs.t
-    inside = np.flatnonzero((t > t0) & (t <= end + 1e-9))
-    n_cov = n_samples // every_cov + inside.size + 1
+    velocity = use_velocity and epochs.velocity is not None
+    names = [source.name for source in sources]
+    if "gnss" in names or len(set(names)) < len(names):
+        raise InvalidParameter("sources", f"each source once and none named gnss, got {names}")
+    every_source = [_gnss_source(epochs, lever_arm, velocity, n, earth_rate), *sources]
+    inside_of, groups = _groups(every_source, t0, end)
+    n_cov = n_samples // every_cov + len(groups) + 1
     n_out = n_samples // output_every
-    require(8.0 * members * (n_cov * (n * n + 12) + (n_out + 1) * _kernels.OUTPUT_SIZE), "the filter's stored "
-            "solution and covariances", "the duration, the members, the covariance interval or the output step")
-    navigator = _Navigator(start, increments, interval, t0, output_every, n_out, earth_rate)
+    logged = sum(kept.size * (2 + 2 * source.components) for source, kept in zip(every_source, inside_of))
+    require(8.0 * members * (n_cov * (n * n + 12 + n - model.sensor_size) + (n_out + 1) * _kernels.OUTPUT_SIZE
+                             + logged), "the filter's stored solution, covariances and innovations",
+            "the duration, the members, the covariance interval, the output step or the aiding rates")
+    logs = [SourceLog.empty(source.t[kept], members, source.components)
+            for source, kept in zip(every_source, inside_of)]
+    position_of = [{int(j): k for k, j in enumerate(kept)} for kept in inside_of]
+    aiding_states = n - model.sensor_size
+    navigator = _Navigator(start, increments, interval, t0, output_every, n_out, earth_rate, aiding_states)
     if initial_sensor_errors is not None:
         guess = np.asarray(initial_sensor_errors, dtype=float)
         navigator.gyro_bias[:], navigator.accel_bias[:] = guess[0:3], guess[3:6]
         navigator.gyro_scale[:], navigator.accel_scale[:] = guess[6:9], guess[9:12]
-    sensor_sigma = model.initial_sigma() if initial_sensor_sigma is None else np.asarray(initial_sensor_sigma, float)
+    sensor_sigma = model.initial_sigma()
+    if initial_sensor_sigma is not None:
+        sensor_sigma = np.concatenate([np.asarray(initial_sensor_sigma, float).reshape(-1),
+                                       sensor_sigma[sensor_sigma.size - aiding_states:]])
     if sensor_sigma.shape != (n - 9,):
-        raise InvalidParameter("initial_sensor_sigma", f"needs {n - 9} values for {n} states, got {sensor_sigma.shape}")
+        given = sensor_sigma.size - aiding_states
+        raise InvalidParameter("initial_sensor_sigma", f"needs {model.sensor_size - 9} values for "
+                                                       f"{model.sensor_size} states, got {given}")
     sigma0 = np.concatenate([start.position_sigma, start.velocity_sigma, start.attitude_sigma, sensor_sigma])
     P = np.broadcast_to(np.diag(sigma0**2), (members, n, n)).copy()
     accumulator = _Accumulator(members)
     point = navigator.point(accumulator)
     cov_t, covs, estimates = [t0], [P.copy()], [navigator.estimates()]
-    velocity = use_velocity and epochs.velocity is not None
-    m = 6 if velocity else 3
-    nis = np.zeros((members, inside.size))
-    accepted = np.zeros((members, inside.size), dtype=bool)
-    residuals = np.zeros((members, inside.size, m))
-    residual_sigma = np.zeros((members, inside.size, m))
+    aiding_estimates = [navigator.aiding.copy()]
     boundaries = t0 + np.arange(every_cov, n_samples + 1, every_cov) * interval
-    events = sorted([(float(b), -1) for b in boundaries] + [(float(t[j]), int(j)) for j in inside], key=lambda e: e[0])
+    events = sorted([(float(b), -1) for b in boundaries]
+                    + [(float(every_source[group[0][0]].t[group[0][1]]), g) for g, group in enumerate(groups)],
+                    key=lambda e: e[0])
 
     def propagate(P):
         elapsed = accumulator.elapsed
@@ -446,30 +524,30 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
             P = propagate(P)
         previous = time
         if epoch >= 0:
-            j = int(np.searchsorted(t[inside], time))
-            solution = navigator.solution()
-            residual, H = measurements.gnss_position(solution, lever_arm, epochs.latitude[:, epoch],
-                                                     epochs.longitude[:, epoch], epochs.height[:, epoch], n)
-            sigma = epochs.sigma[epoch]
-            if velocity:
-                assert epochs.velocity is not None and epochs.velocity_sigma is not None
-                v_res, v_H = measurements.gnss_velocity(solution, lever_arm, epochs.velocity[:, epoch], n, earth_rate)
-                residual = np.concatenate([residual, v_res], axis=1)
-                H = np.concatenate([H, v_H], axis=1)
-                sigma = np.concatenate([sigma, epochs.velocity_sigma[epoch]])
-            R = np.diag(sigma**2)
-            outcome = kalman.update(P, residual, H, R, gate)
+            context = navigator.context(accumulator, model)
+            blocks = [every_source[s].measure(j, context) for s, j in groups[epoch]]
+            if len(blocks) == 1:
+                outcome = kalman.update(P, *blocks[0], gate)
+                per_block = [outcome]
+            else:
+                outcome, per_block = kalman.stacked_update(P, blocks, gate)
             P = outcome.covariance
-            navigator.correct(outcome.correction, n)
-            nis[:, j], accepted[:, j] = outcome.nis, outcome.accepted
-            residuals[:, j], residual_sigma[:, j] = outcome.residual, outcome.residual_sigma
+            navigator.correct(outcome.correction, model)
+            for (s, j), block in zip(groups[epoch], per_block):
+                log, k = logs[s], position_of[s][j]
+                log.nis[:, k], log.accepted[:, k] = block.nis, block.accepted
+                log.residual[:, k], log.residual_sigma[:, k] = block.residual, block.residual_sigma
         accumulator.reset()
         point = navigator.point(accumulator)
         cov_t.append(time)
         covs.append(P.copy())
         estimates.append(navigator.estimates())
+        aiding_estimates.append(navigator.aiding.copy())
     if navigator.time < end - 1e-9:
         navigator.advance_to(end, accumulator)
     out_t = t0 + np.arange(1, n_out + 1) * output_every * interval
+    gnss_log = logs[0]
     return FilterRun(out_t, navigator.out[:, 1:], np.asarray(cov_t), np.stack(covs, axis=1),
-                     np.stack(estimates, axis=1), t[inside], nis, accepted, residuals, residual_sigma, n)
+                     np.stack(estimates, axis=1), gnss_log.t_s, gnss_log.nis, gnss_log.accepted, gnss_log.residual,
+                     gnss_log.residual_sigma, n, {source.name: log for source, log in zip(sources, logs[1:])},
+                     np.stack(aiding_estimates, axis=1))

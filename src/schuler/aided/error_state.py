@@ -12,7 +12,14 @@ index      unit   state
 12-14      m/s^2  b_a: residual accelerometer bias, body axes
 15-17      1      s_g: residual gyro scale-factor error (optional)
 18-20      1      s_a: residual accelerometer scale-factor error (optional)
+next       1      s_o: residual odometer scale-factor error (optional, after the 15 or 21)
+next       m      b_h: residual barometric height bias (optional, last)
 =========  =====  =====================================================================
+
+The aiding states (``FilterModel.odometer_scale``, ``FilterModel.barometer_bias``) are
+appended after the 15 or 21 in that order, each only when modelled: 15 to 23 states. Like the
+sensor states they are the residual errors of the compensated measurement (speed / (1 + s_hat_o),
+height - b_hat_h), have no coupling in F but their own process, and are fed back s_hat += delta_s.
 
 Continuous model delta_x' = F delta_x + w (the psi-angle model of spec 06):
 
@@ -66,10 +73,10 @@ STATE_UNITS = ("m",) * 3 + ("m/s",) * 3 + ("rad",) * 3 + ("rad/s",) * 3 + ("m/s^
 KINDS = ("constant", "random-walk", "gauss-markov")
 
 
-def _triple(name: str, value) -> np.ndarray:
-    array = np.broadcast_to(np.asarray(value, dtype=float), (3,)).copy()
+def _triple(name: str, value, axes: int = 3) -> np.ndarray:
+    array = np.broadcast_to(np.asarray(value, dtype=float), (axes,)).copy()
     if not np.all(np.isfinite(array)) or np.any(array < 0):
-        raise InvalidParameter(name, f"must be three finite numbers >= 0, got {value!r}")
+        raise InvalidParameter(name, f"must be {axes} finite number(s) >= 0, got {value!r}")
     return array
 
 
@@ -88,18 +95,21 @@ class ErrorProcess:
         Random-walk density sqrt(q) of ``random-walk``, state unit / sqrt(s) (ignored otherwise).
     correlation_time : float
         T of ``gauss-markov``, s (> 0; ignored otherwise).
+    axes : int
+        Number of states, 3 for a sensor triad, 1 for an aiding state (odometer scale, barometer bias).
     """
 
     kind: str = "constant"
     sigma: np.ndarray | float = 0.0
     random_walk: np.ndarray | float = 0.0
     correlation_time: float = np.inf
+    axes: int = 3
 
     def __post_init__(self):
         if self.kind not in KINDS:
             raise InvalidParameter("kind", f"{self.kind!r} is not a model; choose from {', '.join(KINDS)}")
-        object.__setattr__(self, "sigma", _triple("sigma", self.sigma))
-        object.__setattr__(self, "random_walk", _triple("random_walk", self.random_walk))
+        object.__setattr__(self, "sigma", _triple("sigma", self.sigma, self.axes))
+        object.__setattr__(self, "random_walk", _triple("random_walk", self.random_walk, self.axes))
         if self.kind == "gauss-markov" and not (np.isfinite(self.correlation_time) and self.correlation_time > 0):
             raise InvalidParameter("correlation_time", f"a Gauss-Markov process needs T > 0 s, got "
                                                        f"{self.correlation_time!r}")
@@ -116,7 +126,7 @@ class ErrorProcess:
             return np.asarray(self.random_walk) ** 2
         if self.kind == "gauss-markov":
             return 2.0 * np.asarray(self.sigma) ** 2 / self.correlation_time
-        return np.zeros(3)
+        return np.zeros(self.axes)
 
 
 @dataclass(frozen=True)
@@ -133,6 +143,10 @@ class FilterModel:
         Bias models, rad/s and m/s^2.
     gyro_scale, accel_scale : ErrorProcess or None
         Scale-factor models (dimensionless); None leaves the scale states out (15 states).
+    odometer_scale : ErrorProcess or None
+        Model of the odometer's scale-factor error (one axis, dimensionless); None: no state.
+    barometer_bias : ErrorProcess or None
+        Model of the barometric height bias (one axis, m); None: no state.
     """
 
     angle_random_walk: np.ndarray | float
@@ -141,28 +155,50 @@ class FilterModel:
     accel_bias: ErrorProcess
     gyro_scale: ErrorProcess | None = None
     accel_scale: ErrorProcess | None = None
+    odometer_scale: ErrorProcess | None = None
+    barometer_bias: ErrorProcess | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "angle_random_walk", _triple("angle_random_walk", self.angle_random_walk))
         object.__setattr__(self, "velocity_random_walk", _triple("velocity_random_walk", self.velocity_random_walk))
         if (self.gyro_scale is None) != (self.accel_scale is None):
             raise InvalidParameter("scale", "give both scale-factor models (21 states) or neither (15 states)")
+        for name in ("odometer_scale", "barometer_bias"):
+            process = getattr(self, name)
+            if process is not None and process.axes != 1:
+                raise InvalidParameter(name, f"is one state, got a model of {process.axes}")
+
+    @property
+    def sensor_size(self) -> int:
+        """Number of navigation and IMU error states: 15, or 21 with the scale factors."""
+        return 15 if self.gyro_scale is None else 21
 
     @property
     def size(self) -> int:
-        """Number of error states: 15, or 21 with the scale factors."""
-        return 15 if self.gyro_scale is None else 21
+        """Number of error states: ``sensor_size`` and the aiding states (module docstring)."""
+        return self.sensor_size + len(self.aiding_states())
+
+    def aiding_states(self) -> dict[str, int]:
+        """Index of each aiding state modelled: ``odometer_scale``, then ``barometer_bias``."""
+        names = [name for name in ("odometer_scale", "barometer_bias") if getattr(self, name) is not None]
+        return {name: self.sensor_size + k for k, name in enumerate(names)}
 
     def processes(self) -> list[tuple[slice, ErrorProcess]]:
-        """The sensor-error processes with the state slices they occupy."""
+        """The sensor-error and aiding processes with the state slices they occupy."""
         pairs = [(GYRO_BIAS, self.gyro_bias), (ACCEL_BIAS, self.accel_bias)]
         if self.gyro_scale is not None and self.accel_scale is not None:
             pairs += [(GYRO_SCALE, self.gyro_scale), (ACCEL_SCALE, self.accel_scale)]
+        for name, index in self.aiding_states().items():
+            pairs.append((slice(index, index + 1), getattr(self, name)))
         return pairs
 
     def initial_sigma(self) -> np.ndarray:
-        """1-sigma of the sensor-error states at the start (sizes 6 or 12), their units."""
+        """1-sigma of the sensor-error and aiding states at the start (sizes 6 or 12, then the aiding states)."""
         return np.concatenate([process.sigma for _, process in self.processes()])
+
+    def names(self) -> tuple[str, ...]:
+        """The states' names in their order (:data:`schuler.aided.error_state.STATE_NAMES`, then the aiding states')."""
+        return STATE_NAMES[:self.sensor_size] + tuple(self.aiding_states())
 
 
 @dataclass(frozen=True)
@@ -356,7 +392,7 @@ def system_matrix(model: FilterModel, point: NavigationPoint, earth_rate: float 
     F[..., ATTITUDE, ATTITUDE] = -skew(omega_ie + omega_en)
     F[..., ATTITUDE, GYRO_BIAS] = -C
     F[..., VELOCITY, ACCEL_BIAS] = C
-    if n == 21:
+    if model.sensor_size == 21:
         F[..., ATTITUDE, GYRO_SCALE] = -C * np.asarray(point.angular_rate)[..., None, :]
         F[..., VELOCITY, ACCEL_SCALE] = C * np.asarray(point.specific_force)[..., None, :]
     for states, process in model.processes():

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from schuler.aided import aiding as more_aiding
 from schuler.aided import analysis, files
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import KINDS, FilterModel, filter_model, overridden
@@ -52,7 +53,7 @@ from schuler.navigate.drive import GroundVehicleProfile, drive
 from schuler.navigate.truth import IdealImu, ideal_imu, sample_count
 from schuler.params import Case, IntervalsParameter, Parameter, ParameterSet
 
-AIDING = ("gnss-position", "gnss-velocity")
+AIDING = ("gnss-position", "gnss-velocity") + more_aiding.NAMES
 """The measurements ``aiding`` may name."""
 
 SIMULATED_SIGMA = (0.5, 0.5, 1.0)
@@ -102,8 +103,10 @@ PARAMETERS = ParameterSet((
     IntervalsParameter("outages", "s", None, "GNSS outages one by one, start:duration pairs (400:60,1000:90; "
                        "a scenario writes [[400, 60], [1000, 90]]; none: no outage); replaces the three options "
                        "above."),
-    Parameter("aiding", "", None, "Measurements used, comma-separated: " + ", ".join(AIDING) + " (not set: both; "
-              "with --kf-gins-config gnss-position, KF-GINS's model).", kind="text"),
+    Parameter("aiding", "", None, "Measurements used, comma-separated: " + ", ".join(AIDING) + " (not set: both "
+              "GNSS; with --kf-gins-config gnss-position, KF-GINS's model; the others on a simulated drive only).",
+              kind="text"),
+    *more_aiding.PARAMETERS,
     Parameter("covariance_interval", "s", 1.0, "Covariance propagation step (a whole number of IMU intervals; on "
               "files rounded to one).", minimum=0.0, exclusive_minimum=True, maximum=60.0),
     Parameter("filter_angle_random_walk", "deg/sqrt(h)", None, "The filter's gyro angle random walk, in place of "
@@ -138,7 +141,7 @@ OUTPUTS = (
     Output("heading_error_rms_rad", "rad", "deg", "RMS of the heading error"),
     Output("outage_horizontal_error_max_m", "m", "", "largest horizontal error in any outage"),
     Output("outage_horizontal_error_sigma_m", "m", "", "filter's horizontal 1-sigma at the end of that outage"),
-    Output("rejected_measurements", "1", "", "GNSS epochs the chi-square gate rejected"),
+    Output("rejected_measurements", "1", "", "measurement epochs the chi-square gate rejected, every source"),
 )
 
 SAMPLE_BYTES = 6 * 8 * 3 + 10 * 8 + 3 * 3 * 8
@@ -148,6 +151,8 @@ solution (10) and its three error histories (3 x 3)."""
 
 def aiding_of(text: str | None, default: str = "gnss-position,gnss-velocity") -> tuple[bool, bool]:
     """Which GNSS measurements ``aiding`` names: (position, velocity); refuses an unknown one with a suggestion.
+
+    The others it may name (:data:`schuler.aided.aiding.NAMES`) are read by :func:`schuler.aided.aiding.named`.
 
     Parameters
     ----------
@@ -305,9 +310,13 @@ def _simulated_group(case: Case, members: np.ndarray, streams):
     """One group of members of the same simulated case: the filter run, its errors and the outages."""
     require(member_bytes(case) * members.size, f"{members.size} members of this aided run", "--duration or --imu-rate")
     data = simulated_inputs(case, members, streams)
-    run = run_filter(data.increments, data.truth.interval_s, _start(data.path, members.size),
-                     assumed(case, filter_model(resolve_model(_imu(case)))), data.gnss, lever_arm=data.lever_arm,
-                     covariance_interval=case["covariance_interval"], use_velocity=data.use_velocity)
+    model = more_aiding.with_states(assumed(case, filter_model(resolve_model(_imu(case)))), case)
+    noisy = streams is not None and not case["nominal"]
+    extra = more_aiding.simulated_sources(case, data.path, data.increments, data.truth.interval_s, members,
+                                          streams if noisy else None, model)
+    run = run_filter(data.increments, data.truth.interval_s, _start(data.path, members.size), model, data.gnss,
+                     lever_arm=data.lever_arm, covariance_interval=case["covariance_interval"],
+                     use_velocity=data.use_velocity, sources=extra)
     truth = data.truth
     true = analysis.Truth(truth.latitude_rad, truth.longitude_rad, truth.height_m, truth.velocity_ned_m_s,
                           truth.quaternion)
@@ -327,6 +336,9 @@ def _file_group(case: Case, members: np.ndarray):
     kfgins_model = config is not None and case["imu"] is None
     _, use_velocity = aiding_of(case["aiding"], "gnss-position" if config is not None else
                                 "gnss-position,gnss-velocity")
+    if more_aiding.named(case["aiding"]):
+        raise InvalidParameter("aiding", f"{', '.join(more_aiding.named(case['aiding']))}: on a simulated drive only "
+                                         "(the files hold IMU and GNSS data)")
     if kfgins_model:
         assert config is not None
         model, initial, sigma = files.kfgins_model(config)
@@ -393,6 +405,9 @@ def _member(value, m: int):
         item = getattr(value, f.name)
         per_member = isinstance(item, np.ndarray) and item.ndim >= 2 and f.name not in ("t_s", "covariance_t_s",
                                                                                          "epoch_t_s")
+        if isinstance(item, dict):  # a run's other sources: each log alone
+            fields[f.name] = {name: _member(log, m) for name, log in item.items()}
+            continue
         fields[f.name] = item[m:m + 1] if per_member else item
     return dataclasses.replace(value, **fields)
 
@@ -429,7 +444,8 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
     return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors),
                                           "navigation": navigation_histories(full),
                                           "aided_innovations": innovation_histories(run)},
-                      extras=run_extras(run, errors, outages), units={"inside": "1", "band": "1"})
+                      extras=run_extras(run, errors, outages),
+                      units={"inside": "1", "band": "1", **{name: "1" for name in ("gnss",) + more_aiding.SOURCES}})
 
 
 def _variances(run, t_s: np.ndarray) -> np.ndarray:
@@ -552,4 +568,5 @@ def run_extras(run, errors, outages) -> dict:
         "nees": nees,
         "nis": {"inside": float(np.mean((nis >= low) & (nis <= high))) if nis.size else None,
                 "band": [float(low), float(high)]},
+        "rejected_by_source": {name: int(count[0]) for name, count in run.rejected_by_source().items()},  # epochs
     }

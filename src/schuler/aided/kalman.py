@@ -12,6 +12,11 @@ needs only the residual delta_z = h_hat - z_measured:
 * delta_x = K delta_z and the Joseph form P = (I - K H) P (I - K H)^T + K R K^T, which keeps
   P symmetric positive definite in floating point (Bucy and Joseph 1968), symmetrised.
 
+Measurements of several sources at one epoch (:func:`stacked_update`) are gated source by source,
+each on its own NIS against its own S block (the marginal of its residual), and the accepted ones
+applied in one update: a member's rejected block gets zero rows of H and of the residual, which
+leaves its gain columns zero, the same as leaving the block out.
+
 References
 ----------
 R. S. Bucy and P. D. Joseph, *Filtering for Stochastic Processes with Applications to
@@ -76,6 +81,17 @@ class Update:
     residual_sigma: np.ndarray
 
 
+def _innovation(P, residual, H, R):
+    """P H^T, S, its Cholesky factor and the NIS of every member."""
+    PHt = P @ np.swapaxes(H, -1, -2)
+    S = H @ PHt + R
+    S = 0.5 * (S + np.swapaxes(S, -1, -2))
+    L = np.linalg.cholesky(S)
+    # K^T = S^-1 H P: two triangular solves per member
+    whitened = np.linalg.solve(L, residual[..., None])[..., 0]
+    return PHt, S, L, np.einsum("...i,...i->...", whitened, whitened)
+
+
 @functools.lru_cache(maxsize=64)
 def gate_threshold(dimension: int, probability: float = DEFAULT_GATE) -> float:
     """The chi-square quantile a NIS of ``dimension`` degrees of freedom is compared with.
@@ -116,13 +132,7 @@ def update(P: np.ndarray, residual: np.ndarray, H: np.ndarray, R: np.ndarray,
     """
     H = np.broadcast_to(H, (P.shape[0],) + np.shape(H)[-2:])
     R = np.broadcast_to(R, (P.shape[0],) + np.shape(R)[-2:])
-    PHt = P @ np.swapaxes(H, -1, -2)
-    S = H @ PHt + R
-    S = 0.5 * (S + np.swapaxes(S, -1, -2))
-    L = np.linalg.cholesky(S)
-    # K^T = S^-1 H P: two triangular solves per member
-    whitened = np.linalg.solve(L, residual[..., None])[..., 0]
-    nis = np.einsum("...i,...i->...", whitened, whitened)
+    PHt, S, L, nis = _innovation(P, residual, H, R)
     accepted = nis <= gate_threshold(int(residual.shape[-1]), float(gate))
     K = np.swapaxes(np.linalg.solve(np.swapaxes(L, -1, -2), np.linalg.solve(L, np.swapaxes(PHt, -1, -2))), -1, -2)
     correction = np.einsum("...ij,...j->...i", K, residual) * accepted[:, None]
@@ -132,3 +142,46 @@ def update(P: np.ndarray, residual: np.ndarray, H: np.ndarray, R: np.ndarray,
     covariance = np.where(accepted[:, None, None], posterior, P)
     sigma = np.sqrt(np.diagonal(S, axis1=-2, axis2=-1))
     return Update(correction, covariance, nis, accepted, residual, sigma)
+
+
+def stacked_update(P: np.ndarray, blocks, gate: float = DEFAULT_GATE) -> tuple[Update, list[Update]]:
+    """Several sources' measurements at one epoch: each gated on its own, the accepted applied at once.
+
+    Parameters
+    ----------
+    P : ndarray, shape (N, n, n)
+        Prior covariance, (state units)^2.
+    blocks : sequence of (residual, H, R)
+        Each source's residual (N, m_i), H ([N,] m_i, n) and R ([N,] m_i, m_i), measurement units.
+    gate : float
+        Chi-square gate probability, a plain number in (0, 1] (1: no gate).
+
+    Returns
+    -------
+    update, per_block : Update, list of Update
+        The joint update (its ``accepted``: every block accepted), and each block's NIS, acceptance, residual and
+        predicted 1-sigma (their ``correction`` and ``covariance`` those of the joint update).
+    """
+    members = P.shape[0]
+    stats, residuals, Hs, Rs = [], [], [], []
+    for residual, H, R in blocks:
+        H = np.broadcast_to(H, (members,) + np.shape(H)[-2:])
+        R = np.broadcast_to(R, (members,) + np.shape(R)[-2:])
+        _, S, _, nis = _innovation(P, residual, H, R)
+        accepted = nis <= gate_threshold(int(residual.shape[-1]), float(gate))
+        stats.append((nis, accepted, residual, np.sqrt(np.diagonal(S, axis1=-2, axis2=-1))))
+        residuals.append(residual * accepted[:, None])
+        Hs.append(H * accepted[:, None, None])
+        Rs.append(R)
+    m = sum(r.shape[-1] for r in residuals)
+    R_all = np.zeros((members, m, m))
+    start = 0
+    for R in Rs:
+        stop = start + R.shape[-1]
+        R_all[:, start:stop, start:stop] = R
+        start = stop
+    joint = update(P, np.concatenate(residuals, axis=-1), np.concatenate(Hs, axis=-2), R_all, 1.0)
+    every = np.logical_and.reduce([accepted for _, accepted, _, _ in stats])
+    joint = Update(joint.correction, joint.covariance, joint.nis, every, joint.residual, joint.residual_sigma)
+    return joint, [Update(joint.correction, joint.covariance, nis, accepted, residual, sigma)
+                   for nis, accepted, residual, sigma in stats]

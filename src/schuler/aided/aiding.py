@@ -1,0 +1,174 @@
+"""The aiding besides GNSS of a simulated ``schuler aided run``: its parameters, its data and its sources.
+
+``--aiding`` names, beside ``gnss-position`` and ``gnss-velocity``:
+
+* ``zupt`` and ``zaru``: zero velocity and zero angular rate at ``zupt_rate`` during the stops, the
+  drive's own stationary intervals (``stops given``) or those found in each member's IMU data
+  (``stops detected``: :func:`schuler.aided.sources.detect_stops`, window
+  :data:`~schuler.aided.sources.STOP_WINDOW_S`, threshold :data:`~schuler.aided.sources.STOP_THRESHOLD`;
+  on the drive's vibration-free cruises it also marks the cruises, whose false updates the gate must refuse);
+* ``nhc``: the wheel point's lateral and vertical velocities zero, at the odometer's epochs;
+* ``odometer``: the wheel point's forward speed (:func:`schuler.aided.epochs.simulate_odometer`: white
+  noise ``odometer_sigma``, scale error ``odometer_scale_error``), with an odometer scale-factor state if
+  ``odometer_scale_state``;
+* ``baro``: the barometric height (:func:`schuler.aided.epochs.simulate_barometer`: white noise
+  ``baro_sigma``, bias ``baro_bias``), with a bias state if ``baro_bias_state``.
+
+The drive's IMU is aligned with the vehicle: mounting angles set here are those the filter assumes, a
+mounting error on the simulated drive.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from schuler.aided import sources
+from schuler.aided.epochs import (
+    DEFAULT_BAROMETER_SIGMA_M,
+    DEFAULT_ODOMETER_SIGMA_M_S,
+    simulate_barometer,
+    simulate_odometer,
+)
+from schuler.aided.error_state import ErrorProcess, FilterModel
+from schuler.aided.measurements import mounting_matrix
+from schuler.exceptions import InvalidParameter
+from schuler.params import Case, Parameter
+
+NAMES = ("zupt", "zaru", "nhc", "odometer", "baro")
+"""The measurements besides GNSS ``aiding`` may name."""
+
+SOURCES = ("zupt", "zaru", "vehicle", "baro")
+"""The sources they make (:mod:`schuler.aided.sources`): nhc and odometer are one, ``vehicle``."""
+
+ODOMETER_SCALE_SIGMA = 0.01
+"""Initial 1-sigma of the odometer scale-factor state, dimensionless (1 %, a tyre's wear and pressure)."""
+
+BAROMETER_BIAS_SIGMA_M = 10.0
+"""Initial 1-sigma of the barometer bias state, m."""
+
+PARAMETERS = (
+    Parameter("stops", "", "given", "Stops for zupt and zaru: the drive's own (given) or found in the IMU data by a "
+              "moving-variance test (detected).", kind="choice", choices=("given", "detected")),
+    Parameter("zupt_rate", "Hz", 10.0, "Rate of the zero-velocity and zero-rate updates during a stop.",
+              minimum=0.01, maximum=100.0),
+    Parameter("zupt_sigma", "m/s", 0.01, "1-sigma of the velocity at a stop.", minimum=0.0, exclusive_minimum=True,
+              maximum=10.0),
+    Parameter("zaru_sigma", "deg/h", 10.0, "1-sigma of the angular rate at a stop, besides the gyro noise.",
+              minimum=0.0, exclusive_minimum=True, maximum=1e5),
+    Parameter("odometer_rate", "Hz", 10.0, "Rate of the odometer and of the non-holonomic constraint.",
+              minimum=0.01, maximum=200.0),
+    Parameter("odometer_sigma", "m/s", DEFAULT_ODOMETER_SIGMA_M_S, "Odometer speed 1-sigma (simulated and assumed).",
+              minimum=0.0, exclusive_minimum=True, maximum=10.0),
+    Parameter("odometer_scale_error", "ppm", 0.0, "Simulated odometer scale error.", minimum=-1e5, maximum=1e5),
+    Parameter("odometer_scale_state", "", False, "Estimate the odometer's scale factor (one more state).",
+              kind="flag"),
+    Parameter("nhc_sigma", "m/s", 0.1, "1-sigma of the wheel's lateral and vertical velocity (skid, suspension).",
+              minimum=0.0, exclusive_minimum=True, maximum=10.0),
+    Parameter("wheel_lever_arm_x", "m", 0.0, "IMU to the wheel's contact point, body x (forward).", minimum=-30.0,
+              maximum=30.0),
+    Parameter("wheel_lever_arm_y", "m", 0.0, "IMU to the wheel's contact point, body y (right).", minimum=-30.0,
+              maximum=30.0),
+    Parameter("wheel_lever_arm_z", "m", 0.0, "IMU to the wheel's contact point, body z (down).", minimum=-30.0,
+              maximum=30.0),
+    Parameter("mounting_roll", "deg", 0.0, "The IMU's roll in the vehicle frame, as the filter assumes it.",
+              minimum=-180.0, maximum=180.0),
+    Parameter("mounting_pitch", "deg", 0.0, "The IMU's pitch in the vehicle frame.", minimum=-90.0, maximum=90.0),
+    Parameter("mounting_heading", "deg", 0.0, "The IMU's heading in the vehicle frame.", minimum=-180.0,
+              maximum=180.0),
+    Parameter("baro_rate", "Hz", 1.0, "Barometer rate.", minimum=0.01, maximum=100.0),
+    Parameter("baro_sigma", "m", DEFAULT_BAROMETER_SIGMA_M, "Barometric height 1-sigma (simulated and assumed).",
+              minimum=0.0, exclusive_minimum=True, maximum=100.0),
+    Parameter("baro_bias", "m", 0.0, "Simulated barometric height bias.", minimum=-1e4, maximum=1e4),
+    Parameter("baro_bias_state", "", False, "Estimate the barometer's bias (one more state).", kind="flag"),
+)
+"""The options of the aiding besides GNSS (module docstring)."""
+
+
+def named(text: str | None) -> tuple[str, ...]:
+    """The measurements besides GNSS that ``aiding`` names (already checked against the known names).
+
+    Parameters
+    ----------
+    text : str or None
+        Comma-separated names; None: none besides GNSS.
+    """
+    return tuple(name for name in NAMES if text is not None and name in
+                 [part.strip() for part in str(text).split(",")])
+
+
+def with_states(model: FilterModel, case: Case) -> FilterModel:
+    """The filter's model with the aiding states the case asks for (odometer scale, barometer bias).
+
+    Parameters
+    ----------
+    model : FilterModel
+        The filter's IMU model.
+    case : Case
+        A validated case (``aiding``, ``odometer_scale_state``, ``baro_bias_state``).
+    """
+    names = named(case["aiding"])
+    odometer = ErrorProcess("constant", ODOMETER_SCALE_SIGMA, axes=1) \
+        if case["odometer_scale_state"] and "odometer" in names else None
+    barometer = ErrorProcess("constant", BAROMETER_BIAS_SIGMA_M, axes=1) \
+        if case["baro_bias_state"] and "baro" in names else None
+    return FilterModel(model.angle_random_walk, model.velocity_random_walk, model.gyro_bias, model.accel_bias,
+                       model.gyro_scale, model.accel_scale, odometer, barometer)
+
+
+def simulated_sources(case: Case, path, increments: np.ndarray, interval: float, members: np.ndarray, streams,
+                      model: FilterModel) -> list[sources.Source]:
+    """The sources besides GNSS of a simulated case, their data drawn for each member (module docstring).
+
+    Parameters
+    ----------
+    case : Case
+        A validated simulated case (SI).
+    path : GroundVehicleProfile
+        The drive.
+    increments : ndarray, shape (N, n, 6)
+        The members' IMU increments, rad and m/s (for ``stops detected``).
+    interval : float
+        IMU interval, s.
+    members : ndarray of int
+        Member numbers (the addresses of the random draws).
+    streams : RandomStreams or None
+        The noise's source; None: noise-free data.
+    model : FilterModel
+        The filter's model, with its aiding states (:func:`schuler.aided.aiding.with_states`).
+    """
+    names = named(case["aiding"])
+    duration, imu_rate = case["duration"], case["imu_rate"]
+    built: list[sources.Source] = []
+    if "zupt" in names or "zaru" in names:
+        if case["stops"] == "given":
+            stops = path.stationary_intervals()
+        else:
+            if increments.shape[0] > 1 and not np.array_equal(increments[0], increments[-1]):
+                raise InvalidParameter("stops", "detected stops are one record's: run the members one by one or "
+                                                "give the drive's stops (--stops given)")
+            noise = math.sqrt(interval)
+            stops = sources.detect_stops(increments[0], interval, float(np.max(model.angle_random_walk)) / noise,
+                                         float(np.max(model.velocity_random_walk)) / noise)
+        times = sources.stop_epochs(stops, case["zupt_rate"])
+        if "zupt" in names:
+            built.append(sources.zero_velocity_source(times, case["zupt_sigma"], model))
+        if "zaru" in names:
+            built.append(sources.zero_rate_source(times, case["zaru_sigma"], model))
+    arm = (case["wheel_lever_arm_x"], case["wheel_lever_arm_y"], case["wheel_lever_arm_z"])
+    if "odometer" in names or "nhc" in names:
+        records = [simulate_odometer(path, duration, imu_rate=imu_rate, rate=case["odometer_rate"], lever_arm=arm,
+                                     scale_factor_error=case["odometer_scale_error"], sigma=case["odometer_sigma"],
+                                     streams=streams, member=int(m)) for m in members]
+        speed = np.stack([record.speed_m_s for record in records]) if "odometer" in names else None
+        mounting = mounting_matrix(case["mounting_roll"], case["mounting_pitch"], case["mounting_heading"])
+        built.append(sources.vehicle_source(records[0].t_s, speed, model, lever_arm=arm, mounting=mounting,
+                                            speed_sigma=case["odometer_sigma"], constraint_sigma=case["nhc_sigma"],
+                                            constraint="nhc" in names))
+    if "baro" in names:
+        heights = [simulate_barometer(path, duration, imu_rate=imu_rate, rate=case["baro_rate"], bias=case["baro_bias"],
+                                      sigma=case["baro_sigma"], streams=streams, member=int(m)) for m in members]
+        built.append(sources.barometer_source(heights[0].t_s, np.stack([r.height_m for r in heights]),
+                                              case["baro_sigma"], model))
+    return built
