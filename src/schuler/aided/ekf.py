@@ -165,6 +165,13 @@ class FilterRun:
         Residuals delta_z (m, then m/s for velocity).
     residual_sigma : ndarray, shape (N, k, m)
         Their predicted 1-sigma, sqrt(diag(S)).
+    prior_covariance : ndarray, shape (N, n_cov, n, n), or None
+        P before any update at each of those times (the initial P first), (state units)^2; kept for the smoother
+        (``keep_for_smoother``), None otherwise.
+    transition : ndarray, shape (N, n_cov, n, n), or None
+        Phi from the previous stored time to each (the identity first and where no time passed), likewise.
+    correction : ndarray, shape (N, n_cov, n), or None
+        The estimated errors fed back at each of those times (zero where none), state units, likewise.
     """
 
     t_s: np.ndarray
@@ -178,6 +185,9 @@ class FilterRun:
     residual: np.ndarray
     residual_sigma: np.ndarray
     n_states: int = field(default=21)
+    prior_covariance: np.ndarray | None = field(default=None, repr=False)
+    transition: np.ndarray | None = field(default=None, repr=False)
+    correction: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def rejected(self) -> np.ndarray:
@@ -230,6 +240,7 @@ class _Navigator:
         self.accel_scale = np.zeros((n, 3))
         self.last_rate = np.zeros((n, 3))
         self._zeros_row = np.zeros((n, 12))
+        self.fed_back: np.ndarray | None = None  # the sum of the corrections since it was last taken, when kept
         self._dummy_out = np.zeros((n, 1, _kernels.OUTPUT_SIZE))
 
     @property
@@ -311,6 +322,8 @@ class _Navigator:
 
     def correct(self, dx: np.ndarray, n_states: int) -> None:
         """Feed the estimated errors back into the solution and the sensor compensation."""
+        if self.fed_back is not None:
+            self.fed_back += dx
         st = self.state
         lat, h = st[:, _kernels.LAT], st[:, _kernels.HGT]
         R_N, R_E = radii_of_curvature(lat)
@@ -347,7 +360,7 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
                t0: float = 0.0, lever_arm=(0.0, 0.0, 0.0), covariance_interval: float = 1.0,
                use_velocity: bool = True, gate: float = kalman.DEFAULT_GATE, output_every: int = 1,
                initial_sensor_errors: np.ndarray | None = None, initial_sensor_sigma: np.ndarray | None = None,
-               earth_rate: float = EARTH_RATE) -> FilterRun:
+               earth_rate: float = EARTH_RATE, keep_for_smoother: bool = False) -> FilterRun:
     """Filter a batch of members' IMU increments with GNSS fixes (module docstring).
 
     Parameters
@@ -383,6 +396,9 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         model's (:meth:`~schuler.aided.error_state.FilterModel.initial_sigma`; KF-GINS's ``initbgstd`` ... differ).
     earth_rate : float
         Omega, rad/s.
+    keep_for_smoother : bool
+        Whether to keep, at every stored covariance, the prior P, Phi and the correction fed back
+        (:func:`schuler.aided.smoother.smooth` needs them; 2 n^2 + n more doubles per member and stored time).
 
     Returns
     -------
@@ -403,8 +419,10 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     inside = np.flatnonzero((t > t0) & (t <= end + 1e-9))
     n_cov = n_samples // every_cov + inside.size + 1
     n_out = n_samples // output_every
-    require(8.0 * members * (n_cov * (n * n + 12) + (n_out + 1) * _kernels.OUTPUT_SIZE), "the filter's stored "
-            "solution and covariances", "the duration, the members, the covariance interval or the output step")
+    kept = 2 * n * n + n if keep_for_smoother else 0
+    require(8.0 * members * (n_cov * (n * n + 12 + kept) + (n_out + 1) * _kernels.OUTPUT_SIZE), "the filter's stored "
+            "solution and covariances" + (" with the smoother's" if kept else ""),
+            "the duration, the members, the covariance interval or the output step")
     navigator = _Navigator(start, increments, interval, t0, output_every, n_out, earth_rate)
     if initial_sensor_errors is not None:
         guess = np.asarray(initial_sensor_errors, dtype=float)
@@ -418,6 +436,10 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     accumulator = _Accumulator(members)
     point = navigator.point(accumulator)
     cov_t, covs, estimates = [t0], [P.copy()], [navigator.estimates()]
+    identity = np.broadcast_to(np.eye(n), (members, n, n))
+    if keep_for_smoother:
+        navigator.fed_back = np.zeros((members, n))
+        priors, transitions, corrections = [P.copy()], [identity], [np.zeros((members, n))]
     velocity = use_velocity and epochs.velocity is not None
     m = 6 if velocity else 3
     nis = np.zeros((members, inside.size))
@@ -430,21 +452,25 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     def propagate(P):
         elapsed = accumulator.elapsed
         if elapsed <= 0:
-            return P
+            return P, identity
         start_point = NavigationPoint(point.latitude, point.height, point.velocity, point.body_to_ned,
                                       accumulator.velocity / elapsed, accumulator.angle / elapsed)
         Phi, Q = transition(model, start_point, elapsed, earth_rate)
         navigator.decay(model, elapsed)
-        return kalman.predict(P, Phi, Q)
+        return kalman.predict(P, Phi, Q), Phi
 
     previous = t0
     for index, (time, epoch) in enumerate(events):
         if epoch < 0 and index + 1 < len(events) and abs(events[index + 1][0] - time) < 1e-9:
             continue  # an epoch at the same time follows: propagate once, there
+        Phi = identity
         if time - previous > 1e-12:
             navigator.advance_to(time, accumulator)
-            P = propagate(P)
+            P, Phi = propagate(P)
         previous = time
+        if keep_for_smoother:
+            priors.append(P.copy())
+            transitions.append(np.broadcast_to(Phi, (members, n, n)))
         if epoch >= 0:
             j = int(np.searchsorted(t[inside], time))
             solution = navigator.solution()
@@ -468,8 +494,16 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         cov_t.append(time)
         covs.append(P.copy())
         estimates.append(navigator.estimates())
+        if keep_for_smoother:
+            assert navigator.fed_back is not None
+            corrections.append(navigator.fed_back.copy())
+            navigator.fed_back[:] = 0.0
     if navigator.time < end - 1e-9:
         navigator.advance_to(end, accumulator)
     out_t = t0 + np.arange(1, n_out + 1) * output_every * interval
-    return FilterRun(out_t, navigator.out[:, 1:], np.asarray(cov_t), np.stack(covs, axis=1),
-                     np.stack(estimates, axis=1), t[inside], nis, accepted, residuals, residual_sigma, n)
+    run = FilterRun(out_t, navigator.out[:, 1:], np.asarray(cov_t), np.stack(covs, axis=1),
+                    np.stack(estimates, axis=1), t[inside], nis, accepted, residuals, residual_sigma, n)
+    if keep_for_smoother:
+        run.prior_covariance, run.transition = np.stack(priors, axis=1), np.stack(transitions, axis=1)
+        run.correction = np.stack(corrections, axis=1)
+    return run
