@@ -19,7 +19,10 @@ from schuler.aided import analysis, kalman, smoother
 from schuler.aided.ekf import run_filter
 from schuler.exceptions import InvalidParameter
 from schuler.memory import MemoryBudgetExceeded
+from schuler.navigate.trajectory import WaypointProfile
+from schuler.navigate.truth import ideal_imu
 from schuler.registry import get_system
+from test_aided_filter import gnss_from, increments_of, start_of, tactical_model
 
 AIDED = get_system("aided")
 
@@ -123,11 +126,6 @@ def test_between_covariance_times_the_interpolated_smoother_is_the_one_kept_at_e
     # a straight 80-s drive at 50 Hz (F constant: the 1-s step's Phi is exact) with a 30-s outage, biased and noisy
     # sensors, one member: the smoother kept every second and interpolated to the samples against the one kept at
     # every sample (measured: 0.6 % of the 1-sigma at most, the 1-sigma alike to 0.17 %)
-    from test_aided_filter import gnss_from, increments_of, start_of, tactical_model
-
-    from schuler.navigate.trajectory import WaypointProfile
-    from schuler.navigate.truth import ideal_imu
-
     rate, duration = 50.0, 80.0
     path = WaypointProfile(latitude=np.radians(30.5), longitude=np.radians(114.5), height=20.0, times=[0, duration],
                            speeds=[10.0, 10.0], headings=[0.5, 0.5], flight_path_angles=[0.0, 0.0])
@@ -226,8 +224,6 @@ def test_a_thousand_members_smoothed_errors_match_their_smoothed_sigma(consisten
 
 def test_the_memory_is_estimated_before_the_run_and_refused_above_the_budget(consistency_members, monkeypatch):
     chunks, path, imu, _, times = consistency_members
-    from test_aided_filter import gnss_from, increments_of, start_of, tactical_model
-
     increments, fixes = increments_of(imu), gnss_from(imu, times)
     # one member over 300 s: 541 stored times; the forward run holds 8 (541 (21^2 + 12) + 15,001 x 20) bytes,
     # about 4.4 MB; the smoother's prior P, Phi and corrections 8 x 541 x 903 more, 3.9 MB
@@ -273,3 +269,20 @@ def test_aided_run_smooth_gives_the_forward_keys_smoothed_and_the_smoothed_colum
         errors["smoothed_horizontal_error_m"][inside].max(), rel=1e-12)
     plain = AIDED.run(duration=300.0, outage_start=120.0, seed=3)
     assert "smoothed" not in plain.extras and plain.outputs == result.outputs
+
+
+def test_a_run_on_files_is_smoothed_against_its_reference_and_without_one(tmp_path):
+    from schuler.aided.outputs import write_simulated_files
+
+    paths = write_simulated_files(AIDED.case(duration=300.0, outage_start=120.0), tmp_path, week_start=456_300.0)
+    result = AIDED.run(kf_gins_config=str(paths["configuration"]), reference=str(paths["reference"]), smooth=True)
+    (forward,), (smoothed,) = result.outages, result.smoothed["outages"]
+    # KF-GINS's model on the tactical IMU's data (measured: 15.9 m forward, 0.80 m smoothed)
+    assert smoothed["horizontal_error_max_m"] < 0.1 * forward["horizontal_error_max_m"]
+    assert smoothed["start_s"] == forward["start_s"] == 456_420.0
+    alone = AIDED.run(kf_gins_config=str(paths["configuration"]), smooth=True)
+    (outage,) = alone.smoothed["outages"]
+    assert outage["horizontal_error_max_m"] is None
+    assert outage["horizontal_error_sigma_m"] == pytest.approx(smoothed["horizontal_error_sigma_m"], rel=1e-12)
+    assert "smoothed_north_sigma_m" in alone.histories["aided_errors"] \
+        and "smoothed_north_error_m" not in alone.histories["aided_errors"]

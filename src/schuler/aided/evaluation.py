@@ -364,16 +364,17 @@ def _file_group(case: Case, members: np.ndarray, smooth: bool = False):
                      lever_arm=files.lever_arm_of(case, config), covariance_interval=steps * dt,
                      use_velocity=use_velocity, initial_sensor_errors=initial, initial_sensor_sigma=sigma,
                      keep_for_smoother=smooth)
-    smoothed = smoother.smooth(run) if smooth else None
+    smoothed_run = smoother.smooth(run) if smooth else None
     if inputs.reference is None:
-        return run, None, inputs.outages, run, None if smoothed is None else (smoothed, None)
+        return run, None, inputs.outages, run, None if smoothed_run is None else (smoothed_run, None)
     kept, latitude, longitude, height, velocity, quaternion = files.reference_at(inputs.reference, run.t_s)
     if not kept.any():
         raise InvalidParameter("reference", "no output time falls inside the reference's span")
     truth = analysis.Truth(latitude, longitude, height, velocity, quaternion)
     inside = dataclasses.replace(run, t_s=run.t_s[kept], solution=run.solution[:, kept])
-    if smoothed is not None:
-        smoothed_inside = dataclasses.replace(smoothed, t_s=inside.t_s, solution=smoothed.solution[:, kept])
+    smoothed = None
+    if smoothed_run is not None:
+        smoothed_inside = dataclasses.replace(smoothed_run, t_s=inside.t_s, solution=smoothed_run.solution[:, kept])
         smoothed = (smoothed_inside, analysis.errors(smoothed_inside, truth))
     return inside, analysis.errors(inside, truth), inputs.outages, run, smoothed
 
@@ -465,7 +466,7 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
     run, errors, outages, full, smoothed = kept
     extras = run_extras(run, errors, outages)
     if smoothed is not None:
-        extras["smoothed"] = smoothed_extras(*smoothed, outages)
+        extras["smoothed"] = smoothed_extras(smoothed[0], smoothed[1], outages)
     return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors, smoothed),
                                           "navigation": navigation_histories(full),
                                           "aided_innovations": innovation_histories(run)},

@@ -170,13 +170,13 @@ def smoothed_bytes(members: int, stored: int, outputs: int, n: int) -> float:
     Parameters
     ----------
     members : int
-        N.
+        N, the members.
     stored : int
-        Stored times of the forward run.
+        Stored times of the forward run (a count).
     outputs : int
-        Output times.
+        Output times (a count).
     n : int
-        States.
+        Number of states.
     """
     return 8.0 * members * (stored * (2 * n * n + n) + outputs * (3 * 10 + 2 * NAVIGATION_STATES))
 
