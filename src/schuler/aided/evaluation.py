@@ -438,7 +438,7 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
         ``cases.members[i]`` (None: the nominal case). A case on files (:mod:`schuler.aided.files`) is one member.
     histories : bool
         Whether to return the first case's error histories, 1-sigma envelopes, navigation solution, outages and
-        consistency.
+        consistency (with its ``smooth``, its member 0 smoothed beside: module docstring).
     """
     outputs = {output.name: np.full(len(cases), math.nan) for output in OUTPUTS}
     kept = None
@@ -466,29 +466,13 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
     run, errors, outages, full, smoothed = kept
     extras = run_extras(run, errors, outages)
     if smoothed is not None:
-        extras["smoothed"] = smoothed_extras(smoothed[0], smoothed[1], outages)
+        # the forward run's keys from the smoothed run and its errors (a NaN, without a truth, is written as null)
+        summary = {name: float(values[0]) for name, values in _summaries(smoothed[0], smoothed[1], outages).items()}
+        extras["smoothed"] = {**summary, **run_extras(smoothed[0], smoothed[1], outages)}
     return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors, smoothed),
                                           "navigation": navigation_histories(full),
                                           "aided_innovations": innovation_histories(run)},
                       extras=extras, units={"inside": "1", "band": "1"})
-
-
-def smoothed_extras(smoothed, errors, outages) -> dict:
-    """The ``smoothed`` extra: the forward run's output and extra keys from the smoothed run (NIS and rejected
-    epochs: the forward run's).
-
-    Parameters
-    ----------
-    smoothed : FilterRun
-        :func:`schuler.aided.smoother.smooth` of one member.
-    errors : analysis.Errors or None
-        Its errors against the truth.
-    outages : sequence of (float, float)
-        The outages, (start, duration), s.
-    """
-    # the JSON writes a NaN (no truth) as null, as it does the forward outputs
-    summary = {name: float(values[0]) for name, values in _summaries(smoothed, errors, outages).items()}
-    return {**summary, **run_extras(smoothed, errors, outages)}
 
 
 def _variances(run, t_s: np.ndarray) -> np.ndarray:
