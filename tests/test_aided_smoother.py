@@ -17,7 +17,7 @@ import scipy.linalg
 
 from schuler.aided import analysis, kalman, smoother
 from schuler.aided.ekf import run_filter
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, SimulationError
 from schuler.memory import MemoryBudgetExceeded
 from schuler.navigate.trajectory import WaypointProfile
 from schuler.navigate.truth import ideal_imu
@@ -98,6 +98,19 @@ def test_the_fixed_interval_smoother_is_the_batch_least_squares_solution():
     assert np.all(errors[:, -1] == 0.0)
     filtered = np.trace(stack["posterior"][:, :-1], axis1=-2, axis2=-1)
     assert np.all(np.trace(covariance[:, :-1], axis1=-2, axis2=-1) <= filtered + 1e-12)
+
+
+def test_a_prior_without_variance_or_not_positive_definite_is_refused_in_one_line():
+    kept, _ = closed_loop_chain(np.random.default_rng(3), members=2, steps=6)
+    stack = {name: np.stack(kept[name], axis=1) for name in ("posterior", "prior", "transition", "correction")}
+    flat = stack["prior"].copy()
+    flat[1, 4, 2, :] = flat[1, 4, :, 2] = 0.0  # member 1, time 4: a state that never varied
+    with pytest.raises(SimulationError, match="prior variance > 0"):
+        smoother.rts(stack["posterior"], flat, stack["transition"], stack["correction"])
+    indefinite = stack["prior"].copy()
+    indefinite[0, 3, 0, 1] = indefinite[0, 3, 1, 0] = 2.0 * np.sqrt(indefinite[0, 3, 0, 0] * indefinite[0, 3, 1, 1])
+    with pytest.raises(SimulationError, match="stored time 3 is not positive definite"):
+        smoother.rts(stack["posterior"], indefinite, stack["transition"], stack["correction"])
 
 
 def test_taking_out_an_error_undoes_putting_it_in():

@@ -34,10 +34,12 @@ between x_k^s (at t_k, after the feedback) and x_{k+1}^s + c_{k+1} (at t_{k+1}, 
 variances between P_k^s and P_{k+1}^s. The exact smoothed mean of the linear model is
 Phi(t, t_k) x_k^s + Q(t, t_k) lambda(t) (the smoothed process noise; lambda = Phi(t_{k+1}, t)^T
 (P_{k+1}^-)^-1 (x_{k+1}^s + c_{k+1})): the straight line differs from it by the error's curvature over the
-interval Delta, at most Delta^2 / 8 max|d^2 e / dt^2| -- for position Delta^2 / 8 |d(delta_v)/dt|, with
-d(delta_v)/dt = psi x f + C_b^n b_a about 1 mrad x 9.8 m/s^2 for a tactical IMU: 1.2 mm at Delta = 1 s --
-and the interpolated variance misses the bridge term of the process noise over the interval, at most Q_d / 4
-(for velocity N_a^2 Delta / 4). After the last stored time the smoothed error is the filter's, zero.
+interval Delta, at most Delta^2 / 8 times the largest d^2 e / dt^2 -- for position Delta^2 / 8 times
+d(delta_v)/dt = -psi x f^n + C_b^n b_a + ..., where 1 mrad of tilt gives 9.8 mm/s^2 and so 1.2 mm at
+Delta = 1 s -- and the interpolated variance misses the bridge term of the process noise over the interval,
+at most Q_d / 4 (for velocity N_a^2 Delta / 4). After the last stored time the smoothed error is the filter's,
+zero. (Measured on a straight drive, against the smoother kept at every IMU sample: 0.6 % of the 1-sigma at
+most; tests/test_aided_smoother.py.)
 
 References
 ----------
@@ -95,10 +97,11 @@ def rts(posterior: np.ndarray, prior: np.ndarray, transition: np.ndarray,
     covariance[:, -1] = posterior[:, -1]
     for k in range(count - 2, -1, -1):
         ahead = prior[:, k + 1]
-        scale = 1.0 / np.sqrt(np.diagonal(ahead, axis1=-2, axis2=-1))
-        if not np.all(np.isfinite(scale)):
+        variance = np.diagonal(ahead, axis1=-2, axis2=-1)
+        if not np.all(variance > 0):
             raise SimulationError("the smoother needs every state's prior variance > 0 (give each state a positive "
                                   "initial 1-sigma)")
+        scale = 1.0 / np.sqrt(variance)
         try:
             factor = scipy.linalg.cho_factor(ahead * scale[:, :, None] * scale[:, None, :])
         except np.linalg.LinAlgError:
