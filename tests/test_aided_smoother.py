@@ -1,8 +1,8 @@
 """The Rauch-Tung-Striebel smoother over the closed-loop aided filter (spec 07, "Smoother").
 
 A linear-Gaussian chain filtered in closed loop with the package's own predict and update, smoothed, against the
-batch weighted least-squares solution of the whole interval (the fixed-interval smoother is that solution); the
-feedback's signs as a round trip; the smoothed outage drift and its 1-sigma on seeded drives (1,000 members:
+batch weighted least-squares solution of the whole interval (the fixed-interval smoother is that solution), for
+any chain P^s below P^+; the feedback's signs as a round trip; the interpolation between stored times; the smoothed outage drift and its 1-sigma on seeded drives (1,000 members:
 slow); the memory refusals; ``aided run --smooth``'s JSON and error columns.
 """
 
@@ -14,6 +14,8 @@ import types
 import numpy as np
 import pytest
 import scipy.linalg
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from schuler.aided import analysis, kalman, smoother
 from schuler.aided.ekf import run_filter
@@ -34,8 +36,8 @@ def closed_loop_chain(rng, members=3, n=4, m=2, steps=40):
     noise = rng.normal(size=(n, n))
     Q = 0.05 * noise @ noise.T + 0.01 * np.eye(n)
     H = rng.normal(size=(m, n))
-    R = np.diag([0.3, 0.5]) ** 2
-    P0 = np.diag([1.0, 2.0, 0.5, 1.5]) ** 2
+    R = np.diag(rng.uniform(0.2, 0.6, m)) ** 2
+    P0 = np.diag(rng.uniform(0.5, 2.0, n)) ** 2
     mean0 = rng.normal(size=n)
     x = mean0 + rng.normal(size=(members, n)) @ np.sqrt(P0)
     s, P = np.broadcast_to(mean0, (members, n)).copy(), np.broadcast_to(P0, (members, n, n)).copy()
@@ -98,6 +100,21 @@ def test_the_fixed_interval_smoother_is_the_batch_least_squares_solution():
     assert np.all(errors[:, -1] == 0.0)
     filtered = np.trace(stack["posterior"][:, :-1], axis1=-2, axis2=-1)
     assert np.all(np.trace(covariance[:, :-1], axis1=-2, axis2=-1) <= filtered + 1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 6), m=st.integers(1, 3), steps=st.integers(1, 25))
+def test_any_chain_smoothed_is_its_batch_solution_and_no_less_certain_than_filtered(seed, n, m, steps):
+    kept, model = closed_loop_chain(np.random.default_rng(seed), members=2, n=n, m=m, steps=steps)
+    stack = {name: np.stack(kept[name], axis=1) for name in ("posterior", "prior", "transition", "correction",
+                                                             "solution")}
+    errors, covariance = smoother.rts(stack["posterior"], stack["prior"], stack["transition"], stack["correction"])
+    mean, blocks = batch_solution(model, kept["z"], 1)
+    assert np.max(np.abs(stack["solution"][1] - errors[1] - mean)) < 1e-8 * max(1.0, np.max(np.abs(mean)))
+    assert np.max(np.abs(covariance[1] - blocks)) < 1e-8 * np.max(np.abs(blocks))
+    # P^+ - P^s is positive semi-definite at every time (the smoother adds information)
+    gap = np.linalg.eigvalsh(stack["posterior"] - covariance)
+    assert np.all(gap >= -1e-10 * np.max(np.abs(stack["posterior"])))
 
 
 def test_a_prior_without_variance_or_not_positive_definite_is_refused_in_one_line():
@@ -238,8 +255,9 @@ def test_a_thousand_members_smoothed_errors_match_their_smoothed_sigma(consisten
 def test_the_memory_is_estimated_before_the_run_and_refused_above_the_budget(consistency_members, monkeypatch):
     chunks, path, imu, _, times = consistency_members
     increments, fixes = increments_of(imu), gnss_from(imu, times)
-    # one member over 300 s: 541 stored times; the forward run holds 8 (541 (21^2 + 12) + 15,001 x 20) bytes,
-    # about 4.4 MB; the smoother's prior P, Phi and corrections 8 x 541 x 903 more, 3.9 MB
+    # one member over 300 s at 50 Hz, 540 stored times (300 steps, 239 epochs, the start): the forward run holds
+    # 8 (540 (21^2 + 12) + 15,001 x 10) bytes, 3.2 MB; the smoother's prior P, Phi and corrections 8 x 540 x 903
+    # more, 3.9 MB
     monkeypatch.setenv("SCHULER_MEMORY_BUDGET", "6 MB")
     run = run_filter(increments, 1.0 / chunks.RATE, start_of(path), tactical_model(), fixes)
     assert run.prior_covariance is None and run.transition is None and run.correction is None
@@ -250,8 +268,9 @@ def test_the_memory_is_estimated_before_the_run_and_refused_above_the_budget(con
     monkeypatch.setenv("SCHULER_MEMORY_BUDGET", "10 MB")
     kept = run_filter(increments, 1.0 / chunks.RATE, start_of(path), tactical_model(), fixes,
                       keep_for_smoother=True)
+    assert kept.correction is not None and kept.correction.shape == (1, 540, 21)
     assert np.array_equal(kept.solution, run.solution) and np.array_equal(kept.covariance, run.covariance)
-    # the smoother's own arrays: 8 (541 x 903 + 15,000 x 48) bytes, 9.7 MB
+    # the smoother's own arrays: 8 (540 x 903 + 15,000 x 48) bytes, 9.7 MB
     monkeypatch.setenv("SCHULER_MEMORY_BUDGET", "5 MB")
     with pytest.raises(MemoryBudgetExceeded, match="the smoother's covariances"):
         smoother.smooth(kept)
