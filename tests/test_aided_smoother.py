@@ -2,8 +2,9 @@
 
 A linear-Gaussian chain filtered in closed loop with the package's own predict and update, smoothed, against the
 batch weighted least-squares solution of the whole interval (the fixed-interval smoother is that solution), for
-any chain P^s below P^+; the feedback's signs as a round trip; the interpolation between stored times; the smoothed outage drift and its 1-sigma on seeded drives (1,000 members:
-slow); the memory refusals; ``aided run --smooth``'s JSON and error columns.
+any chain P^s below P^+; the feedback's signs as a round trip; the interpolation between stored times; the
+smoothed outage drift and its 1-sigma on seeded drives (1,000 members: slow); the memory refusals; ``aided run
+--smooth``'s JSON and error columns, on simulated data and on files.
 """
 
 from __future__ import annotations
