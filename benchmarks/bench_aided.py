@@ -10,6 +10,10 @@ filter with its covariance propagated every second.
 * pyins 1.0.1 (``python-ins``, the benchmark-only extra): ``filters.run_feedback_filter`` on the first
   60 s of the same drive (its own IMU synthesis from the same truth; position fixes at 1 Hz, covariance
   step 1 s), CPU seconds per second of data, against schuler's on the whole drive. Skipped when absent.
+* The Rauch-Tung-Striebel smoother (:func:`schuler.aided.smoother.smooth`) on the same drive: the filter run kept
+  for it (``keep_for_smoother``) against the plain one, and the backward pass with the smoothed solution at every
+  IMU epoch, CPU seconds and their ratios to the plain filter's; memory: the kept arrays and the smoother's peak
+  (tracemalloc, numpy's allocations) beside their estimates before the run.
 * Batched Monte Carlo: 100 members of a 300-s drive in one call against 10 single-member calls scaled to
   100 (members per CPU second; target >= 10x).
 * The whole command on files: the same drive (tactical IMU, member 0) written in KF-GINS's formats with a
@@ -30,6 +34,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import tracemalloc
 from pathlib import Path
 
 import numpy as np
@@ -37,6 +42,7 @@ import numpy as np
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import ErrorProcess, FilterModel
 from schuler.aided.gnss import simulate_gnss
+from schuler.aided.smoother import smooth, smoothed_bytes
 from schuler.core.random import RandomStreams
 from schuler.navigate.drive import drive
 from schuler.navigate.truth import ideal_imu
@@ -123,6 +129,28 @@ def bench_pyins(path, imu, seconds: float) -> float | None:
     return spent / seconds
 
 
+def bench_smoother(path, data, fixes, filter_cpu: float) -> None:
+    """The filter kept for the smoother and the smoother on one member of the whole drive: CPU and memory."""
+    kept, _, kept_cpu = cpu(lambda: run_filter(data, 1.0 / RATE, start(path, 1), model(), fixes,
+                                               keep_for_smoother=True))
+    smoothed, _, smooth_cpu = cpu(lambda: smooth(kept))
+    assert kept.prior_covariance is not None and kept.transition is not None and kept.correction is not None
+    members, stored, n = kept.correction.shape
+    held = kept.prior_covariance.nbytes + kept.transition.nbytes + kept.correction.nbytes
+    tracemalloc.start()
+    smooth(kept)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    estimate = smoothed_bytes(members, stored, kept.t_s.size, n)
+    sigma = np.sqrt(smoothed.covariance[0, :, 0, 0] + smoothed.covariance[0, :, 1, 1]).max()
+    print(f"smoother, the same drive ({stored:,} stored covariance times, {kept.t_s.size:,} IMU epochs): the filter "
+          f"kept for it {kept_cpu:.2f} s CPU ({kept_cpu / filter_cpu:.2f}x the plain filter's {filter_cpu:.2f} s), "
+          f"the backward pass with the smoothed solution {smooth_cpu:.2f} s CPU ({smooth_cpu / filter_cpu:.2f}x); "
+          f"memory: the kept P-, Phi and corrections {held / 1e6:.1f} MB (estimated "
+          f"{8.0 * stored * (2 * n * n + n) / 1e6:.1f} MB), the smoother's peak {peak / 1e6:.1f} MB (estimated "
+          f"{estimate / 1e6:.1f} MB); largest smoothed horizontal 1-sigma {sigma:.2f} m")
+
+
 def bench_command(filter_wall: float) -> None:
     """Wall seconds of ``schuler aided run --kf-gins-config ... --out DIR`` on the drive written to files."""
     from schuler.aided.outputs import write_simulated_files
@@ -161,6 +189,7 @@ def main() -> int:
     print(f"schuler, 1,500-s drive at 200 Hz ({len(data):,} IMU epochs, {fixes.epochs} GNSS epochs, 21 states, "
           f"three 60-s outages): {wall:.2f} s wall, {spent:.2f} s CPU (target <= {TARGET_SECONDS} s: "
           f"{'met' if ok else 'NOT met'}); {run.rejected[0]} epochs rejected")
+    bench_smoother(path, data, fixes, spent)
     per_second = bench_pyins(path, imu, 60.0)
     if per_second is not None:
         print(f"ratio, CPU per second of data: pyins / schuler = {per_second / (spent / path.duration):.0f}x")

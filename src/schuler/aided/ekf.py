@@ -176,6 +176,13 @@ class FilterRun:
         The other sources' epochs (``zupt``, ``zaru``, ``vehicle``, ``baro``), as the GNSS ones above.
     aiding_estimates : ndarray, shape (N, n_cov, e)
         The aiding states' estimates at the covariance times (odometer scale 1, barometer bias m; e may be 0).
+    prior_covariance : ndarray, shape (N, n_cov, n, n), or None
+        P before any update at each of those times (the initial P first), (state units)^2; kept for the smoother
+        (``keep_for_smoother``), None otherwise.
+    transition : ndarray, shape (N, n_cov, n, n), or None
+        Phi from the previous stored time to each (the identity first and where no time passed), likewise.
+    correction : ndarray, shape (N, n_cov, n), or None
+        The estimated errors fed back at each of those times (zero where none), state units, likewise.
     """
 
     t_s: np.ndarray
@@ -191,6 +198,9 @@ class FilterRun:
     n_states: int = field(default=21)
     sources: dict = field(default_factory=dict)
     aiding_estimates: np.ndarray | None = None
+    prior_covariance: np.ndarray | None = field(default=None, repr=False)
+    transition: np.ndarray | None = field(default=None, repr=False)
+    correction: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def rejected(self) -> np.ndarray:
@@ -248,6 +258,7 @@ class _Navigator:
         self.aiding = np.zeros((n, aiding_states))
         self.last_rate = np.zeros((n, 3))
         self._zeros_row = np.zeros((n, 12))
+        self.fed_back: np.ndarray | None = None  # the sum of the corrections since it was last taken, when kept
         self._dummy_out = np.zeros((n, 1, _kernels.OUTPUT_SIZE))
 
     @property
@@ -329,6 +340,8 @@ class _Navigator:
 
     def correct(self, dx: np.ndarray, model: FilterModel) -> None:
         """Feed the estimated errors back into the solution and the sensor compensation."""
+        if self.fed_back is not None:
+            self.fed_back += dx
         st = self.state
         lat, h = st[:, _kernels.LAT], st[:, _kernels.HGT]
         R_N, R_E = radii_of_curvature(lat)
@@ -410,7 +423,8 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
                t0: float = 0.0, lever_arm=(0.0, 0.0, 0.0), covariance_interval: float = 1.0,
                use_velocity: bool = True, gate: float = kalman.DEFAULT_GATE, output_every: int = 1,
                initial_sensor_errors: np.ndarray | None = None, initial_sensor_sigma: np.ndarray | None = None,
-               earth_rate: float = EARTH_RATE, sources: Sequence[Source] = ()) -> FilterRun:
+               earth_rate: float = EARTH_RATE, sources: Sequence[Source] = (),
+               keep_for_smoother: bool = False) -> FilterRun:
     """Filter a batch of members' IMU increments with GNSS fixes (module docstring).
 
     Parameters
@@ -449,6 +463,9 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         Omega, rad/s.
     sources : sequence of Source
         Aiding besides GNSS (:mod:`schuler.aided.sources`), each named once, none named ``gnss``.
+    keep_for_smoother : bool
+        Whether to keep, at every stored covariance, the prior P, Phi and the correction fed back
+        (:func:`schuler.aided.smoother.smooth` needs them; 2 n^2 + n more doubles per member and stored time).
 
     Returns
     -------
@@ -473,9 +490,12 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     inside_of, groups = _groups(every_source, t0, end)
     n_cov = n_samples // every_cov + len(groups) + 1
     n_out = n_samples // output_every
+    smoother_doubles = 2 * n * n + n if keep_for_smoother else 0
     logged = sum(kept.size * (2 + 2 * source.components) for source, kept in zip(every_source, inside_of))
-    require(8.0 * members * (n_cov * (n * n + 12 + n - model.sensor_size) + (n_out + 1) * _kernels.OUTPUT_SIZE
-                             + logged), "the filter's stored solution, covariances and innovations",
+    require(8.0 * members * (n_cov * (n * n + 12 + n - model.sensor_size + smoother_doubles)
+                             + (n_out + 1) * _kernels.OUTPUT_SIZE + logged),
+            "the filter's stored solution, covariances and innovations"
+            + (" with the smoother's" if smoother_doubles else ""),
             "the duration, the members, the covariance interval, the output step or the aiding rates")
     logs = [SourceLog.empty(source.t[kept], members, source.components)
             for source, kept in zip(every_source, inside_of)]
@@ -500,6 +520,10 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     point = navigator.point(accumulator)
     cov_t, covs, estimates = [t0], [P.copy()], [navigator.estimates()]
     aiding_estimates = [navigator.aiding.copy()]
+    identity = np.broadcast_to(np.eye(n), (members, n, n))
+    if keep_for_smoother:
+        navigator.fed_back = np.zeros((members, n))
+        priors, transitions, corrections = [P.copy()], [identity], [np.zeros((members, n))]
     boundaries = t0 + np.arange(every_cov, n_samples + 1, every_cov) * interval
     events = sorted([(float(b), -1) for b in boundaries]
                     + [(float(every_source[group[0][0]].t[group[0][1]]), g) for g, group in enumerate(groups)],
@@ -508,21 +532,25 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     def propagate(P):
         elapsed = accumulator.elapsed
         if elapsed <= 0:
-            return P
+            return P, identity
         start_point = NavigationPoint(point.latitude, point.height, point.velocity, point.body_to_ned,
                                       accumulator.velocity / elapsed, accumulator.angle / elapsed)
         Phi, Q = transition(model, start_point, elapsed, earth_rate)
         navigator.decay(model, elapsed)
-        return kalman.predict(P, Phi, Q)
+        return kalman.predict(P, Phi, Q), Phi
 
     previous = t0
     for index, (time, epoch) in enumerate(events):
         if epoch < 0 and index + 1 < len(events) and abs(events[index + 1][0] - time) < 1e-9:
             continue  # an epoch at the same time follows: propagate once, there
+        Phi = identity
         if time - previous > 1e-12:
             navigator.advance_to(time, accumulator)
-            P = propagate(P)
+            P, Phi = propagate(P)
         previous = time
+        if keep_for_smoother:
+            priors.append(P.copy())
+            transitions.append(np.broadcast_to(Phi, (members, n, n)))
         if epoch >= 0:
             context = navigator.context(accumulator, model)
             blocks = [every_source[s].measure(j, context) for s, j in groups[epoch]]
@@ -543,11 +571,19 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         covs.append(P.copy())
         estimates.append(navigator.estimates())
         aiding_estimates.append(navigator.aiding.copy())
+        if keep_for_smoother:
+            assert navigator.fed_back is not None
+            corrections.append(navigator.fed_back.copy())
+            navigator.fed_back[:] = 0.0
     if navigator.time < end - 1e-9:
         navigator.advance_to(end, accumulator)
     out_t = t0 + np.arange(1, n_out + 1) * output_every * interval
     gnss_log = logs[0]
-    return FilterRun(out_t, navigator.out[:, 1:], np.asarray(cov_t), np.stack(covs, axis=1),
-                     np.stack(estimates, axis=1), gnss_log.t_s, gnss_log.nis, gnss_log.accepted, gnss_log.residual,
-                     gnss_log.residual_sigma, n, {source.name: log for source, log in zip(sources, logs[1:])},
-                     np.stack(aiding_estimates, axis=1))
+    run = FilterRun(out_t, navigator.out[:, 1:], np.asarray(cov_t), np.stack(covs, axis=1),
+                    np.stack(estimates, axis=1), gnss_log.t_s, gnss_log.nis, gnss_log.accepted, gnss_log.residual,
+                    gnss_log.residual_sigma, n, {source.name: log for source, log in zip(sources, logs[1:])},
+                    np.stack(aiding_estimates, axis=1))
+    if keep_for_smoother:
+        run.prior_covariance, run.transition = np.stack(priors, axis=1), np.stack(transitions, axis=1)
+        run.correction = np.stack(corrections, axis=1)
+    return run

@@ -27,6 +27,13 @@ Besides the error histories (``aided_errors``) every run keeps its navigation
 solution with the filter's 1-sigma at every IMU epoch (``navigation``:
 :mod:`schuler.aided.outputs` writes it as ``navigation.nav`` and
 ``navigation.csv``).
+
+With ``smooth`` the first case's member 0 is also smoothed
+(:func:`schuler.aided.smoother.smooth`, Rauch-Tung-Striebel over the forward
+run): the extras gain ``smoothed``, the forward run's keys (outputs, outages,
+NEES; the NIS and rejected epochs are the forward run's, the smoother
+reprocesses no measurement) from the smoothed solution and covariance, and
+``aided_errors`` the same channels prefixed ``smoothed_``.
 """
 
 from __future__ import annotations
@@ -38,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from schuler.aided import aiding as more_aiding
-from schuler.aided import analysis, files
+from schuler.aided import analysis, files, smoother
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import KINDS, FilterModel, filter_model, overridden
 from schuler.aided.gnss import scheduled_outages, simulate_gnss
@@ -130,6 +137,9 @@ PARAMETERS = ParameterSet((
               "errors, and the start without --kf-gins-config (not set: errors null).", kind="text"),
     Parameter("kf_gins_config", "", None, "KF-GINS YAML configuration (its paths relative to its folder, then to "
               "the working directory); options given here win over it.", kind="text"),
+    Parameter("smooth", "", False, "Rauch-Tung-Striebel smoother over the forward run: the JSON's smoothed (the "
+              "forward run's keys, outages included) and the smoothed errors and 1-sigma in aided_errors.",
+              kind="flag"),
 ), owner="aided", exclusive=(("outages", "outage_start"), ("outages", "outage_duration"),
                                ("outages", "outage_every")))
 
@@ -216,15 +226,24 @@ def lever_arm(case: Case) -> tuple[float, float, float]:
                  for name in ("lever_arm_x", "lever_arm_y", "lever_arm_z"))
 
 
+SMOOTHER_STATES = 21
+"""States the smoother's memory estimate counts (the larger filter model)."""
+
+
 def member_bytes(case: Case) -> int:
-    """Memory one member holds while filtered, from its declared sizes per IMU sample.
+    """Memory one member holds while filtered, from its declared sizes per IMU sample (and per stored covariance
+    time the smoother's prior P, Phi and correction with ``smooth``).
 
     Parameters
     ----------
     case : Case
-        A validated case (SI: ``duration`` s, ``imu_rate`` Hz).
+        A validated case (SI: ``duration`` s, ``imu_rate`` and ``gnss_rate`` Hz, ``covariance_interval`` s).
     """
-    return int(SAMPLE_BYTES * sample_count(case["duration"], case["imu_rate"]))
+    kept = 0.0
+    if case["smooth"]:
+        stored = case["duration"] * (1.0 / case["covariance_interval"] + case["gnss_rate"]) + 1
+        kept = 8.0 * stored * (2 * SMOOTHER_STATES**2 + SMOOTHER_STATES)
+    return int(SAMPLE_BYTES * sample_count(case["duration"], case["imu_rate"]) + kept)
 
 
 def _start(path, members: int) -> Start:
@@ -306,8 +325,9 @@ def _imu(case: Case) -> str:
     return "tactical" if case["imu"] is None else case["imu"]
 
 
-def _simulated_group(case: Case, members: np.ndarray, streams):
-    """One group of members of the same simulated case: the filter run, its errors and the outages."""
+def _simulated_group(case: Case, members: np.ndarray, streams, smooth: bool = False):
+    """One group of members of the same simulated case: the filter run, its errors and the outages; with ``smooth``
+    a fourth item, member 0's smoothed run and its errors."""
     require(member_bytes(case) * members.size, f"{members.size} members of this aided run", "--duration or --imu-rate")
     data = simulated_inputs(case, members, streams)
     model = more_aiding.with_states(assumed(case, filter_model(resolve_model(_imu(case)))), case)
@@ -316,18 +336,23 @@ def _simulated_group(case: Case, members: np.ndarray, streams):
                                           streams if noisy else None, model)
     run = run_filter(data.increments, data.truth.interval_s, _start(data.path, members.size), model, data.gnss,
                      lever_arm=data.lever_arm, covariance_interval=case["covariance_interval"],
-                     use_velocity=data.use_velocity, sources=extra)
+                     use_velocity=data.use_velocity, sources=extra,
+                     keep_for_smoother=smooth)
     truth = data.truth
-    true = analysis.Truth(truth.latitude_rad, truth.longitude_rad, truth.height_m, truth.velocity_ned_m_s,
-                          truth.quaternion)
-    return run, analysis.errors(run, _at(true, run.t_s, truth.t_s)), data.outages
+    true = _at(analysis.Truth(truth.latitude_rad, truth.longitude_rad, truth.height_m, truth.velocity_ned_m_s,
+                              truth.quaternion), run.t_s, truth.t_s)
+    if not smooth:
+        return run, analysis.errors(run, true), data.outages
+    smoothed = smoother.smooth(_member(run, 0))
+    return dataclasses.replace(run, prior_covariance=None, transition=None, correction=None), \
+        analysis.errors(run, true), data.outages, (smoothed, analysis.errors(smoothed, true))
 
 
-def _file_group(case: Case, members: np.ndarray):
+def _file_group(case: Case, members: np.ndarray, smooth: bool = False):
     """A case on files (one member: the data have no random terms of their own).
 
-    Returns the run where the reference covers it, its errors (None without a reference), the outages and the whole
-    run.
+    Returns the run where the reference covers it, its errors (None without a reference), the outages, the whole
+    run, and with ``smooth`` the smoothed run where the reference covers it and its errors (None without).
     """
     if members.size > 1:
         raise InvalidParameter("monte_carlo", "a run on files has no random terms: every member would be the same")
@@ -349,15 +374,21 @@ def _file_group(case: Case, members: np.ndarray):
     steps = max(round(case["covariance_interval"] / dt), 1)  # a whole number of the data's IMU intervals
     run = run_filter(inputs.increments, dt, files.start_of(inputs, START_SIGMA), model, inputs.gnss, t0=inputs.t0_s,
                      lever_arm=files.lever_arm_of(case, config), covariance_interval=steps * dt,
-                     use_velocity=use_velocity, initial_sensor_errors=initial, initial_sensor_sigma=sigma)
+                     use_velocity=use_velocity, initial_sensor_errors=initial, initial_sensor_sigma=sigma,
+                     keep_for_smoother=smooth)
+    smoothed_run = smoother.smooth(run) if smooth else None
     if inputs.reference is None:
-        return run, None, inputs.outages, run
+        return run, None, inputs.outages, run, None if smoothed_run is None else (smoothed_run, None)
     kept, latitude, longitude, height, velocity, quaternion = files.reference_at(inputs.reference, run.t_s)
     if not kept.any():
         raise InvalidParameter("reference", "no output time falls inside the reference's span")
+    truth = analysis.Truth(latitude, longitude, height, velocity, quaternion)
     inside = dataclasses.replace(run, t_s=run.t_s[kept], solution=run.solution[:, kept])
-    return inside, analysis.errors(inside, analysis.Truth(latitude, longitude, height, velocity, quaternion)), \
-        inputs.outages, run
+    smoothed = None
+    if smoothed_run is not None:
+        smoothed_inside = dataclasses.replace(smoothed_run, t_s=inside.t_s, solution=smoothed_run.solution[:, kept])
+        smoothed = (smoothed_inside, analysis.errors(smoothed_inside, truth))
+    return inside, analysis.errors(inside, truth), inputs.outages, run, smoothed
 
 
 def _at(truth: analysis.Truth, t_s: np.ndarray, grid: np.ndarray) -> analysis.Truth:
@@ -422,29 +453,41 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
         ``cases.members[i]`` (None: the nominal case). A case on files (:mod:`schuler.aided.files`) is one member.
     histories : bool
         Whether to return the first case's error histories, 1-sigma envelopes, navigation solution, outages and
-        consistency.
+        consistency (with its ``smooth``, its member 0 smoothed beside: module docstring).
     """
     outputs = {output.name: np.full(len(cases), math.nan) for output in OUTPUTS}
     kept = None
     for index, group in cases.groups(*[p.name for p in PARAMETERS]):
         case = group.case(0)
+        first = histories and kept is None and 0 in index
+        smooth = first and bool(case["smooth"])
+        smoothed = None
         if files.is_file_case(case):
-            run, errors, outages, full = _file_group(case, group.members)
+            run, errors, outages, full, smoothed = _file_group(case, group.members, smooth)
+        elif smooth:
+            run, errors, outages, smoothed = _simulated_group(case, group.members, cases.random, smooth)
+            full = run
         else:
             run, errors, outages = _simulated_group(case, group.members, cases.random)
             full = run
         for name, values in _summaries(run, errors, outages).items():
             outputs[name][index] = values
-        if histories and kept is None and 0 in index:
+        if first:
             # the navigation at every IMU epoch (full), the errors where the reference covers the run (run)
-            kept = (_member(run, 0), None if errors is None else _member(errors, 0), outages, _member(full, 0))
+            kept = (_member(run, 0), None if errors is None else _member(errors, 0), outages, _member(full, 0),
+                    smoothed)
     if not histories or kept is None:
         return Evaluation(outputs)
-    run, errors, outages, full = kept
-    return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors),
+    run, errors, outages, full, smoothed = kept
+    extras = run_extras(run, errors, outages)
+    if smoothed is not None:
+        # the forward run's keys from the smoothed run and its errors (a NaN, without a truth, is written as null)
+        summary = {name: float(values[0]) for name, values in _summaries(smoothed[0], smoothed[1], outages).items()}
+        extras["smoothed"] = {**summary, **run_extras(smoothed[0], smoothed[1], outages)}
+    return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors, smoothed),
                                           "navigation": navigation_histories(full),
                                           "aided_innovations": innovation_histories(run)},
-                      extras=run_extras(run, errors, outages),
+                      extras=extras,
                       units={"inside": "1", "band": "1", **{name: "1" for name in ("gnss",) + more_aiding.SOURCES}})
 
 
@@ -455,8 +498,11 @@ def _variances(run, t_s: np.ndarray) -> np.ndarray:
     return np.diagonal(run.covariance[0], axis1=1, axis2=2)[:, :9][rows]
 
 
-def error_histories(run, errors) -> Histories:
+def error_histories(run, errors, smoothed=None) -> Histories:
     """One member's errors and the filter's 1-sigma of each, at every output time (SI; no errors without a truth).
+
+    With ``smoothed`` the smoother's errors and 1-sigma (interpolated between its stored times,
+    :func:`schuler.aided.smoother.output_variances`) follow, the same channels prefixed ``smoothed_``.
 
     Parameters
     ----------
@@ -464,9 +510,20 @@ def error_histories(run, errors) -> Histories:
         A filter run of one member.
     errors : analysis.Errors or None
         Its errors against the truth (None: the 1-sigma alone).
+    smoothed : tuple of (FilterRun, analysis.Errors or None), optional
+        The smoothed run of that member and its errors.
     """
     t_s = run.t_s if errors is None else errors.t_s
-    variance = _variances(run, t_s)
+    channels = _error_channels(errors, _variances(run, t_s))
+    if smoothed is not None:
+        variance = smoother.output_variances(smoothed[0], t_s)[0]
+        channels.update({f"smoothed_{name}": values for name, values in _error_channels(smoothed[1], variance).items()})
+    units = {name: "rad" if name.endswith("_rad") else "m/s" if name.endswith("_m_s") else "m" for name in channels}
+    return Histories(t_s, channels, units)
+
+
+def _error_channels(errors, variance: np.ndarray) -> dict[str, np.ndarray]:
+    """The error channels of member 0 (none without a truth) and the 1-sigma of the variances given, shape (n, 9)."""
     channels = {}
     if errors is not None:
         channels = {
@@ -478,8 +535,7 @@ def error_histories(run, errors) -> Histories:
         "north_sigma_m": np.sqrt(variance[:, 0]), "east_sigma_m": np.sqrt(variance[:, 1]),
         "down_sigma_m": np.sqrt(variance[:, 2]), "horizontal_sigma_m": np.sqrt(variance[:, 0] + variance[:, 1]),
         "heading_sigma_rad": np.sqrt(variance[:, 8])})
-    units = {name: "rad" if name.endswith("_rad") else "m/s" if name.endswith("_m_s") else "m" for name in channels}
-    return Histories(t_s, channels, units)
+    return channels
 
 
 INNOVATION_COMPONENTS = ("position_north", "position_east", "position_down", "velocity_north", "velocity_east",

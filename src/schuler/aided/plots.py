@@ -20,7 +20,8 @@ PLOTTED_POINTS = 4000
 def error_envelopes(histories, outages):
     """North, east, down and heading errors of one member with the filter's +-3-sigma (outages shaded).
 
-    Without a truth (no error channels) the envelopes alone are drawn.
+    Without a truth (no error channels) the envelopes alone are drawn; with the smoother's channels
+    (``smoothed_``, :func:`schuler.aided.evaluation.error_histories`) its errors and +-3-sigma are drawn beside.
 
     Parameters
     ----------
@@ -45,11 +46,21 @@ def error_envelopes(histories, outages):
         axis.fill_between(minutes, -envelope, envelope, color="tab:blue", alpha=0.2, lw=0, label="+-3 sigma")
         if error in histories:
             axis.plot(minutes, histories[error][::stride] * scale, color="tab:red", lw=0.8, label="error")
+        if f"smoothed_{sigma}" in histories:
+            envelope = 3 * histories[f"smoothed_{sigma}"][::stride] * scale
+            axis.plot(minutes, envelope, color="tab:green", lw=0.6, ls="--", label="+-3 sigma smoothed")
+            axis.plot(minutes, -envelope, color="tab:green", lw=0.6, ls="--")
+        if f"smoothed_{error}" in histories:
+            axis.plot(minutes, histories[f"smoothed_{error}"][::stride] * scale, color="tab:green", lw=0.8,
+                      label="smoothed error")
         axis.set_ylabel(label)
         axis.grid(True, alpha=0.3)
-    axes[0].legend(loc="upper right", fontsize=9)
+    axes[0].legend(loc="upper right", fontsize=9, ncol=2)
     truth = "errors and " if "north_error_m" in histories else ""
-    axes[0].set_title(f"Aided INS: {truth}the filter's +-3-sigma (GNSS outages shaded)")
+    if "smoothed_north_sigma_m" in histories:
+        axes[0].set_title(f"Aided INS: {truth}+-3-sigma, forward and smoothed (GNSS outages shaded)")
+    else:
+        axes[0].set_title(f"Aided INS: {truth}the filter's +-3-sigma (GNSS outages shaded)")
     axes[-1].set_xlabel("time from the start [min]")
     fig.tight_layout()
     return fig
