@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from schuler.aided import analysis, files
+from schuler.aided import analysis, files, initialisation
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import KINDS, FilterModel, filter_model, overridden
 from schuler.aided.gnss import scheduled_outages, simulate_gnss
@@ -127,6 +127,7 @@ PARAMETERS = ParameterSet((
               "errors, and the start without --kf-gins-config (not set: errors null).", kind="text"),
     Parameter("kf_gins_config", "", None, "KF-GINS YAML configuration (its paths relative to its folder, then to "
               "the working directory); options given here win over it.", kind="text"),
+    *initialisation.PARAMETERS,
 ), owner="aided", exclusive=(("outages", "outage_start"), ("outages", "outage_duration"),
                                ("outages", "outage_every")))
 
@@ -139,6 +140,8 @@ OUTPUTS = (
     Output("outage_horizontal_error_max_m", "m", "", "largest horizontal error in any outage"),
     Output("outage_horizontal_error_sigma_m", "m", "", "filter's horizontal 1-sigma at the end of that outage"),
     Output("rejected_measurements", "1", "", "GNSS epochs the chi-square gate rejected"),
+    Output("start_heading_error_rad", "rad", "deg", "heading error at the filter's first output"),
+    Output("start_heading_sigma_rad", "rad", "deg", "filter's initial heading 1-sigma (psi down)"),
 )
 
 SAMPLE_BYTES = 6 * 8 * 3 + 10 * 8 + 3 * 3 * 8
@@ -305,13 +308,26 @@ def _simulated_group(case: Case, members: np.ndarray, streams):
     """One group of members of the same simulated case: the filter run, its errors and the outages."""
     require(member_bytes(case) * members.size, f"{members.size} members of this aided run", "--duration or --imu-rate")
     data = simulated_inputs(case, members, streams)
-    run = run_filter(data.increments, data.truth.interval_s, _start(data.path, members.size),
-                     assumed(case, filter_model(resolve_model(_imu(case)))), data.gnss, lever_arm=data.lever_arm,
+    imu = resolve_model(_imu(case))
+    first_stop = data.path.stationary_intervals()[0]
+    start = _initialisation(case, data.increments, data.truth.interval_s, data.gnss, lambda: _start(data.path,
+                            members.size), lever_arm=data.lever_arm, imu=imu,
+                            at_rest_s=first_stop[1] if first_stop[0] == 0.0 else 0.0)
+    run = run_filter(data.increments[:, start.first_sample:], data.truth.interval_s, start.start, assumed(case, filter_model(imu)),
+                     data.gnss, t0=start.t0_s, lever_arm=data.lever_arm,
                      covariance_interval=case["covariance_interval"], use_velocity=data.use_velocity)
     truth = data.truth
     true = analysis.Truth(truth.latitude_rad, truth.longitude_rad, truth.height_m, truth.velocity_ned_m_s,
                           truth.quaternion)
     return run, analysis.errors(run, _at(true, run.t_s, truth.t_s)), data.outages
+
+
+def _initialisation(case: Case, increments, interval: float, gnss, given, **options) -> initialisation.Initialisation:
+    """The filter's start by the case's ``initialisation`` (:func:`schuler.aided.initialisation.initialise`)."""
+    return initialisation.initialise(case["initialisation"], np.reshape(increments, (-1,) + np.shape(increments)[-2:]),
+                                     interval, gnss, given=given,
+                                     speed_threshold=case["speed_threshold"],
+                                     alignment_duration=case["alignment_duration"], **options)
 
 
 def _file_group(case: Case, members: np.ndarray):
@@ -335,8 +351,11 @@ def _file_group(case: Case, members: np.ndarray):
     model = assumed(case, model)
     dt = inputs.interval_s
     steps = max(round(case["covariance_interval"] / dt), 1)  # a whole number of the data's IMU intervals
-    run = run_filter(inputs.increments, dt, files.start_of(inputs, START_SIGMA), model, inputs.gnss, t0=inputs.t0_s,
-                     lever_arm=files.lever_arm_of(case, config), covariance_interval=steps * dt,
+    lever = files.lever_arm_of(case, config)
+    start = _initialisation(case, inputs.increments, dt, inputs.gnss, lambda: files.start_of(inputs, START_SIGMA),
+                            t0=inputs.t0_s, lever_arm=lever, imu=None if kfgins_model else resolve_model(_imu(case)))
+    run = run_filter(np.asarray(inputs.increments)[..., start.first_sample:, :], dt, start.start, model, inputs.gnss,
+                     t0=start.t0_s, lever_arm=lever, covariance_interval=steps * dt,
                      use_velocity=use_velocity, initial_sensor_errors=initial, initial_sensor_sigma=sigma)
     if inputs.reference is None:
         return run, None, inputs.outages, run
@@ -382,8 +401,10 @@ def _summaries(run, errors, outages) -> dict[str, np.ndarray]:
             "velocity_error_horizontal_rms_m_s": _rms(velocity),
             "heading_error_rms_rad": _rms(errors.heading),
         })
+    start = np.full(members, math.nan) if errors is None or errors.heading.shape[-1] == 0 else errors.heading[:, 0]
     return {**summary, "outage_horizontal_error_max_m": worst, "outage_horizontal_error_sigma_m": sigma,
-            "rejected_measurements": run.rejected.astype(float)}
+            "rejected_measurements": run.rejected.astype(float), "start_heading_error_rad": start,
+            "start_heading_sigma_rad": np.sqrt(run.covariance[:, 0, 8, 8])}
 
 
 def _member(value, m: int):
@@ -422,14 +443,17 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
             outputs[name][index] = values
         if histories and kept is None and 0 in index:
             # the navigation at every IMU epoch (full), the errors where the reference covers the run (run)
-            kept = (_member(run, 0), None if errors is None else _member(errors, 0), outages, _member(full, 0))
+            kept = (_member(run, 0), None if errors is None else _member(errors, 0), outages, _member(full, 0),
+                    case["initialisation"])
     if not histories or kept is None:
         return Evaluation(outputs)
-    run, errors, outages, full = kept
+    run, errors, outages, full, mode = kept
     return Evaluation(outputs, histories={"aided_errors": error_histories(run, errors),
                                           "navigation": navigation_histories(full),
                                           "aided_innovations": innovation_histories(run)},
-                      extras=run_extras(run, errors, outages), units={"inside": "1", "band": "1"})
+                      extras={**run_extras(run, errors, outages),
+                              "start": initialisation.start_report(mode, full, errors)},
+                      units={"inside": "1", "band": "1"})
 
 
 def _variances(run, t_s: np.ndarray) -> np.ndarray:
