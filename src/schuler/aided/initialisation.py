@@ -227,8 +227,8 @@ def _static(increments, interval, records, t0, lever_arm, imu, duration, at_rest
     quaternion = quaternion_from_euler(roll, pitch, heading)
     position = _imu_position(latitude, _stack(records, "longitude_rad")[:, k], _stack(records, "height_m")[:, k],
                              dcm_from_euler(roll, pitch, heading), lever_arm)
-    start = Start(*position, np.zeros((latitude.size, 3)), quaternion, first.position_sigma_m[k],
-                  np.full(3, AT_REST_VELOCITY_SIGMA), psi_sigma)
+    start = Start(position[0], position[1], position[2], np.zeros((latitude.size, 3)), quaternion,
+                  first.position_sigma_m[k], np.full(3, AT_REST_VELOCITY_SIGMA), psi_sigma)
     return Initialisation("static", start, samples, end,
                           np.array([limit.roll_rad, limit.pitch_rad, limit.heading_rad]))
 
@@ -294,8 +294,8 @@ def _in_motion(increments, interval, records, t0, lever_arm, threshold) -> Initi
     at_antenna = Solution(latitude, longitude, height, v_antenna, C, rate)
     v_imu = v_antenna - (antenna_velocity(at_antenna, lever_arm) - v_antenna)
     position = _imu_position(latitude, longitude, height, C, lever_arm)
-    start = Start(*position, v_imu, quaternion_from_euler(roll, pitch, heading), first.position_sigma_m[k],
-                  np.asarray(sigma_v, dtype=float), psi_sigma)
+    start = Start(position[0], position[1], position[2], v_imu, quaternion_from_euler(roll, pitch, heading),
+                  first.position_sigma_m[k], np.asarray(sigma_v, dtype=float), psi_sigma)
     return Initialisation("in-motion", start, i, t_k, np.array([LEVEL_SIGMA, pitch_sigma, heading_sigma]))
 
 
