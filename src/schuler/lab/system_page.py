@@ -55,7 +55,7 @@ def offered_names(system: System) -> dict[str, Names]:
     Parameters
     ----------
     system : System
-        The system the page shows.
+        Whose page is drawn (by its name).
 
     Returns
     -------
