@@ -313,8 +313,8 @@ def _simulated_group(case: Case, members: np.ndarray, streams):
     start = _initialisation(case, data.increments, data.truth.interval_s, data.gnss, lambda: _start(data.path,
                             members.size), lever_arm=data.lever_arm, imu=imu,
                             at_rest_s=first_stop[1] if first_stop[0] == 0.0 else 0.0)
-    run = run_filter(data.increments[:, start.first_sample:], data.truth.interval_s, start.start, assumed(case, filter_model(imu)),
-                     data.gnss, t0=start.t0_s, lever_arm=data.lever_arm,
+    run = run_filter(data.increments[:, start.first_sample:], data.truth.interval_s, start.start,
+                     assumed(case, filter_model(imu)), data.gnss, t0=start.t0_s, lever_arm=data.lever_arm,
                      covariance_interval=case["covariance_interval"], use_velocity=data.use_velocity)
     truth = data.truth
     true = analysis.Truth(truth.latitude_rad, truth.longitude_rad, truth.height_m, truth.velocity_ned_m_s,
@@ -324,8 +324,8 @@ def _simulated_group(case: Case, members: np.ndarray, streams):
 
 def _initialisation(case: Case, increments, interval: float, gnss, given, **options) -> initialisation.Initialisation:
     """The filter's start by the case's ``initialisation`` (:func:`schuler.aided.initialisation.initialise`)."""
-    return initialisation.initialise(case["initialisation"], np.reshape(increments, (-1,) + np.shape(increments)[-2:]),
-                                     interval, gnss, given=given,
+    batch = np.reshape(increments, (-1,) + np.shape(increments)[-2:])  # a file's (n, 6): one member
+    return initialisation.initialise(case["initialisation"], batch, interval, gnss, given=given,
                                      speed_threshold=case["speed_threshold"],
                                      alignment_duration=case["alignment_duration"], **options)
 
