@@ -282,8 +282,8 @@ def test_aided_run_smooth_gives_the_forward_keys_smoothed_and_the_smoothed_colum
                   "--out", str(tmp_path))
     assert out.code == 0, out.stderr
     data = out.json()
-    forward = {key: value for key, value in data.items() if key not in ("smoothed", "inputs", "units", "monte_carlo",
-                                                                        "schuler_version", "files")}
+    forward = {key: value for key, value in data.items()
+               if key not in ("smoothed", "inputs", "units", "monte_carlo", "schuler_version", "files", "start")}
     smoothed = data["smoothed"]
     assert set(smoothed) == set(forward)
     assert set(smoothed["outages"][0]) == set(forward["outages"][0]) and set(smoothed["nees"]) == set(forward["nees"])

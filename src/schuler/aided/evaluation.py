@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from schuler.aided import aiding as more_aiding
-from schuler.aided import analysis, files, smoother
+from schuler.aided import analysis, files, initialisation, smoother
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import KINDS, FilterModel, filter_model, overridden
 from schuler.aided.gnss import scheduled_outages, simulate_gnss
@@ -140,6 +140,7 @@ PARAMETERS = ParameterSet((
     Parameter("smooth", "", False, "Rauch-Tung-Striebel smoother over the forward run: the JSON's smoothed (the "
               "forward run's keys, outages included) and the smoothed errors and 1-sigma in aided_errors.",
               kind="flag"),
+    *initialisation.PARAMETERS,
 ), owner="aided", exclusive=(("outages", "outage_start"), ("outages", "outage_duration"),
                                ("outages", "outage_every")))
 
@@ -152,6 +153,8 @@ OUTPUTS = (
     Output("outage_horizontal_error_max_m", "m", "", "largest horizontal error in any outage"),
     Output("outage_horizontal_error_sigma_m", "m", "", "filter's horizontal 1-sigma at the end of that outage"),
     Output("rejected_measurements", "1", "", "measurement epochs the chi-square gate rejected, every source"),
+    Output("start_heading_error_rad", "rad", "deg", "heading error at the filter's first output"),
+    Output("start_heading_sigma_rad", "rad", "deg", "filter's initial heading 1-sigma (psi down)"),
 )
 
 SAMPLE_BYTES = 6 * 8 * 3 + 10 * 8 + 3 * 3 * 8
@@ -330,14 +333,18 @@ def _simulated_group(case: Case, members: np.ndarray, streams, smooth: bool = Fa
     a fourth item, member 0's smoothed run and its errors."""
     require(member_bytes(case) * members.size, f"{members.size} members of this aided run", "--duration or --imu-rate")
     data = simulated_inputs(case, members, streams)
-    model = more_aiding.with_states(assumed(case, filter_model(resolve_model(_imu(case)))), case)
+    imu = resolve_model(_imu(case))
+    model = more_aiding.with_states(assumed(case, filter_model(imu)), case)
+    first_stop = data.path.stationary_intervals()[0]
+    start = _initialisation(case, data.increments, data.truth.interval_s, data.gnss, lambda: _start(data.path,
+                            members.size), lever_arm=data.lever_arm, imu=imu,
+                            at_rest_s=first_stop[1] if first_stop[0] == 0.0 else 0.0)
     noisy = streams is not None and not case["nominal"]
     extra = more_aiding.simulated_sources(case, data.path, data.increments, data.truth.interval_s, members,
                                           streams if noisy else None, model)
-    run = run_filter(data.increments, data.truth.interval_s, _start(data.path, members.size), model, data.gnss,
-                     lever_arm=data.lever_arm, covariance_interval=case["covariance_interval"],
-                     use_velocity=data.use_velocity, sources=extra,
-                     keep_for_smoother=smooth)
+    run = run_filter(data.increments[:, start.first_sample:], data.truth.interval_s, start.start, model, data.gnss,
+                     t0=start.t0_s, lever_arm=data.lever_arm, covariance_interval=case["covariance_interval"],
+                     use_velocity=data.use_velocity, sources=extra, keep_for_smoother=smooth)
     truth = data.truth
     true = _at(analysis.Truth(truth.latitude_rad, truth.longitude_rad, truth.height_m, truth.velocity_ned_m_s,
                               truth.quaternion), run.t_s, truth.t_s)
@@ -346,6 +353,14 @@ def _simulated_group(case: Case, members: np.ndarray, streams, smooth: bool = Fa
     smoothed = smoother.smooth(_member(run, 0))
     return dataclasses.replace(run, prior_covariance=None, transition=None, correction=None), \
         analysis.errors(run, true), data.outages, (smoothed, analysis.errors(smoothed, true))
+
+
+def _initialisation(case: Case, increments, interval: float, gnss, given, **options) -> initialisation.Initialisation:
+    """The filter's start by the case's ``initialisation`` (:func:`schuler.aided.initialisation.initialise`)."""
+    batch = np.reshape(increments, (-1,) + np.shape(increments)[-2:])  # a file's (n, 6): one member
+    return initialisation.initialise(case["initialisation"], batch, interval, gnss, given=given,
+                                     speed_threshold=case["speed_threshold"],
+                                     alignment_duration=case["alignment_duration"], **options)
 
 
 def _file_group(case: Case, members: np.ndarray, smooth: bool = False):
@@ -372,8 +387,11 @@ def _file_group(case: Case, members: np.ndarray, smooth: bool = False):
     model = assumed(case, model)
     dt = inputs.interval_s
     steps = max(round(case["covariance_interval"] / dt), 1)  # a whole number of the data's IMU intervals
-    run = run_filter(inputs.increments, dt, files.start_of(inputs, START_SIGMA), model, inputs.gnss, t0=inputs.t0_s,
-                     lever_arm=files.lever_arm_of(case, config), covariance_interval=steps * dt,
+    lever = files.lever_arm_of(case, config)
+    start = _initialisation(case, inputs.increments, dt, inputs.gnss, lambda: files.start_of(inputs, START_SIGMA),
+                            t0=inputs.t0_s, lever_arm=lever, imu=None if kfgins_model else resolve_model(_imu(case)))
+    run = run_filter(np.asarray(inputs.increments)[..., start.first_sample:, :], dt, start.start, model, inputs.gnss,
+                     t0=start.t0_s, lever_arm=lever, covariance_interval=steps * dt,
                      use_velocity=use_velocity, initial_sensor_errors=initial, initial_sensor_sigma=sigma,
                      keep_for_smoother=smooth)
     smoothed_run = smoother.smooth(run) if smooth else None
@@ -425,8 +443,10 @@ def _summaries(run, errors, outages) -> dict[str, np.ndarray]:
             "velocity_error_horizontal_rms_m_s": _rms(velocity),
             "heading_error_rms_rad": _rms(errors.heading),
         })
+    start = np.full(members, math.nan) if errors is None or errors.heading.shape[-1] == 0 else errors.heading[:, 0]
     return {**summary, "outage_horizontal_error_max_m": worst, "outage_horizontal_error_sigma_m": sigma,
-            "rejected_measurements": run.rejected.astype(float)}
+            "rejected_measurements": run.rejected.astype(float), "start_heading_error_rad": start,
+            "start_heading_sigma_rad": np.sqrt(run.covariance[:, 0, 8, 8])}
 
 
 def _member(value, m: int):
@@ -475,11 +495,11 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
         if first:
             # the navigation at every IMU epoch (full), the errors where the reference covers the run (run)
             kept = (_member(run, 0), None if errors is None else _member(errors, 0), outages, _member(full, 0),
-                    smoothed)
+                    smoothed, case["initialisation"])
     if not histories or kept is None:
         return Evaluation(outputs)
-    run, errors, outages, full, smoothed = kept
-    extras = run_extras(run, errors, outages)
+    run, errors, outages, full, smoothed, mode = kept
+    extras = {**run_extras(run, errors, outages), "start": initialisation.start_report(mode, full, errors)}
     if smoothed is not None:
         # the forward run's keys from the smoothed run and its errors (a NaN, without a truth, is written as null)
         summary = {name: float(values[0]) for name, values in _summaries(smoothed[0], smoothed[1], outages).items()}

@@ -2,7 +2,10 @@
 
 Every control is a ``<div data-param="NAME">`` holding a label with the display
 unit, a text ``<input>`` (a typed value, applied on Enter or when the field is
-left), the default and range, and a place for the one-line error. Values travel
+left), the default and range, and a place for the one-line error. A text
+parameter a page offers names for gets them as suggestions of its input, or,
+when it takes several comma-separated names, as check boxes whose ticked names
+travel joined by commas (:class:`Names`). Values travel
 as the text the user typed and are converted only by
 :meth:`~schuler.params.ParameterSet.parse` (the command line's own parser), so
 the messages are the command line's too and nothing typed is ever evaluated.
@@ -11,6 +14,8 @@ the messages are the command line's too and nothing typed is ever evaluated.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
 
 from dash import dcc, html
 
@@ -26,6 +31,23 @@ PARAM = "param"
 """Component-id type of a control's input: ``{"type": PARAM, "name": NAME}``."""
 ERROR = "param-error"
 """Component-id type of a control's message line."""
+
+
+@dataclass(frozen=True)
+class Names:
+    """The names a text parameter takes, offered by its control.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The names, in the order shown.
+    several : bool
+        Whether the parameter takes several of them, comma-separated (check boxes) or one (suggestions of the
+        text input, which still takes any other text: a file's path).
+    """
+
+    names: tuple[str, ...]
+    several: bool = False
 
 
 def initial_text(parameter: Parameter) -> str:
@@ -129,7 +151,8 @@ def human_label(name: str) -> str:
     return name if len(words[0]) == 1 else " ".join(words)
 
 
-def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM) -> html.Div:
+def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM,
+            names: Names | None = None) -> html.Div:
     """One control: ``div[data-param=NAME]`` with label (``drift east``, unit), ``<input>``, option, default and
     range, error line.
 
@@ -142,6 +165,8 @@ def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM
     id_type : str
         Component-id type of the input (``{"type": id_type, "name": NAME}``); the message line's type is
         ``param-error`` for the default, ``ID_TYPE-error`` otherwise, so that two pages' controls stay apart.
+    names : Names, optional
+        The names a text parameter takes: suggestions of its input, or check boxes when it takes several.
 
     Returns
     -------
@@ -151,22 +176,25 @@ def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM
     name = parameter.name
     unit = unit_label(parameter)
     options = None
-    if parameter.kind in ("choice", "flag"):
-        choices = (parameter.choices or ()) if parameter.kind == "choice" else ("true", "false")
+    text = initial_text(parameter) if value is None else value
+    if parameter.kind == "choice":
+        choices: tuple[str, ...] = parameter.choices or ()
+    elif parameter.kind == "flag":
+        choices = ("true", "false")
+    else:
+        choices = names.names if names is not None and not names.several else ()
+    if choices:
         options = html.Datalist(id=f"{id_type}-{name}-choices", children=[html.Option(value=c) for c in choices])
-    placeholder = "not set" if parameter.default is None else ""
-    field = dcc.Input(
-        id={"type": id_type, "name": name},
-        type="text",
-        value=initial_text(parameter) if value is None else value,
-        debounce=True,
-        maxLength=MAX_VALUE_CHARS,
-        placeholder=placeholder,
-        list=f"{id_type}-{name}-choices" if options is not None else None,
-        autoComplete="off",
-        spellCheck=False,
-        className="value",
-    )
+    field: Any
+    if names is not None and names.several:  # none ticked: not set, the parameter's own default
+        field = dcc.Checklist(id={"type": id_type, "name": name}, options=list(names.names),
+                              value=[n for n in (part.strip() for part in text.split(",")) if n in names.names],
+                              inline=True, className="value names")
+    else:
+        field = dcc.Input(id={"type": id_type, "name": name}, type="text", value=text, debounce=True,
+                          maxLength=MAX_VALUE_CHARS, placeholder="not set" if parameter.default is None else "",
+                          list=f"{id_type}-{name}-choices" if options is not None else None, autoComplete="off",
+                          spellCheck=False, className="value")
     label = html.Label([html.Span(human_label(name), className="name"),
                         html.Span(unit, className="unit") if unit else None], title=parameter.help)
     hint = f"{parameter.option}; {describe(parameter)}"  # the option the command line takes for the same value
@@ -176,8 +204,8 @@ def control(parameter: Parameter, value: str | None = None, id_type: str = PARAM
     return html.Div([c for c in children if c is not None], className="control", **data_attributes(param=name))
 
 
-def controls(parameters: Iterable[Parameter], id_type: str = PARAM, values: Mapping[str, str] | None = None
-             ) -> list[html.Div]:
+def controls(parameters: Iterable[Parameter], id_type: str = PARAM, values: Mapping[str, str] | None = None,
+             names: Mapping[str, Names] | None = None) -> list[html.Div]:
     """A control per parameter; ``values`` are texts to start with instead of the defaults.
 
     Parameters
@@ -188,13 +216,16 @@ def controls(parameters: Iterable[Parameter], id_type: str = PARAM, values: Mapp
         Component-id type of the inputs (see :func:`control`).
     values : mapping of str to str, optional
         Parameter name -> text to start with (as typed, display unit); names not in it show their default.
+    names : mapping of str to Names, optional
+        Parameter name -> the names its control offers (text parameters).
 
     Returns
     -------
     list of dash.html.Div
         One control per parameter.
     """
-    return [control(p, (values or {}).get(p.name), id_type=id_type) for p in parameters]
+    return [control(p, (values or {}).get(p.name), id_type=id_type, names=(names or {}).get(p.name))
+            for p in parameters]
 
 
 def typed_values(parameters: ParameterSet, ids: list[dict], values: list) -> dict[str, str]:
@@ -209,7 +240,8 @@ def typed_values(parameters: ParameterSet, ids: list[dict], values: list) -> dic
     ids : list of dict
         Component ids of the inputs (``{"type": ..., "name": NAME}``), as Dash passes them.
     values : list
-        The inputs' current texts, in the order of ``ids`` (None for an input never filled).
+        The inputs' current texts, in the order of ``ids`` (None for an input never filled; a list of the names
+        ticked for check boxes, joined by commas).
 
     Returns
     -------
@@ -221,7 +253,7 @@ def typed_values(parameters: ParameterSet, ids: list[dict], values: list) -> dic
         name = ident.get("name") if isinstance(ident, Mapping) else None
         if not isinstance(name, str) or name not in parameters:
             continue
-        text = "" if value is None else str(value)
+        text = "" if value is None else ",".join(map(str, value)) if isinstance(value, list) else str(value)
         if text.strip() and text.strip() != initial_text(parameters[name]):
             typed[name] = text
     return typed

@@ -1,13 +1,14 @@
-"""The lab's figures: interactive ones for gyrocompassing, the system's own files for any system.
+"""The lab's figures: interactive ones for gyrocompassing and aided navigation, the system's own files for any system.
 
 A system's page shows interactive (plotly) figures where the lab knows its
 result's histories (:data:`INTERACTIVE`: the gyrocompassing system, whose page
-must follow a change within a second), and otherwise the PNG figures of the
+must follow a change within a second, and ``aided``: its errors inside the
+filter's +-3-sigma and its track, GNSS outages marked), and otherwise the PNG figures of the
 system's own ``write_files`` (slower: matplotlib renders them, so they come in
 a second step with its own progress indicator).
 
 Angles are shown as the source's figures show them: delta in arcmin, level
-errors in arcsec, time in minutes.
+errors in arcsec, time in minutes; the aided heading in deg.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import numpy as np
 from dash import dcc, html
 
 from schuler.contract import System
+from schuler.core.earth import radii_of_curvature
 from schuler.exceptions import InvalidParameter
 from schuler.lab.views import data_attributes, number_text
 from schuler.units import to_unit
@@ -385,7 +387,102 @@ def _alignment_figures(result) -> list[dict]:
     return [time_history(runs), phase_trajectory(runs)]
 
 
-INTERACTIVE = {"align": Interactive(("align_time_history", "align_phase_trajectory"), _alignment_figures)}
+OUTAGE_FILL = "rgba(128, 128, 128, 0.25)"
+"""Colour of a GNSS outage's band."""
+
+ENVELOPE_ROWS = (("north_error_m", "north_sigma_m", "north [m]", "m"),
+                 ("east_error_m", "east_sigma_m", "east [m]", "m"), ("down_error_m", "down_sigma_m", "down [m]", "m"),
+                 ("heading_error_rad", "heading_sigma_rad", "heading [deg]", "deg"))
+"""The rows of the aided error figure: error channel, its 1-sigma channel, axis title, display unit."""
+
+
+def error_envelopes(histories, outages, title: str = "Errors inside the filter's +-3 sigma (GNSS outages grey)"):
+    """North, east, down errors [m] and heading error [deg] of one member in the filter's +-3-sigma band.
+
+    The time axis counts minutes from the run's first output (a file's seconds of week from its start); without a
+    truth (no error channels) the bands alone are drawn.
+
+    Parameters
+    ----------
+    histories : Histories
+        ``aided_errors`` of an aided run (SI: s, m, rad).
+    outages : list of dict
+        The run's outages, ``start_s`` and ``duration_s`` (s, the histories' time scale).
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    dict
+        A plotly figure (plain dict) of four rows sharing the time axis.
+    """
+    origin = float(histories.time[0]) if histories.time.size else 0.0
+    minutes = (histories.time - origin) / 60.0
+    traces: list[dict] = []
+    shapes = []
+    for row, (error, sigma, _, unit) in enumerate(ENVELOPE_ROWS, start=1):
+        x, band = thin(minutes, 3.0 * np.asarray(to_unit(histories[sigma], unit), dtype=float))
+        first = row == 1
+        band_line = {"color": "rgba(31, 119, 180, 0.6)", "width": 1}
+        traces += [_line(x, band, "+3 sigma", row, line=band_line, legendgroup="band", showlegend=False),
+                   _line(x, -band, "+-3 sigma", row, line=band_line, fill="tonexty",
+                         fillcolor="rgba(31, 119, 180, 0.15)", legendgroup="band", showlegend=first)]
+        if error in histories:
+            x, value = thin(minutes, to_unit(histories[error], unit))
+            traces.append(_line(x, value, "error", row, line={"color": "crimson", "width": 1}, legendgroup="error",
+                                showlegend=first))
+        suffix = "" if first else str(row)
+        shapes += [{"type": "rect", "xref": f"x{suffix}", "yref": f"y{suffix} domain", "y0": 0, "y1": 1,
+                    "x0": (o["start_s"] - origin) / 60.0, "x1": (o["start_s"] + o["duration_s"] - origin) / 60.0,
+                    "fillcolor": OUTAGE_FILL, "line": {"width": 0}, "layer": "below"} for o in outages]
+    return _figure(traces, title, [row[2] for row in ENVELOPE_ROWS], "time from the start [min]", 820, shapes)
+
+
+def track(navigation, outages, title: str = "Track: the aided solution, north against east (GNSS outages red)"):
+    """The navigation solution's track in metres north and east of its first point, the outages' parts in red.
+
+    Parameters
+    ----------
+    navigation : Histories
+        An aided run's navigation (``latitude_rad``, ``longitude_rad``, ``height_m``; s).
+    outages : list of dict
+        The run's outages, ``start_s`` and ``duration_s`` (s, the navigation's time scale).
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    dict
+        A plotly figure (plain dict), east [m] across, north [m] up, one metre the same length on both.
+    """
+    latitude, longitude, height = (np.asarray(navigation[n], dtype=float)
+                                   for n in ("latitude_rad", "longitude_rad", "height_m"))
+    R_N, R_E = radii_of_curvature(latitude[0])
+    north = (latitude - latitude[0]) * (R_N + height[0])
+    east = (longitude - longitude[0]) * (R_E + height[0]) * np.cos(latitude[0])
+    x, y = thin(east, north)
+    traces = [_line(x, y, "aided solution", line={"color": "rgb(31, 119, 180)"})]
+    for number, outage in enumerate(outages):
+        inside = (navigation.time > outage["start_s"]) & (navigation.time <= outage["start_s"] + outage["duration_s"])
+        x, y = thin(east[inside], north[inside])
+        traces.append(_line(x, y, "in outages", line={"color": "crimson", "width": 3}, legendgroup="outage",
+                            showlegend=number == 0))
+    traces.append(_line(east[:1], north[:1], "start", mode="markers", marker={"size": 9, "color": "black"}))
+    fig = _figure(traces, title, ["north [m]"], "east [m]", 560)
+    fig["layout"]["yaxis"]["scaleanchor"] = "x"
+    return fig
+
+
+def _aided_figures(result) -> list[dict]:
+    histories = getattr(result, "histories", {})
+    if "aided_errors" not in histories or getattr(result, "navigation", None) is None:
+        return [empty("no histories in this result")] * 2
+    outages = result.extras.get("outages", [])
+    return [error_envelopes(histories["aided_errors"], outages), track(result.navigation, outages)]
+
+
+INTERACTIVE = {"align": Interactive(("align_time_history", "align_phase_trajectory"), _alignment_figures),
+               "aided": Interactive(("aided_errors", "aided_track"), _aided_figures)}
 """System name -> the interactive figures of its ``run`` result."""
 
 

@@ -12,6 +12,7 @@ page's session token; nothing about a user is kept in the server.
 
 from __future__ import annotations
 
+import importlib
 import io
 import logging
 import tempfile
@@ -25,7 +26,7 @@ from dash.exceptions import PreventUpdate
 from schuler.contract import RUN_OPTIONS, System
 from schuler.exceptions import SchulerError
 from schuler.lab import views
-from schuler.lab.controls import ERROR, PARAM, controls, error_owner, parse_typed, typed_values
+from schuler.lab.controls import ERROR, PARAM, Names, controls, error_owner, parse_typed, typed_values
 from schuler.lab.figures import GRAPH, block, empty, file_figures, interactive_figures, interactive_stems
 from schuler.params import Parameter, ParameterSet
 from schuler.registry import get_system
@@ -39,6 +40,30 @@ four sessions' polls alone kept a loaded 2-core machine's web server busy and an
 
 ACTION_PAGES = {"align": {"compare": "Every self-alignment method on the same data, compared"}}
 """System name -> its actions that have a page of their own (``/NAME/ACTION``) and the link's text."""
+
+
+OFFERED_NAMES = {"aided": {"imu": ("schuler.imu.spec", "GRADES", False),
+                           "aiding": ("schuler.aided.evaluation", "AIDING", True)}}
+"""System name -> its text parameters whose controls offer names: (module, attribute holding the names the
+parameter takes, whether it takes several). The names are read from where the parameter checks them, so that a
+name added there appears on the page."""
+
+
+def offered_names(system: System) -> dict[str, Names]:
+    """The names a system page's text controls offer (:data:`OFFERED_NAMES`), read from their modules.
+
+    Parameters
+    ----------
+    system : System
+        Whose page is drawn (by its name).
+
+    Returns
+    -------
+    dict of str to Names
+        Parameter name -> its names; empty for a system without such parameters.
+    """
+    return {name: Names(tuple(getattr(importlib.import_module(module), attribute)), several)
+            for name, (module, attribute, several) in OFFERED_NAMES.get(system.name, {}).items()}
 
 
 def page_parameters(system: System) -> ParameterSet:
@@ -129,7 +154,8 @@ def layout(system: System) -> html.Div:
             html.Aside([html.H2("Parameters"),
                         html.P("Type a value (a bare number is in the unit shown, or write a unit: "
                                "'0.02 deg/h'); Enter or leaving the field applies it.", className="hint"),
-                        *controls(page_parameters(system))], className="controls"),
+                        *controls(page_parameters(system), names=offered_names(system))],
+                       className="controls"),
             html.Main([
                 html.Div([html.Span("running", className="label"), html.Progress(id="run-progress"),
                           html.Button("Cancel", id="run-cancel", disabled=True, className="cancel")],
