@@ -21,7 +21,7 @@ def error_envelopes(histories, outages):
     """North, east, down and heading errors of one member with the filter's +-3-sigma (outages shaded).
 
     Without a truth (no error channels) the envelopes alone are drawn; with the smoother's channels
-    (``smoothed_``, :func:`schuler.aided.evaluation.error_histories`) its errors and +-3-sigma are drawn beside.
+    (``smoothed_``, :func:`schuler.aided.histories.error_histories`) its errors and +-3-sigma are drawn beside.
 
     Parameters
     ----------
