@@ -138,5 +138,28 @@ class MissionResult(SystemResult):
         for name, share in sorted(self.budget.items(), key=lambda item: -item[1]):
             if share >= 1e-4:
                 shares.add_row(name, f"{100 * share:.2f} %")
-        return Group(table, shares)
+        if not self.extras.get("outages"):
+            return Group(table, shares)
+        return Group(table, shares, self._outage_table())
+
+    def _outage_table(self):
+        from rich.table import Table
+
+        compared = {(o["start_s"], o["duration_s"]): o for o in self.outage_comparison()}
+        table = Table(title="GNSS outages: horizontal position error at the end", show_header=True)
+        for name in ("start", "duration", "1-sigma (covariance)", "largest shares"):
+            table.add_column(name, justify="left" if name == "largest shares" else "right")
+        if compared:
+            table.add_column("Monte Carlo RMS: end, largest", justify="right")
+        for outage in self.extras["outages"]:
+            top = sorted(outage["shares"].items(), key=lambda item: -item[1])[:3]
+            row = [f"{outage['start_s']:g} s", f"{outage['duration_s']:g} s",
+                   f"{outage['horizontal_error_sigma_m']:,.4g} m",
+                   ", ".join(f"{name} {100 * share:.1f} %" for name, share in top)]
+            if compared:
+                mc = compared.get((outage["start_s"], outage["duration_s"]))
+                row.append("" if mc is None or mc["horizontal_error_end_rms_m"] is None else
+                           f"{mc['horizontal_error_end_rms_m']:,.4g} m, {mc['horizontal_error_max_rms_m']:,.4g} m")
+            table.add_row(*row)
+        return table
 
