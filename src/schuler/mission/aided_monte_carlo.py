@@ -137,13 +137,13 @@ def member_outputs(run, errors, outages) -> dict[str, np.ndarray]:
     -------
     dict of str to ndarray
         ``member_position_error_m`` and ``member_outage_<k>_horizontal_error_end_m|max_m`` (k from 1), shape (N,),
-        m (NaN for an outage the case does not have).
+        m (0 for an outage the case does not have).
     """
     count = run.solution.shape[0]
     out = {"member_position_error_m": errors.horizontal[:, -1]}
     for k in range(1, OUTAGE_SLOTS + 1):
         for kind in ("end", "max"):
-            out[f"member_outage_{k}_horizontal_error_{kind}_m"] = np.full(count, np.nan)
+            out[f"member_outage_{k}_horizontal_error_{kind}_m"] = np.zeros(count)
     for m in range(count):
         drifts = analysis.outage_drift(_member(run, m), _member(errors, m), outages[:OUTAGE_SLOTS])
         for k, drift in enumerate(drifts, start=1):

@@ -263,10 +263,10 @@ def aided_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> AidedBu
     white = {name: 1 + SOURCES.index(name) for name in WHITE_SOURCES}
     for name, covariance in alignment_noise(setup, start_rotation, 9).items():
         P[white[name], 6:9, 6:9] = covariance[6:9, 6:9]
-    P[1:] *= on[:, None, None]
-    true_initial = P[1:].sum(axis=0)
     start_sigma = np.sqrt(np.diag(P[1:1 + len(SOURCES)].sum(axis=0)))
     P[0] = np.diag(start_sigma**2)
+    P[1:] *= on[:, None, None]
+    true_initial = P[1:].sum(axis=0)
 
     H, R_parts = _measurements(setup, aiding, coefficients, trajectory, fixes, dt)
     noise_index = [1 + sources.index(name) for name in aiding.sources]

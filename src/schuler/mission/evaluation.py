@@ -126,11 +126,16 @@ OUTPUTS = (
     Output("member_position_error_m", "m", "",
            "a Monte Carlo member's final horizontal position error, nonlinear INS (0 in the nominal case)"),
     Output("outage_horizontal_error_sigma_m", "m", "",
-           "aided: 1-sigma horizontal position error at the end of the worst outage (NaN free-inertial)"),
+           "1-sigma horizontal position error at the end of the worst GNSS outage (free-inertial: the whole "
+           "navigation is one, the final 1-sigma; 0 when aided without outages)"),
     *(Output(f"member_outage_{k}_horizontal_error_{kind}_m", "m", "",
-             f"aided Monte Carlo: a member's horizontal error {what} outage {k} (NaN without it)")
+             f"aided Monte Carlo: a member's horizontal error {what} outage {k} (0 without it or in the nominal "
+             "case)")
       for k in range(1, OUTAGE_SLOTS + 1) for kind, what in (("end", "at the end of"), ("max", "largest in"))),
 )
+
+_MEMBER_OUTPUTS = tuple(output.name for output in OUTPUTS if output.name.startswith("member_"))
+"""The outputs of a Monte Carlo member (0 in the nominal case)."""
 
 _BUDGET_KEYS = tuple(p.name for p in PARAMETERS if p.name != "imu_rate")
 """The parameters the covariance analysis depends on."""
@@ -255,7 +260,7 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
     -------
     dict of str to ndarray, or Evaluation
         Output name -> values of shape (number of cases,), SI (``member_position_error_m`` 0 without random
-        streams; the ``member_outage_*`` outputs NaN without them).
+        streams, as are the ``member_outage_*`` outputs).
 
     Examples
     --------
@@ -266,7 +271,8 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
     """
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
-    out["member_position_error_m"] = np.zeros(n)
+    for name in _MEMBER_OUTPUTS:
+        out[name] = np.zeros(n)
     models: dict[str, ErrorModel] = {}
     first: tuple[dict, dict] = ({}, {})
     for shape_index, shape_group in cases.groups(*_SHAPE_KEYS):
@@ -279,10 +285,11 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
             setups.append(mission_setup(values, model=models[values["imu"]]))
         for (index, group), setup, (budget, aided) in zip(distinct, setups, _budgets(setups)):
             rows = shape_index[index]
-            for name, value in budget_outputs(budget).items():
+            summary = budget_outputs(budget)
+            for name, value in summary.items():
                 out[name][rows] = value
-            if aided is not None and aided.outages:
-                out["outage_horizontal_error_sigma_m"][rows] = max(o["horizontal_error_sigma_m"] for o in aided.outages)
+            out["outage_horizontal_error_sigma_m"][rows] = summary["position_error_sigma_m"] if aided is None \
+                else max((o["horizontal_error_sigma_m"] for o in aided.outages), default=0.0)
             if histories and rows[0] == 0:
                 first = _in_full(budget, setup.error_model, aided)
             if cases.random is not None:
