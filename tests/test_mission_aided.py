@@ -12,7 +12,8 @@ from schuler.mission.aiding import aided_budget
 from schuler.mission.api import SYSTEM
 from schuler.mission.covariance import covariance_budget
 from schuler.mission.evaluation import PARAMETERS
-from schuler.mission.setup import CONSTANT_SOURCES, mission_setup
+from schuler.mission.setup import mission_setup
+from schuler.mission.survival import longest_outage, survival_figure, survival_table
 
 SHORT = {"imu": "tactical", "trajectory": "drive", "duration": 1200.0, "aiding": "gnss-position,gnss-velocity",
          "outage_start": 300.0, "outage_duration": 60.0, "outage_every": 600.0}
@@ -157,3 +158,37 @@ def test_the_covariance_is_the_filters_monte_carlo_at_every_outage_end(grade):
         ratio = outage["horizontal_error_end_rms_m"] / outage["horizontal_error_sigma_m"]
         assert abs(ratio - 1.0) < 0.10, (grade, outage)
         assert outage["horizontal_error_max_rms_m"] >= outage["horizontal_error_end_rms_m"]
+
+
+@pytest.mark.parametrize("power", [1.0, 2.0, 3.0])
+def test_the_longest_outage_is_exact_on_a_power_law(power):
+    durations = np.array([300.0, 3.0, 30.0, 3000.0])  # any order
+    sigmas = 0.02 * durations**power
+    for bound in (1.0, 10.0, 100.0):
+        expected = (bound / 0.02) ** (1.0 / power)
+        got = longest_outage(durations, sigmas, bound)
+        assert got == (pytest.approx(expected, rel=1e-12) if 3.0 <= expected <= 3000.0
+                       else (0.0 if expected < 3.0 else math.inf))
+
+
+def test_the_survival_table_of_a_sweep_is_the_outage_that_reaches_each_bound(tmp_path):
+    import pandas as pd
+
+    from schuler.study.scenario import load_scenario
+    from schuler.study.sweep import run_sweep
+
+    scenario = load_scenario("examples/mission_tactical_gnss.toml")
+    run_sweep(scenario, tmp_path, ["imu=navigation,tactical", "duration=1500", "outage_start=600",
+                                   "outage_duration=10,30,100,300"], progress=False, plots=False)
+    frame = pd.read_parquet(tmp_path / "results.parquet")
+    table = survival_table(frame)
+    assert list(table.index) == ["navigation", "tactical"] and list(table.columns) == ["1 m", "10 m", "100 m"]
+    assert np.all(table.loc["navigation"] > table.loc["tactical"])
+    # the interpolated outage, run as a case of its own, ends near the bound (log-log between sweep points)
+    longest = float(table.loc["tactical", "10 m"])
+    assert 30.0 < longest < 100.0
+    case = {**scenario.given(), "duration": 1500.0, "outage_start": 600.0, "outage_duration": longest}
+    reached = SYSTEM.run(**case).outage_horizontal_error_sigma_m
+    assert reached == pytest.approx(10.0, rel=0.1)
+    figure = survival_figure(frame)
+    assert len(figure.axes[0].lines) == 2 + 3  # a line per grade, one per bound
