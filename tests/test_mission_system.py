@@ -23,7 +23,8 @@ KEYS = ["position_error_sigma_m", "position_error_north_sigma_m", "position_erro
         "velocity_error_sigma_m_s", "heading_error_sigma_rad", "initial_heading_error_sigma_rad",
         "initial_tilt_sigma_rad", "dominant_share", "member_position_error_m", "budget", "dominant_source",
         "instrument", "monte_carlo", "units", "outage_horizontal_error_sigma_m",
-        *(f"member_outage_{k}_horizontal_error_{kind}_m" for k in range(1, OUTAGE_SLOTS + 1) for kind in ("end", "max"))]
+        *(f"member_outage_{k}_horizontal_error_{kind}_m" for k in range(1, OUTAGE_SLOTS + 1)
+          for kind in ("end", "max"))]
 """The top-level keys of ``mission run --json`` (with schuler_version, inputs and files), recorded before the
 mission moved to the one evaluation (main at 58a5aa9, the light case), and the outputs of the aided mission
 since."""

@@ -29,7 +29,8 @@ from schuler.study.scenario import load_scenario
 from schuler.study.sweep import run_sweep
 
 name = Path("examples", "mission_navigation_gnss.toml")  # found from the repository or its gallery folder
-scenario = load_scenario(next(folder / name for folder in (Path.cwd(), *Path.cwd().parents) if (folder / name).is_file()))
+scenario = load_scenario(next(folder / name for folder in (Path.cwd(), *Path.cwd().parents)
+                              if (folder / name).is_file()))
 grid = ["imu=navigation,tactical,industrial,consumer", "gnss_rate=1", "covariance_interval=1",
         "outage_duration=1,3,10,30,100,300,1000,3000"]
 with tempfile.TemporaryDirectory() as folder:

@@ -118,7 +118,7 @@ def filter_model(setup: MissionSetup) -> FilterModel:
     sigma = dict(zip(CONSTANT_SOURCES, setup.constant_sigmas))
 
     def triad(family: str) -> ErrorProcess:
-        return ErrorProcess("constant", [sigma[f"{family}_{axis}"] for axis in AXES])
+        return ErrorProcess("constant", np.array([sigma[f"{family}_{axis}"] for axis in AXES]))
 
     return FilterModel(setup.gyro_random_walk, setup.accel_random_walk, triad("gyro_bias"), triad("accel_bias"),
                        triad("gyro_scale_factor"), triad("accel_scale_factor"))
@@ -311,13 +311,14 @@ def _measurements(setup: MissionSetup, aiding: Aiding, coefficients, trajectory,
     solution = measurements.Solution(coefficients.latitude[before], np.zeros(t.size), coefficients.height[before],
                                      velocity, dcm_from_quaternion(quaternion), coefficients.body_rate[before])
     zeros = np.zeros(t.size)
-    _, H = measurements.gnss_position(solution, aiding.lever_arm, zeros, zeros, zeros, STATES)
+    arm = np.asarray(aiding.lever_arm, dtype=float)
+    _, H = measurements.gnss_position(solution, arm, zeros, zeros, zeros, STATES)
     m = 6 if aiding.use_velocity else 3
     position = np.zeros((m, m))
     position[:3, :3] = np.diag(np.square(aiding.position_sigma))
     if not aiding.use_velocity:
         return H, [position]
-    _, H_velocity = measurements.gnss_velocity(solution, aiding.lever_arm, velocity, STATES, EARTH_RATE)
+    _, H_velocity = measurements.gnss_velocity(solution, arm, velocity, STATES, EARTH_RATE)
     speed = np.zeros((m, m))
     speed[3:, 3:] = np.eye(3) * aiding.velocity_sigma**2
     return np.concatenate([H, H_velocity], axis=1), [position, speed]

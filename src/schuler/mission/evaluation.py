@@ -224,7 +224,7 @@ def _budgets(setups: list[MissionSetup]) -> list[tuple[CovarianceBudget, AidedBu
     """Each mission's budget: the free-inertial ones batched, the aided ones through their filter one by one."""
     free = [setup for setup in setups if setup.aiding is None]
     batched = iter(covariance_budgets(free))
-    out = []
+    out: list[tuple[CovarianceBudget, AidedBudget | None]] = []
     for setup in setups:
         if setup.aiding is None:
             out.append((next(batched), None))
@@ -298,8 +298,8 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
                     target = rows[rate_index]
                     if aided is not None and setup.aiding is not None:
                         run, errors = aided_members(setup, members.members, cases.random, rate, aided.start_sigma)
-                        for name, values in member_outputs(run, errors, setup.aiding.outages).items():
-                            out[name][target] = values
+                        for name, drifts in member_outputs(run, errors, setup.aiding.outages).items():
+                            out[name][target] = drifts
                     else:
                         result = run_members(setup, members.members, cases.random, rate, output_step=setup.duration)
                         out["member_position_error_m"][target] = final_horizontal_errors(result)
