@@ -14,27 +14,16 @@ Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_mission_aided.py``.
 
 from __future__ import annotations
 
-import math
 import time
 import tomllib
 from pathlib import Path
 
+from bench_mission import timed
 from schuler.mission.aiding import aided_budget
 from schuler.mission.setup import mission_setup
 from schuler.study.scenario import load_scenario
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-
-
-def timed(function, repeat: int = 3):
-    best_wall = best_cpu = math.inf
-    result = None
-    for _ in range(repeat):
-        wall, cpu = time.perf_counter(), time.process_time()
-        result = function()
-        best_wall = min(best_wall, time.perf_counter() - wall)
-        best_cpu = min(best_cpu, time.process_time() - cpu)
-    return result, best_wall, best_cpu
 
 
 def one_at_a_time(setup, sources):

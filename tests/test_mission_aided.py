@@ -14,6 +14,7 @@ from schuler.mission.covariance import covariance_budget
 from schuler.mission.evaluation import PARAMETERS
 from schuler.mission.setup import mission_setup
 from schuler.mission.survival import longest_outage, survival_figure, survival_table
+from test_mission_instrument import WHITE_SPEC
 
 SHORT = {"imu": "tactical", "trajectory": "drive", "duration": 1200.0, "aiding": "gnss-position,gnss-velocity",
          "outage_start": 300.0, "outage_duration": 60.0, "outage_every": 600.0}
@@ -50,15 +51,6 @@ def test_switching_a_source_off_removes_exactly_its_share(source):
         assert without["horizontal_error_sigma_m"] ** 2 == pytest.approx(
             with_it["horizontal_error_sigma_m"] ** 2 * (1.0 - share), rel=1e-9)
         assert without["shares"][source] == 0.0
-
-
-WHITE_SPEC = """\
-name = "white noise only"
-[gyro]
-random_walk = "0.15 deg/sqrt(h)"
-[accel]
-random_walk = "100 ug/sqrt(Hz)"
-"""
 
 
 def test_the_sources_add_up_to_the_filters_own_covariance_when_it_is_given_the_true_start(tmp_path):
