@@ -105,6 +105,8 @@ def main() -> None:
     print(f"  the noise alone: {samples / noise_cpu / 1e6:.2f} M member-samples/s CPU")
     for path in sorted(EXAMPLES.glob("mission_*.toml")):
         values = tomllib.loads(path.read_text())
+        if values["parameters"].get("aiding"):
+            continue  # the filter's Monte Carlo: benchmarks/bench_mission_aided.py
         scenario = load_scenario(path)
         given = scenario.given()
         duration = given.get("duration", 7200.0)

@@ -10,6 +10,7 @@ import pytest
 
 from schuler.contract import Cases
 from schuler.exceptions import InvalidParameter
+from schuler.mission.aided_monte_carlo import OUTAGE_SLOTS
 from schuler.mission.api import SYSTEM
 from schuler.mission.covariance import covariance_budget
 from schuler.mission.evaluation import PARAMETERS, evaluate
@@ -21,9 +22,12 @@ from test_contract import LIGHT
 KEYS = ["position_error_sigma_m", "position_error_north_sigma_m", "position_error_east_sigma_m",
         "velocity_error_sigma_m_s", "heading_error_sigma_rad", "initial_heading_error_sigma_rad",
         "initial_tilt_sigma_rad", "dominant_share", "member_position_error_m", "budget", "dominant_source",
-        "instrument", "monte_carlo", "units"]
+        "instrument", "monte_carlo", "units", "outage_horizontal_error_sigma_m",
+        *(f"member_outage_{k}_horizontal_error_{kind}_m" for k in range(1, OUTAGE_SLOTS + 1)
+          for kind in ("end", "max"))]
 """The top-level keys of ``mission run --json`` (with schuler_version, inputs and files), recorded before the
-mission moved to the one evaluation (main at 58a5aa9, the light case)."""
+mission moved to the one evaluation (main at 58a5aa9, the light case), and the outputs of the aided mission
+since."""
 
 COLUMNS = ["t_s", "position_error_sigma_m", "velocity_error_sigma_m_s", "heading_error_sigma_rad",
            *(f"variance_{name}_m2" for name in SOURCES)]

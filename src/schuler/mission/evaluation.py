@@ -13,28 +13,53 @@ case's budget comes in full: its 1-sigma histories and each source's variance
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
+from schuler.aided.evaluation import (
+    AIDING,
+    SIMULATED_OUTAGE_START,
+    SIMULATED_SIGMA,
+    SIMULATED_VELOCITY_SIGMA,
+)
+from schuler.aided.evaluation import PARAMETERS as AIDED_PARAMETERS
 from schuler.contract import Cases, Evaluation, Output
 from schuler.core.response import Histories
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.spec import GRADES
+from schuler.mission.aided_monte_carlo import OUTAGE_SLOTS, aided_members, member_outputs
+from schuler.mission.aiding import AidedBudget, aided_budget
 from schuler.mission.covariance import CovarianceBudget, covariance_budgets
 from schuler.mission.monte_carlo import final_horizontal_errors, run_members
 from schuler.mission.plots import BUDGET_HISTORIES
 from schuler.mission.setup import (
     ALIGNMENTS,
     CALIBRATIONS,
+    GNSS_SOURCES,
     SOURCES,
     TRAJECTORIES,
     VERTICAL_CHANNELS,
+    MissionSetup,
     error_model,
     mission_setup,
 )
 from schuler.navigate.mechanization import estimate_memory
 from schuler.params import Case, Parameter, ParameterSet
+
+_AIDED_HELP = {
+    **{f"gnss_sigma_{axis}": f"GNSS position 1-sigma, {axis} (not set: {sigma:g} m)."
+       for axis, sigma in zip(("north", "east", "down"), SIMULATED_SIGMA)},
+    "gnss_velocity_sigma": f"GNSS velocity 1-sigma, each axis (not set: {SIMULATED_VELOCITY_SIGMA:g} m/s).",
+    **{f"lever_arm_{axis}": f"IMU to GNSS antenna, body {axis} ({name}) (not set: 0)."
+       for axis, name in zip("xyz", ("forward", "right", "down"))},
+    "outage_start": f"Start of the first GNSS outage, from the start of navigation (not set: "
+                    f"{SIMULATED_OUTAGE_START:g} s).",
+    "covariance_interval": "Covariance step of the aided filter (the GNSS interval a whole number of them; the "
+                           "Monte Carlo's a whole number of IMU intervals).",
+}
+"""The help of schuler aided's options where the mission's differs (no files)."""
 
 PARAMETERS = ParameterSet((
     Parameter("imu", "", "tactical", "IMU: a grade (" + ", ".join(GRADES) + "; schuler.imu presets with their "
@@ -77,6 +102,13 @@ PARAMETERS = ParameterSet((
               minimum=0, maximum=1e5),
     Parameter("imu_rate", "Hz", 2.0, "IMU rate of the Monte Carlo's nonlinear INS (reduced: exact for the "
               "noise, ample for the smooth trajectories).", minimum=0.1, maximum=1000),
+    Parameter("aiding", "", None, "Aiding after the alignment, comma-separated: " + ", ".join(AIDING) + " (not set: "
+              "free-inertial; the filter and GNSS of schuler aided, the vertical channel aided by the GNSS height).",
+              kind="text"),
+    *(dataclasses.replace(AIDED_PARAMETERS[name], help=_AIDED_HELP.get(name, AIDED_PARAMETERS[name].help))
+      for name in ("gnss_rate", "gnss_sigma_north", "gnss_sigma_east", "gnss_sigma_down", "gnss_velocity_sigma",
+                   "lever_arm_x", "lever_arm_y", "lever_arm_z", "outage_start", "outage_duration", "outage_every",
+                   "covariance_interval")),
 ), owner="mission", exclusive=tuple(("profile", name) for name in ("trajectory", "latitude", "longitude", "height",
                                                                    "heading", "speed")),
    renamed={"grade": "imu", "imu_spec": "imu", "instrument": "imu"})
@@ -93,7 +125,17 @@ OUTPUTS = (
     Output("dominant_share", "1", "%", "share of the dominant source in the final horizontal position variance"),
     Output("member_position_error_m", "m", "",
            "a Monte Carlo member's final horizontal position error, nonlinear INS (0 in the nominal case)"),
+    Output("outage_horizontal_error_sigma_m", "m", "",
+           "1-sigma horizontal position error at the end of the worst GNSS outage (free-inertial: the whole "
+           "navigation is one, the final 1-sigma; 0 when aided without outages)"),
+    *(Output(f"member_outage_{k}_horizontal_error_{kind}_m", "m", "",
+             f"aided Monte Carlo: a member's horizontal error {what} outage {k} (0 without it or in the nominal "
+             "case)")
+      for k in range(1, OUTAGE_SLOTS + 1) for kind, what in (("end", "at the end of"), ("max", "largest in"))),
 )
+
+_MEMBER_OUTPUTS = tuple(output.name for output in OUTPUTS if output.name.startswith("member_"))
+"""The outputs of a Monte Carlo member (0 in the nominal case)."""
 
 _BUDGET_KEYS = tuple(p.name for p in PARAMETERS if p.name != "imu_rate")
 """The parameters the covariance analysis depends on."""
@@ -162,24 +204,44 @@ def budget_histories(budget: CovarianceBudget) -> Histories:
     return Histories(np.asarray(budget.time, dtype=float), channels, units)
 
 
-def _in_full(budget: CovarianceBudget, model: ErrorModel) -> tuple[dict, dict]:
-    """The first case's budget in full: histories and JSON-safe extras."""
+def _in_full(budget: CovarianceBudget, model: ErrorModel, aided: AidedBudget | None) -> tuple[dict, dict]:
+    """The first case's budget in full: histories and JSON-safe extras (with aiding, each outage's end)."""
     shares = budget.shares()
-    extras = {"budget": shares, "dominant_source": max(shares, key=lambda name: shares[name]),
-              "instrument": model.name}
+    extras: dict = {"budget": shares, "dominant_source": max(shares, key=lambda name: shares[name]),
+                    "instrument": model.name}
+    if aided is not None:
+        extras["outages"] = [{key: outage[key] for key in ("start_s", "duration_s", "horizontal_error_sigma_m",
+                                                           "shares")} for outage in aided.outages]
     return {BUDGET_HISTORIES: budget_histories(budget)}, extras
 
 
-EXTRA_UNITS = {"budget": "1", **{name: "1" for name in SOURCES}}
+EXTRA_UNITS = {"budget": "1", **{name: "1" for name in SOURCES + GNSS_SOURCES}, "outages": "1", "start_s": "s",
+               "duration_s": "s", "horizontal_error_sigma_m": "m", "shares": "1"}
 """Units of the extras (the budget's keys are source names whose values are shares; the map is flat by key)."""
+
+
+def _budgets(setups: list[MissionSetup]) -> list[tuple[CovarianceBudget, AidedBudget | None]]:
+    """Each mission's budget: the free-inertial ones batched, the aided ones through their filter one by one."""
+    free = [setup for setup in setups if setup.aiding is None]
+    batched = iter(covariance_budgets(free))
+    out: list[tuple[CovarianceBudget, AidedBudget | None]] = []
+    for setup in setups:
+        if setup.aiding is None:
+            out.append((next(batched), None))
+        else:
+            aided = aided_budget(setup)
+            out.append((aided.budget, aided))
+    return out
 
 
 def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:
     """Every output of :data:`OUTPUTS` for a batch of cases (SI arrays of length ``len(cases)``).
 
-    The covariance analysis runs once per distinct case, and the distinct cases of one duration, output step
-    and vertical channel in one batch (:func:`~schuler.mission.covariance.covariance_budgets`), so that a
-    Monte Carlo whose members draw their cases costs the same per member however many there are.
+    The covariance analysis runs once per distinct case, and the distinct free-inertial cases of one duration,
+    output step and vertical channel in one batch (:func:`~schuler.mission.covariance.covariance_budgets`), so
+    that a Monte Carlo whose members draw their cases costs the same per member however many there are. An aided
+    case (``aiding`` set) runs :func:`~schuler.mission.aiding.aided_budget`, and its Monte Carlo members
+    ``schuler aided``'s filter (:mod:`schuler.mission.aided_monte_carlo`).
 
     Parameters
     ----------
@@ -190,13 +252,15 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
         Also the first case in full (an :class:`~schuler.contract.Evaluation`): the budget's histories
         ``mission_budget`` (:func:`budget_histories`: sigmas in m, m/s, rad, variances in m^2 over ``t_s``),
         ``budget`` (each source's share of the final horizontal position variance, summing to 1),
-        ``dominant_source`` and ``instrument`` (the IMU's name).
+        ``dominant_source``, ``instrument`` (the IMU's name) and, aided, ``outages`` (per outage ``start_s``,
+        ``duration_s`` in s, ``horizontal_error_sigma_m`` in m at its end and ``shares``, each source's fraction
+        of that variance).
 
     Returns
     -------
     dict of str to ndarray, or Evaluation
         Output name -> values of shape (number of cases,), SI (``member_position_error_m`` 0 without random
-        streams).
+        streams, as are the ``member_outage_*`` outputs).
 
     Examples
     --------
@@ -207,7 +271,8 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
     """
     n = len(cases)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
-    out["member_position_error_m"] = np.zeros(n)
+    for name in _MEMBER_OUTPUTS:
+        out[name] = np.zeros(n)
     models: dict[str, ErrorModel] = {}
     first: tuple[dict, dict] = ({}, {})
     for shape_index, shape_group in cases.groups(*_SHAPE_KEYS):
@@ -218,38 +283,60 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
             if values["imu"] not in models:
                 models[values["imu"]] = error_model(values["imu"])
             setups.append(mission_setup(values, model=models[values["imu"]]))
-        for (index, group), setup, budget in zip(distinct, setups, covariance_budgets(setups)):
+        for (index, group), setup, (budget, aided) in zip(distinct, setups, _budgets(setups)):
             rows = shape_index[index]
-            for name, value in budget_outputs(budget).items():
+            summary = budget_outputs(budget)
+            for name, value in summary.items():
                 out[name][rows] = value
+            out["outage_horizontal_error_sigma_m"][rows] = summary["position_error_sigma_m"] if aided is None \
+                else max((o["horizontal_error_sigma_m"] for o in aided.outages), default=0.0)
             if histories and rows[0] == 0:
-                first = _in_full(budget, setup.error_model)
+                first = _in_full(budget, setup.error_model, aided)
             if cases.random is not None:
                 for rate_index, members in group.groups("imu_rate"):
                     rate = float(members.float("imu_rate")[0])
-                    result = run_members(setup, members.members, cases.random, rate, output_step=setup.duration)
-                    out["member_position_error_m"][rows[rate_index]] = final_horizontal_errors(result)
+                    target = rows[rate_index]
+                    if aided is not None and setup.aiding is not None:
+                        run, errors = aided_members(setup, members.members, cases.random, rate, aided.start_sigma)
+                        for name, drifts in member_outputs(run, errors, setup.aiding.outages).items():
+                            out[name][target] = drifts
+                    else:
+                        result = run_members(setup, members.members, cases.random, rate, output_step=setup.duration)
+                        out["member_position_error_m"][target] = final_horizontal_errors(result)
     if not histories:
         return out
     return Evaluation(out, histories=first[0], extras=first[1], units=EXTRA_UNITS)
 
 
+AIDED_STEP_BYTES = 2 * 8 * (21 * 21 + 12)
+"""Bytes an aided member holds per covariance step: the filter's stored covariance and sensor estimates, twice
+(the list of steps and its stacked copy)."""
+
+
 def member_bytes(case: Case) -> int:
     """Memory one Monte Carlo member holds: its outputs and a block of noise and truth, bytes.
+
+    Free-inertial, the estimate assumes two output points per member (the Monte Carlo keeps only the start and
+    the end) and a block of 4096 IMU intervals, whatever the duration and rate. Aided, the filter stores its
+    covariance at every covariance step and fix (:data:`AIDED_STEP_BYTES` each) and the member's increments
+    (6 doubles per IMU interval).
 
     Parameters
     ----------
     case : Case
-        The member's parameters, SI. Not used: the estimate assumes two output points per member (the Monte
-        Carlo keeps only the start and the end) and a block of 4096 IMU intervals, whatever the duration and
-        rate, so it is the same for every case.
+        The member's parameters, SI (``aiding``; ``duration`` and ``covariance_interval`` in s, ``imu_rate`` and
+        ``gnss_rate`` in Hz).
 
     Returns
     -------
     int
         Memory, bytes.
     """
-    return int(estimate_memory(1, 2, 4096, True)) + 64 * 1024
+    fixed = int(estimate_memory(1, 2, 4096, True)) + 64 * 1024
+    if case["aiding"] is None:
+        return fixed
+    events = case["duration"] * (1.0 / case["covariance_interval"] + case["gnss_rate"])
+    return fixed + int(AIDED_STEP_BYTES * events + 6 * 8 * case["duration"] * case["imu_rate"])
 
 
 __all__ = ["OUTPUTS", "PARAMETERS", "budget_histories", "budget_outputs", "evaluate",

@@ -225,6 +225,27 @@ def run_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate: 
     start_quaternion = trajectory.kinematics(np.array([0.0]))[1][0]
     n = 9 if setup.vertical_channel == "free" else 7
     draws, x0 = member_draws(setup, members, streams, n, dcm_from_quaternion(start_quaternion))
+    return navigate(trajectory, setup.duration, imu_rate=imu_rate, output_step=output_step or setup.output_step,
+                    mode="strapdown", vertical_channel=setup.vertical_channel,
+                    initial_errors=initial_errors(x0, setup, start_quaternion), sensor_errors=sensor_errors(draws),
+                    noise=white_noise(setup, streams), member_ids=members,
+                    earth_rate=EARTH_RATE)
+
+
+def sensor_errors(draws: np.ndarray) -> ConstantSensorErrors:
+    """The members' constant sensor errors from their draws of the constant sources.
+
+    Parameters
+    ----------
+    draws : ndarray
+        Drawn values of :data:`~schuler.mission.setup.CONSTANT_SOURCES`, shape (N, n_sources), SI (rad/s, m/s^2,
+        plain-number scale factors).
+
+    Returns
+    -------
+    ConstantSensorErrors
+        Biases and scale factors per member, body axes; scale factors clipped to +/- :data:`SCALE_FACTOR_LIMIT`.
+    """
     column = {name: i for i, name in enumerate(CONSTANT_SOURCES)}
 
     def triad(family: str) -> np.ndarray:
@@ -234,16 +255,28 @@ def run_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate: 
             values = np.clip(values, -SCALE_FACTOR_LIMIT, SCALE_FACTOR_LIMIT)
         return values
 
-    sensors = ConstantSensorErrors(gyro_bias=triad("gyro_bias"), accel_bias=triad("accel_bias"),
-                           gyro_scale_factor=triad("gyro_scale_factor"),
-                           accel_scale_factor=triad("accel_scale_factor"))
+    return ConstantSensorErrors(gyro_bias=triad("gyro_bias"), accel_bias=triad("accel_bias"),
+                                gyro_scale_factor=triad("gyro_scale_factor"),
+                                accel_scale_factor=triad("accel_scale_factor"))
+
+
+def white_noise(setup: MissionSetup, streams: RandomStreams) -> BlockWhiteNoise | None:
+    """The members' angle and velocity random walks (None when the instrument has none).
+
+    Parameters
+    ----------
+    setup : MissionSetup
+        The mission: N per body axis, rad/sqrt(s) and m/s/sqrt(s).
+    streams : RandomStreams
+        The Monte Carlo's addressed random streams (their seed keys the noise).
+
+    Returns
+    -------
+    BlockWhiteNoise or None
+        The noise, addressed by (seed, sensor, member, block).
+    """
     noisy = np.any(setup.gyro_random_walk) or np.any(setup.accel_random_walk)
-    noise = BlockWhiteNoise(setup.gyro_random_walk, setup.accel_random_walk, streams.seed) if noisy else None
-    return navigate(trajectory, setup.duration, imu_rate=imu_rate, output_step=output_step or setup.output_step,
-                    mode="strapdown", vertical_channel=setup.vertical_channel,
-                    initial_errors=initial_errors(x0, setup, start_quaternion), sensor_errors=sensors,
-                    noise=noise, member_ids=members,
-                    earth_rate=EARTH_RATE)
+    return BlockWhiteNoise(setup.gyro_random_walk, setup.accel_random_walk, streams.seed) if noisy else None
 
 
 def final_horizontal_errors(result: NavigationResult) -> np.ndarray:

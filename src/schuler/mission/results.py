@@ -34,13 +34,46 @@ class MissionResult(SystemResult):
       is the nominal one;
     * ``nominal_covariance_position_error_sigma_m``: the covariance at the
       nominal case (the top-level ``position_error_sigma_m``).
+
+    With aiding, ``outages`` lists each outage's ``start_s``, ``duration_s``,
+    ``horizontal_error_sigma_m`` (covariance, at its end) and ``shares``, and
+    ``monte_carlo.outages`` the members' ``horizontal_error_end_rms_m`` (RMS of
+    their horizontal errors at its end) and ``horizontal_error_max_rms_m`` (RMS
+    of each member's largest inside it) beside that 1-sigma, for the first
+    :data:`~schuler.mission.aided_monte_carlo.OUTAGE_SLOTS` outages.
     """
 
     def to_dict(self) -> dict[str, Any]:
         data = super().to_dict()
         if self.monte_carlo is not None and isinstance(data.get("monte_carlo"), dict):
             data["monte_carlo"].update(self.comparison())
+            if self.extras.get("outages"):
+                data["monte_carlo"]["outages"] = self.outage_comparison()
         return data
+
+    def outage_comparison(self) -> list[dict[str, float | None]]:
+        """Per outage: the members' RMS horizontal errors at its end and of their largest in it, m.
+
+        Returns
+        -------
+        list of dict
+            ``start_s``, ``duration_s`` (s), ``horizontal_error_end_rms_m``, ``horizontal_error_max_rms_m`` (the
+            Monte Carlo's, None where no member has a value) and ``horizontal_error_sigma_m`` (the covariance's),
+            m; empty without a Monte Carlo or outages.
+        """
+        if self.monte_carlo is None:
+            return []
+        statistics = self.monte_carlo.statistics
+        out = []
+        for k, outage in enumerate(self.extras.get("outages", ()), start=1):
+            names = {kind: f"member_outage_{k}_horizontal_error_{kind}_m" for kind in ("end", "max")}
+            if names["end"] not in statistics:
+                break
+            out.append({"start_s": outage["start_s"], "duration_s": outage["duration_s"],
+                        "horizontal_error_end_rms_m": statistics[names["end"]].rms,
+                        "horizontal_error_max_rms_m": statistics[names["max"]].rms,
+                        "horizontal_error_sigma_m": outage["horizontal_error_sigma_m"]})
+        return out
 
     def comparison(self) -> dict[str, float]:
         """The covariance beside the Monte Carlo over the same members, m (empty without a Monte Carlo).
@@ -105,5 +138,28 @@ class MissionResult(SystemResult):
         for name, share in sorted(self.budget.items(), key=lambda item: -item[1]):
             if share >= 1e-4:
                 shares.add_row(name, f"{100 * share:.2f} %")
-        return Group(table, shares)
+        if not self.extras.get("outages"):
+            return Group(table, shares)
+        return Group(table, shares, self._outage_table())
+
+    def _outage_table(self):
+        from rich.table import Table
+
+        compared = {(o["start_s"], o["duration_s"]): o for o in self.outage_comparison()}
+        table = Table(title="GNSS outages: horizontal position error at the end", show_header=True)
+        for name in ("start", "duration", "1-sigma (covariance)", "largest shares"):
+            table.add_column(name, justify="left" if name == "largest shares" else "right")
+        if compared:
+            table.add_column("Monte Carlo RMS: end, largest", justify="right")
+        for outage in self.extras["outages"]:
+            top = sorted(outage["shares"].items(), key=lambda item: -item[1])[:3]
+            row = [f"{outage['start_s']:g} s", f"{outage['duration_s']:g} s",
+                   f"{outage['horizontal_error_sigma_m']:,.4g} m",
+                   ", ".join(f"{name} {100 * share:.1f} %" for name, share in top)]
+            if compared:
+                mc = compared.get((outage["start_s"], outage["duration_s"]))
+                row.append("" if mc is None or mc["horizontal_error_end_rms_m"] is None else
+                           f"{mc['horizontal_error_end_rms_m']:,.4g} m, {mc['horizontal_error_max_rms_m']:,.4g} m")
+            table.add_row(*row)
+        return table
 

@@ -42,6 +42,12 @@ Sources of error (independent, each one name in the budget): ``gyro_bias_x|y|z``
 noises ``gyro_random_walk``, ``accel_random_walk`` (angle / velocity random walk,
 acting during alignment and during navigation). Misalignments, g-sensitivity
 and quantization are left out of this study.
+
+4. **Aiding** (optional, ``aiding`` set): GNSS position, or position and
+   velocity, at ``gnss_rate`` through scheduled outages, with the keys and
+   names of ``schuler aided`` (:class:`Aiding`; the analysis in
+   :mod:`schuler.mission.aiding`). Its noise adds the sources
+   ``gnss_position_noise`` and ``gnss_velocity_noise``.
 """
 
 from __future__ import annotations
@@ -53,6 +59,7 @@ from pathlib import Path
 
 import numpy as np
 
+from schuler.aided.evaluation import SIMULATED_SIGMA, SIMULATED_VELOCITY_SIGMA, aiding_of, lever_arm, outages_of
 from schuler.core.earth import STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
 from schuler.imu.error_model import ErrorModel
@@ -81,10 +88,83 @@ WHITE_SOURCES = ("gyro_random_walk", "accel_random_walk")
 SOURCES = CONSTANT_SOURCES + WHITE_SOURCES
 """Every source of the budget."""
 
+GNSS_SOURCES = ("gnss_position_noise", "gnss_velocity_noise")
+"""White measurement-noise sources of an aided mission (GNSS position, GNSS velocity)."""
+
 FLIGHT_ACCELERATION_TIME = 300.0
 """Take-off run of the ``flight`` profile: 0 to cruise speed, s."""
 FLIGHT_TURN_TIME = 120.0
 """Duration of each turn of the ``flight`` profile, s."""
+
+
+@dataclass(frozen=True)
+class Aiding:
+    """The aiding of a mission: GNSS fixes through outages, as ``schuler aided`` simulates them (SI).
+
+    Parameters
+    ----------
+    use_velocity : bool
+        Whether GNSS velocities are used besides the positions.
+    gnss_rate : float
+        Epoch rate, Hz (epochs at j / rate, s).
+    position_sigma : tuple of float
+        1-sigma of a fix, north, east, down, m.
+    velocity_sigma : float
+        1-sigma of a GNSS velocity, each axis, m/s.
+    lever_arm : tuple of float
+        IMU to antenna, body axes, m.
+    outages : tuple of (float, float)
+        (start, duration) of each outage, s from the start of navigation.
+    covariance_interval : float
+        Step of the filter's covariance propagation, s.
+    """
+
+    use_velocity: bool
+    gnss_rate: float
+    position_sigma: tuple[float, float, float]
+    velocity_sigma: float
+    lever_arm: tuple[float, float, float]
+    outages: tuple[tuple[float, float], ...]
+    covariance_interval: float
+
+    @property
+    def sources(self) -> tuple[str, ...]:
+        """The measurement-noise sources this aiding adds to the budget."""
+        return GNSS_SOURCES if self.use_velocity else GNSS_SOURCES[:1]
+
+
+def aiding_setup(values) -> Aiding | None:
+    """The :class:`Aiding` of a case's SI values, or None when ``aiding`` is not set (free-inertial).
+
+    The defaults are ``schuler aided``'s: GNSS 1-sigma
+    :data:`~schuler.aided.evaluation.SIMULATED_SIGMA` and
+    :data:`~schuler.aided.evaluation.SIMULATED_VELOCITY_SIGMA`, the first outage at
+    :data:`~schuler.aided.evaluation.SIMULATED_OUTAGE_START`, the lever arm zero.
+
+    Parameters
+    ----------
+    values : Mapping of str to object
+        ``aiding`` (comma-separated names of :data:`~schuler.aided.evaluation.AIDING`, or None), ``gnss_rate``
+        (Hz), ``gnss_sigma_north|east|down`` (m or None), ``gnss_velocity_sigma`` (m/s or None),
+        ``lever_arm_x|y|z`` (m or None), ``outage_start``, ``outage_duration``, ``outage_every``, ``duration`` and
+        ``covariance_interval`` (s).
+
+    Returns
+    -------
+    Aiding or None
+        The aiding, SI.
+    """
+    if values["aiding"] is None:
+        return None
+    _, use_velocity = aiding_of(values["aiding"])
+    sigma = tuple(float(fallback if values[name] is None else values[name]) for name, fallback in
+                  zip(("gnss_sigma_north", "gnss_sigma_east", "gnss_sigma_down"), SIMULATED_SIGMA))
+    velocity_sigma = SIMULATED_VELOCITY_SIGMA if values["gnss_velocity_sigma"] is None \
+        else float(values["gnss_velocity_sigma"])
+    return Aiding(use_velocity=use_velocity, gnss_rate=float(values["gnss_rate"]),
+                  position_sigma=sigma,  # type: ignore[arg-type]
+                  velocity_sigma=velocity_sigma, lever_arm=lever_arm(values), outages=outages_of(values),
+                  covariance_interval=float(values["covariance_interval"]))
 
 
 @dataclass(frozen=True)
@@ -114,6 +194,7 @@ class MissionSetup:
     output_step: float
     initial_position_error: float
     profile: WaypointProfile | None = None
+    aiding: Aiding | None = None
 
     @property
     def gravity(self) -> float:
@@ -254,7 +335,8 @@ def mission_setup(values, model: ErrorModel | None = None) -> MissionSetup:
     values : Mapping of str to object
         Every parameter of :data:`~schuler.mission.evaluation.PARAMETERS` by name, SI (latitude, longitude,
         heading in rad; height in m; durations and steps in s; speed in m/s; ``pulse_relative_error`` a plain
-        ratio; ``north_reference_error`` in rad; ``initial_position_error`` in m), choices and paths as text.
+        ratio; ``north_reference_error`` in rad; ``initial_position_error`` in m; the aiding's as
+        :func:`aiding_setup` reads them), choices and paths as text.
     model : ErrorModel, optional
         The instrument's error model when the caller has resolved it already (a batch of cases of one
         instrument); not given: resolved from ``imu``.
@@ -284,7 +366,7 @@ def mission_setup(values, model: ErrorModel | None = None) -> MissionSetup:
         duration=float(values["duration"]), speed=float(values["speed"]),
         vertical_channel=str(values["vertical_channel"]), output_step=float(values["output_step"]),
         initial_position_error=float(values["initial_position_error"]), trajectory_kind=kind, profile=profile,
-        **start,
+        aiding=aiding_setup(values), **start,
     )
 
 
