@@ -319,3 +319,23 @@ def test_a_run_on_files_is_smoothed_against_its_reference_and_without_one(tmp_pa
     assert outage["horizontal_error_sigma_m"] == pytest.approx(smoothed["horizontal_error_sigma_m"], rel=1e-12)
     assert "smoothed_north_sigma_m" in alone.histories["aided_errors"] \
         and "smoothed_north_error_m" not in alone.histories["aided_errors"]
+
+
+def test_the_aiding_states_are_smoothed_and_end_where_the_filter_ends():
+    """With the odometer-scale and barometer-bias states (23 states) the smoother carries them too: at the last
+    stored time the smoothed estimates are the filter's, and earlier they move toward the truth."""
+    from schuler.aided.evaluation import _simulated_group
+    from schuler.core.random import RandomStreams
+    from schuler.registry import get_system
+
+    case = get_system("aided").case(duration=400.0, outage_start=250.0,
+                                    aiding="gnss-position,gnss-velocity,nhc,odometer,baro",
+                                    odometer_scale_state=True, baro_bias_state=True)
+    forward, _, _, (smoothed, _) = _simulated_group(case, np.arange(1), RandomStreams(4), smooth=True)
+    assert forward.n_states == 23 and smoothed.aiding_estimates.shape[-1] == 2
+    np.testing.assert_allclose(smoothed.aiding_estimates[0, -1], forward.aiding_estimates[0, -1], rtol=1e-9,
+                               atol=1e-12)
+    np.testing.assert_allclose(smoothed.sensor_estimates[0, -1], forward.sensor_estimates[0, -1], rtol=1e-9,
+                               atol=1e-15)
+    # the start: the smoother has seen the whole drive, the filter nothing yet
+    assert not np.allclose(smoothed.aiding_estimates[0, 0], forward.aiding_estimates[0, 0])

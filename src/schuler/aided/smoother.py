@@ -213,7 +213,13 @@ def smooth(run: FilterRun) -> FilterRun:
     # before the update at the following time: x^s + c there, relative to the solution the outputs carry
     ahead = errors[:, following, nav] + run.correction[:, following, nav]
     at_outputs = (1.0 - fraction)[:, None] * errors[:, previous, nav] + fraction[:, None] * ahead
+    # the sensor states, then the aiding states (odometer scale, barometer bias) after them
+    aiding = run.aiding_estimates
+    sensor_end = n - (0 if aiding is None else aiding.shape[-1])
     sensors = run.sensor_estimates.copy()
-    sensors[..., :n - NAVIGATION_STATES] += errors[..., NAVIGATION_STATES:]
+    sensors[..., :sensor_end - NAVIGATION_STATES] += errors[..., NAVIGATION_STATES:sensor_end]
+    if aiding is not None and aiding.shape[-1]:
+        aiding = aiding + errors[..., sensor_end:]
     return dataclasses.replace(run, solution=corrected(run.solution, at_outputs), covariance=covariance,
-                               sensor_estimates=sensors, prior_covariance=None, transition=None, correction=None)
+                               sensor_estimates=sensors, aiding_estimates=aiding, prior_covariance=None,
+                               transition=None, correction=None)
