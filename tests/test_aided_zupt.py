@@ -1,6 +1,7 @@
 """Zero-velocity and zero-rate updates: H against h, the stop detector on the drive, a consumer IMU at a stop."""
 
 import numpy as np
+import pytest
 
 from aided_measurement_helpers import assert_first_order, model, truth
 from schuler.aided import measurements, sources
@@ -102,3 +103,21 @@ def test_zupt_keeps_a_consumer_imus_drift_bounded_at_a_stop():
     assert free.min() > 300.0
     assert bounded.max() < 0.01
     assert run.rejected_by_source()["zupt"].sum() == 0
+
+
+@pytest.mark.slow
+def test_stops_given_one_by_one_equal_the_drives_own_and_a_false_one_is_refused_by_the_gate(run_cli):
+    from schuler.registry import get_system
+
+    aided = get_system("aided")
+    common = dict(duration=400.0, outage_start=250.0, aiding="gnss-position,gnss-velocity,zupt,zaru", seed=5)
+    own = drive(latitude=aided.case().get("latitude"), duration=400.0).stationary_intervals()
+    listed = aided.run(stop_intervals=[[start, end - start] for start, end in own], **common)
+    given = aided.run(**common)
+    assert listed.outages == given.outages
+    assert listed.rejected_by_source == given.rejected_by_source
+    # a "stop" at road speed: every zero-velocity update there (10 Hz, 5 s) fails the gate
+    moving = aided.run(stop_intervals=[[195.0, 5.0]], **common)  # at 20 m/s
+    assert moving.rejected_by_source["zupt"] == 50
+    out = run_cli("aided", "run", "--stop-intervals", "0:20", "--stops", "detected")
+    assert out.code == 2 and "cannot be combined" in out.stderr

@@ -3,8 +3,8 @@
 ``--aiding`` names, beside ``gnss-position`` and ``gnss-velocity``:
 
 * ``zupt`` and ``zaru``: zero velocity and zero angular rate at ``zupt_rate`` during the stops, the
-  drive's own stationary intervals (``stops given``) or those found in each member's IMU data
-  (``stops detected``: :func:`schuler.aided.sources.detect_stops`, window
+  drive's own stationary intervals (``stops given``), those of ``stop_intervals``, or those found in each
+  member's IMU data (``stops detected``: :func:`schuler.aided.sources.detect_stops`, window
   :data:`~schuler.aided.sources.STOP_WINDOW_S`, threshold :data:`~schuler.aided.sources.STOP_THRESHOLD`;
   on the drive's vibration-free cruises it also marks the cruises, whose false updates the gate must refuse);
 * ``nhc``: the wheel point's lateral and vertical velocities zero, at the odometer's epochs;
@@ -34,7 +34,7 @@ from schuler.aided.epochs import (
 from schuler.aided.error_state import ErrorProcess, FilterModel
 from schuler.aided.measurements import mounting_matrix
 from schuler.exceptions import InvalidParameter
-from schuler.params import Case, Parameter
+from schuler.params import Case, IntervalsParameter, Parameter
 
 NAMES = ("zupt", "zaru", "nhc", "odometer", "baro")
 """The measurements besides GNSS ``aiding`` may name."""
@@ -51,6 +51,8 @@ BAROMETER_BIAS_SIGMA_M = 10.0
 PARAMETERS = (
     Parameter("stops", "", "given", "Stops for zupt and zaru: the drive's own (given) or found in the IMU data by a "
               "moving-variance test (detected).", kind="choice", choices=("given", "detected")),
+    IntervalsParameter("stop_intervals", "s", None, "Stops for zupt and zaru given one by one, start:duration pairs "
+                       "(0:25,300:20), in place of --stops."),
     Parameter("zupt_rate", "Hz", 10.0, "Rate of the zero-velocity and zero-rate updates during a stop.",
               minimum=0.01, maximum=100.0),
     Parameter("zupt_sigma", "m/s", 0.01, "1-sigma of the velocity at a stop.", minimum=0.0, exclusive_minimum=True,
@@ -142,7 +144,9 @@ def simulated_sources(case: Case, path, increments: np.ndarray, interval: float,
     duration, imu_rate = case["duration"], case["imu_rate"]
     built: list[sources.Source] = []
     if "zupt" in names or "zaru" in names:
-        if case["stops"] == "given":
+        if case["stop_intervals"] is not None:
+            stops = [(start, start + length) for start, length in case["stop_intervals"]]
+        elif case["stops"] == "given":
             stops = path.stationary_intervals()
         else:
             if increments.shape[0] > 1 and not np.array_equal(increments[0], increments[-1]):

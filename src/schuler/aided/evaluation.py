@@ -141,7 +141,7 @@ PARAMETERS = ParameterSet((
               kind="flag"),
     *initialisation.PARAMETERS,
 ), owner="aided", exclusive=(("outages", "outage_start"), ("outages", "outage_duration"),
-                               ("outages", "outage_every")))
+                               ("outages", "outage_every"), ("stop_intervals", "stops")))
 
 OUTPUTS = (
     Output("position_error_horizontal_rms_m", "m", "", "RMS of the horizontal position error"),
