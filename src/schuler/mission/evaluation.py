@@ -108,9 +108,10 @@ PARAMETERS = ParameterSet((
     *(dataclasses.replace(AIDED_PARAMETERS[name], help=_AIDED_HELP.get(name, AIDED_PARAMETERS[name].help))
       for name in ("gnss_rate", "gnss_sigma_north", "gnss_sigma_east", "gnss_sigma_down", "gnss_velocity_sigma",
                    "lever_arm_x", "lever_arm_y", "lever_arm_z", "outage_start", "outage_duration", "outage_every",
-                   "covariance_interval")),
-), owner="mission", exclusive=tuple(("profile", name) for name in ("trajectory", "latitude", "longitude", "height",
-                                                                   "heading", "speed")),
+                   "outages", "covariance_interval")),
+), owner="mission", exclusive=(*(("profile", name) for name in ("trajectory", "latitude", "longitude", "height",
+                                                                "heading", "speed")),
+                               *(("outages", name) for name in ("outage_start", "outage_duration", "outage_every"))),
    renamed={"grade": "imu", "imu_spec": "imu", "instrument": "imu"})
 """Every option of ``schuler mission run`` (and key of a ``mission`` scenario)."""
 
