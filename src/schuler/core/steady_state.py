@@ -157,8 +157,9 @@ def loop_error_covariance(A, K, C, Q, R) -> np.ndarray:
     K = np.atleast_2d(np.asarray(K, dtype=float)).reshape(A.shape[0], C.shape[0])
     closed = A - K @ C
     poles = np.linalg.eigvals(closed)
-    # a pole within rounding of the axis is no steady state either: its Lyapunov solution is rounding noise
-    if np.max(poles.real) >= -1e-12 * max(float(np.max(np.abs(poles))), 1e-300):
+    # a pole within the eigenvalues' rounding (a few eps ||A - K C||) of the axis is no steady state either: its
+    # Lyapunov solution is rounding noise; a slow pole beside fast ones (12 decades apart in a Kalman loop) is one
+    if np.max(poles.real) >= -16.0 * np.finfo(float).eps * max(float(np.linalg.norm(closed, 1)), 1e-300):
         raise InvalidParameter("gain", "the loop A - K C is not stable (or within rounding of it): it has no "
                                        "steady error")
     P = scipy.linalg.solve_continuous_lyapunov(closed, -(Q + K @ R @ K.T))

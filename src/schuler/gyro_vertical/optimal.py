@@ -284,7 +284,7 @@ def level_period_damping(tilt_gain: float, velocity_gain: float, gravity: float,
     Examples
     --------
     >>> round(level_period_damping(0.0, 0.0, 9.81, 6.4e6)[0] / 60, 2)   # the seed: Schuler's period, undamped
-    84.64
+    84.58
     """
     stiffness = gravity * (1.0 / radius - tilt_gain)
     if not stiffness > 0:
