@@ -80,3 +80,16 @@ def test_the_text_form_reads_back_what_the_list_says(pairs):
     assert parameter.parse(text) == from_list
     assert [start for start, _ in from_list] == sorted(60.0 * start for start, _ in pairs)
     assert parameter.check(from_list) == from_list
+
+
+def test_a_list_is_one_value_beside_arrays_of_cases():
+    """``evaluate_values``: the list of outages is shared by every case of a batch, not a batch of its own."""
+    outages = [[100, 30], [300, 30]]
+    batch = AIDED.evaluate_values({"outages": outages, "gnss_rate": [1.0, 2.0], "duration": 500.0,
+                                   "nominal": True})
+    for k, rate in enumerate((1.0, 2.0)):
+        single = AIDED.run(outages=outages, gnss_rate=rate, duration=500.0, nominal=True)
+        assert batch["position_error_horizontal_rms_m"][k] == pytest.approx(single.position_error_horizontal_rms_m,
+                                                                            rel=1e-12)
+    with pytest.raises(InvalidParameter, match="different lengths"):
+        AIDED.evaluate_values({"gnss_rate": [1.0, 2.0], "gnss_latency": [0.0, 0.1, 0.2], "duration": 500.0})

@@ -426,7 +426,9 @@ class System:
             One of :attr:`fidelities`.
         """
         given = self.checked_arrays(values)
-        lengths = {array.size for name, array in given.items() if np.ndim(values[name]) > 0}
+        # a list of intervals is one value, not a batch of cases
+        lengths = {array.size for name, array in given.items()
+                   if np.ndim(values[name]) > 0 and not getattr(self.parameters[name], "pairs", False)}
         if len(lengths) > 1:
             raise InvalidParameter("cases", f"parameter arrays have different lengths: {sorted(lengths)}")
         n = lengths.pop() if lengths else 1
