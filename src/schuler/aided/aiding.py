@@ -1,4 +1,4 @@
-"""The aiding besides GNSS of a simulated ``schuler aided run``: its parameters, its data and its sources.
+"""The aiding besides GNSS of ``schuler aided run``: its parameters, its data and its sources.
 
 ``--aiding`` names, beside ``gnss-position`` and ``gnss-velocity``:
 
@@ -16,6 +16,10 @@
 
 The drive's IMU is aligned with the vehicle: mounting angles set here are those the filter assumes, a
 mounting error on the simulated drive.
+
+On files (:func:`file_sources`) ``zupt``, ``zaru`` and ``nhc`` need no data of their own: the stops are given
+(``stop_intervals``, times as in the data) or detected in the record, the constraint holds at ``odometer_rate``
+over the record's span; ``odometer`` and ``baro`` need data the files do not carry.
 """
 
 from __future__ import annotations
@@ -52,7 +56,7 @@ PARAMETERS = (
     Parameter("stops", "", "given", "Stops for zupt and zaru: the drive's own (given) or found in the IMU data by a "
               "moving-variance test (detected).", kind="choice", choices=("given", "detected")),
     IntervalsParameter("stop_intervals", "s", None, "Stops for zupt and zaru given one by one, start:duration pairs "
-                       "(0:25,300:20), in place of --stops."),
+                       "(0:25,300:20; on files, times as in the data), in place of --stops."),
     Parameter("zupt_rate", "Hz", 10.0, "Rate of the zero-velocity and zero-rate updates during a stop.",
               minimum=0.01, maximum=100.0),
     Parameter("zupt_sigma", "m/s", 0.01, "1-sigma of the velocity at a stop.", minimum=0.0, exclusive_minimum=True,
@@ -142,24 +146,7 @@ def simulated_sources(case: Case, path, increments: np.ndarray, interval: float,
     """
     names = named(case["aiding"])
     duration, imu_rate = case["duration"], case["imu_rate"]
-    built: list[sources.Source] = []
-    if "zupt" in names or "zaru" in names:
-        if case["stop_intervals"] is not None:
-            stops = [(start, start + length) for start, length in case["stop_intervals"]]
-        elif case["stops"] == "given":
-            stops = path.stationary_intervals()
-        else:
-            if increments.shape[0] > 1 and not np.array_equal(increments[0], increments[-1]):
-                raise InvalidParameter("stops", "detected stops are one record's: run the members one by one or "
-                                                "give the drive's stops (--stops given)")
-            noise = math.sqrt(interval)
-            stops = sources.detect_stops(increments[0], interval, float(np.max(model.angle_random_walk)) / noise,
-                                         float(np.max(model.velocity_random_walk)) / noise)
-        times = sources.stop_epochs(stops, case["zupt_rate"])
-        if "zupt" in names:
-            built.append(sources.zero_velocity_source(times, case["zupt_sigma"], model))
-        if "zaru" in names:
-            built.append(sources.zero_rate_source(times, case["zaru_sigma"], model))
+    built = _stop_sources(case, names, increments, interval, model, 0.0, path.stationary_intervals)
     arm = (case["wheel_lever_arm_x"], case["wheel_lever_arm_y"], case["wheel_lever_arm_z"])
     if "odometer" in names or "nhc" in names:
         records = [simulate_odometer(path, duration, imu_rate=imu_rate, rate=case["odometer_rate"], lever_arm=arm,
@@ -175,4 +162,72 @@ def simulated_sources(case: Case, path, increments: np.ndarray, interval: float,
                                       sigma=case["baro_sigma"], streams=streams, member=int(m)) for m in members]
         built.append(sources.barometer_source(heights[0].t_s, np.stack([r.height_m for r in heights]),
                                               case["baro_sigma"], model))
+    return built
+
+
+def file_sources(case: Case, increments: np.ndarray, interval: float, t0: float, model: FilterModel
+                 ) -> list[sources.Source]:
+    """The sources besides GNSS of a case on files: stops and the non-holonomic constraint, which need no data.
+
+    ``zupt`` and ``zaru`` at the stops of ``stop_intervals`` (times as in the data) or found in the record
+    (``stops detected``); ``nhc`` at ``odometer_rate`` over the record's span. ``odometer`` and ``baro`` need
+    data the files do not carry and are refused, as is ``stops given`` (a record has no drive to take them from).
+
+    Parameters
+    ----------
+    case : Case
+        A validated case on files (SI).
+    increments : ndarray, shape (n, 6)
+        The record's IMU increments, rad and m/s.
+    interval : float
+        IMU interval, s.
+    t0 : float
+        Time of the record's first sample, s (as in the data).
+    model : FilterModel
+        The filter's model.
+    """
+    names = named(case["aiding"])
+    needing_data = [name for name in ("odometer", "baro") if name in names]
+    if needing_data:
+        raise InvalidParameter("aiding", f"{', '.join(needing_data)}: on a simulated drive only (the files hold IMU "
+                                         "and GNSS data); zupt, zaru and nhc work on files")
+
+    def refused():
+        raise InvalidParameter("stops", "a record has no drive to take its stops from: give them "
+                                        "(--stop-intervals, times as in the data) or find them (--stops detected)")
+
+    built = _stop_sources(case, names, increments[None], interval, model, t0, refused)
+    if "nhc" in names:
+        end = t0 + increments.shape[0] * interval
+        mounting = mounting_matrix(case["mounting_roll"], case["mounting_pitch"], case["mounting_heading"])
+        arm = (case["wheel_lever_arm_x"], case["wheel_lever_arm_y"], case["wheel_lever_arm_z"])
+        built.append(sources.vehicle_source(sources.stop_epochs([(t0, end)], case["odometer_rate"]), None, model,
+                                            lever_arm=arm, mounting=mounting, constraint_sigma=case["nhc_sigma"]))
+    return built
+
+
+def _stop_sources(case: Case, names, increments: np.ndarray, interval: float, model: FilterModel, t0: float,
+                  given) -> list[sources.Source]:
+    """ZUPT and ZARU sources at the case's stops (``given()`` supplies ``stops given``; detected ones are shifted
+    by t0, the record's start)."""
+    if "zupt" not in names and "zaru" not in names:
+        return []
+    if case["stop_intervals"] is not None:
+        stops = [(start, start + length) for start, length in case["stop_intervals"]]
+    elif case["stops"] == "given":
+        stops = given()
+    else:
+        if increments.shape[0] > 1 and not np.array_equal(increments[0], increments[-1]):
+            raise InvalidParameter("stops", "detected stops are one record's: run the members one by one or "
+                                            "give the drive's stops (--stops given)")
+        noise = math.sqrt(interval)
+        stops = [(t0 + start, t0 + end) for start, end in
+                 sources.detect_stops(increments[0], interval, float(np.max(model.angle_random_walk)) / noise,
+                                      float(np.max(model.velocity_random_walk)) / noise)]
+    times = sources.stop_epochs(stops, case["zupt_rate"])
+    built = []
+    if "zupt" in names:
+        built.append(sources.zero_velocity_source(times, case["zupt_sigma"], model))
+    if "zaru" in names:
+        built.append(sources.zero_rate_source(times, case["zaru_sigma"], model))
     return built

@@ -110,7 +110,7 @@ PARAMETERS = ParameterSet((
                        "a scenario writes [[400, 60], [1000, 90]]; none: no outage); replaces the three options "
                        "above."),
     Parameter("aiding", "", None, "Measurements used, comma-separated: " + ", ".join(AIDING) + " (not set: both "
-              "GNSS; with --kf-gins-config gnss-position, KF-GINS's model; the others on a simulated drive only).",
+              "GNSS; with --kf-gins-config gnss-position, KF-GINS's model; odometer and baro simulated only).",
               kind="text"),
     *more_aiding.PARAMETERS,
     Parameter("covariance_interval", "s", 1.0, "Covariance propagation step (a whole number of IMU intervals; on "
@@ -375,9 +375,6 @@ def _file_group(case: Case, members: np.ndarray, smooth: bool = False):
     kfgins_model = config is not None and case["imu"] is None
     _, use_velocity = aiding_of(case["aiding"], "gnss-position" if config is not None else
                                 "gnss-position,gnss-velocity")
-    if more_aiding.named(case["aiding"]):
-        raise InvalidParameter("aiding", f"{', '.join(more_aiding.named(case['aiding']))}: on a simulated drive only "
-                                         "(the files hold IMU and GNSS data)")
     if kfgins_model:
         assert config is not None
         model, initial, sigma = files.kfgins_model(config)
@@ -389,10 +386,11 @@ def _file_group(case: Case, members: np.ndarray, smooth: bool = False):
     lever = files.lever_arm_of(case, config)
     start = _initialisation(case, inputs.increments, dt, inputs.gnss, lambda: files.start_of(inputs, START_SIGMA),
                             t0=inputs.t0_s, lever_arm=lever, imu=None if kfgins_model else resolve_model(_imu(case)))
+    extra = more_aiding.file_sources(case, np.asarray(inputs.increments), dt, inputs.t0_s, model)
     run = run_filter(np.asarray(inputs.increments)[..., start.first_sample:, :], dt, start.start, model, inputs.gnss,
                      t0=start.t0_s, lever_arm=lever, covariance_interval=steps * dt,
                      use_velocity=use_velocity, initial_sensor_errors=initial, initial_sensor_sigma=sigma,
-                     keep_for_smoother=smooth)
+                     sources=extra, keep_for_smoother=smooth)
     smoothed_run = smoother.smooth(run) if smooth else None
     if inputs.reference is None:
         return run, None, inputs.outages, run, None if smoothed_run is None else (smoothed_run, None)
