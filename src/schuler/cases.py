@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -220,12 +221,15 @@ def default_arrays(parameters: ParameterSet, n: int) -> dict[str, np.ndarray]:
 def monte_carlo(evaluate: Callable[..., Mapping[str, np.ndarray]], outputs: tuple[Output, ...], case: Case,
                 members: int, streams: RandomStreams, fidelity: str | None = None, *, chunk: int = MONTE_CARLO_CHUNK,
                 draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None,
-                progress: Callable[[int, int], None] | None = None) -> MonteCarloSummary:
+                progress: Callable[[int, int], None] | None = None, executor=None) -> MonteCarloSummary:
     """Statistics of every output over ``members`` random members of ``case``, streamed in chunks.
 
     Member ``i`` draws its random terms from ``streams`` at address ``i``, so the
-    statistics do not depend on ``chunk``. ``draw(member_numbers) -> {parameter:
-    values}`` optionally replaces parameters per member (a scenario's distributions).
+    statistics do not depend on ``chunk``, nor on where the chunks are evaluated:
+    with an ``executor`` they may finish in any order, and are summarised in the
+    members' order. ``draw(member_numbers) -> {parameter: values}`` optionally
+    replaces parameters per member (a scenario's distributions); it runs here,
+    the chunks' evaluation where the executor sends them.
 
     Parameters
     ----------
@@ -247,19 +251,25 @@ def monte_carlo(evaluate: Callable[..., Mapping[str, np.ndarray]], outputs: tupl
         ``draw(member_numbers) -> {parameter: values}``, SI values per member.
     progress : callable, optional
         ``progress(done, total)`` after each chunk, in members.
+    executor : optional
+        Where the chunks are evaluated: an object whose ``map(function, tasks)`` yields each task's result in any
+        order (:mod:`schuler.study.executors`; ``evaluate`` and the case must pickle for worker processes).
+        None: here, one chunk after another.
 
     """
     statistics = {output.name: StreamingStatistics((1,), reservoir_size=MONTE_CARLO_SAMPLES) for output in outputs}
     samples: dict[str, list[np.ndarray]] = {output.name: [] for output in outputs}
+    names = tuple(statistics)
+
+    def tasks():
+        for start in range(0, members, chunk):
+            numbers = np.arange(start, min(start + chunk, members), dtype=np.int64)
+            yield MonteCarloChunk(evaluate, case, numbers, streams, fidelity,
+                                  None if draw is None else dict(draw(numbers)), names)
+
+    finished = _in_order(run_chunk, tasks(), executor)
     kept = 0
-    for start in range(0, members, chunk):
-        numbers = np.arange(start, min(start + chunk, members), dtype=np.int64)
-        batch = Cases.from_case(case, numbers.size, members=numbers, random=streams, fidelity=fidelity)
-        if draw is not None:
-            drawn = {name: batch[name] for name in batch.names}
-            drawn.update(draw(numbers))
-            batch = Cases(drawn, members=numbers, random=streams, fidelity=fidelity)
-        results = evaluate(batch)
+    for numbers, results in finished:
         for name, stats in statistics.items():
             values = np.asarray(results[name], dtype=float)
             stats.update(values[np.isfinite(values)][:, None])
@@ -270,6 +280,70 @@ def monte_carlo(evaluate: Callable[..., Mapping[str, np.ndarray]], outputs: tupl
             progress(int(numbers[-1]) + 1, members)
     return MonteCarloSummary.from_statistics(members, streams.seed, outputs, statistics,
                                              {k: np.concatenate(v) if v else np.empty(0) for k, v in samples.items()})
+
+
+@dataclass(frozen=True)
+class MonteCarloChunk:
+    """Members of a Monte Carlo evaluated together: what a worker process receives (it pickles).
+
+    Attributes
+    ----------
+    evaluate : callable
+        The system's ``evaluate(cases)``.
+    case : Case
+        The nominal case, SI.
+    members : ndarray of int64
+        The chunk's member numbers (contiguous).
+    streams : RandomStreams
+        Where their random terms come from.
+    fidelity : str or None
+        The evaluation's fidelity.
+    drawn : dict of str to ndarray, or None
+        Parameters drawn per member (SI), replacing the case's.
+    outputs : tuple of str
+        The outputs returned.
+    """
+
+    evaluate: Callable[..., Mapping[str, np.ndarray]]
+    case: Case
+    members: np.ndarray
+    streams: RandomStreams
+    fidelity: str | None
+    drawn: dict[str, np.ndarray] | None
+    outputs: tuple[str, ...]
+
+
+def run_chunk(chunk: MonteCarloChunk) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The chunk's member numbers and its outputs, float arrays (one value per member).
+
+    Parameters
+    ----------
+    chunk : MonteCarloChunk
+        What to evaluate.
+    """
+    numbers = chunk.members
+    batch = Cases.from_case(chunk.case, numbers.size, members=numbers, random=chunk.streams, fidelity=chunk.fidelity)
+    if chunk.drawn is not None:
+        values = {name: batch[name] for name in batch.names}
+        values.update(chunk.drawn)
+        batch = Cases(values, members=numbers, random=chunk.streams, fidelity=chunk.fidelity)
+    results = chunk.evaluate(batch)
+    return numbers, {name: np.asarray(results[name], dtype=float) for name in chunk.outputs}
+
+
+def _in_order(function, tasks: Iterator[MonteCarloChunk], executor) -> Iterator:
+    """``function`` of each task, in the tasks' order, wherever the executor evaluates them (in any order)."""
+    if executor is None:
+        yield from map(function, tasks)
+        return
+    waiting: dict[int, Any] = {}
+    following = 0
+    for numbers, results in executor.map(function, tasks):
+        waiting[int(numbers[0])] = (numbers, results)
+        while following in waiting:
+            ready = waiting.pop(following)
+            following = int(ready[0][-1]) + 1
+            yield ready
 
 
 class MeasuredPace:

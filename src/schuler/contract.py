@@ -35,6 +35,7 @@ random term zero.
 from __future__ import annotations
 
 import difflib
+import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from functools import partial, wraps
@@ -276,7 +277,8 @@ class System:
 
     def run(self, *, monte_carlo: int = 0, seed: int = 0, fidelity: str | None = None,
             progress: Callable[[int, int], None] | None = None,
-            draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None, **si_values) -> Result:
+            draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None, executor=None,
+            **si_values) -> Result:
         """Run one case from SI values (every parameter not given takes its default).
 
         Parameters
@@ -294,6 +296,10 @@ class System:
         draw : callable, optional
             ``draw(member_numbers) -> {parameter: values}``: parameters drawn per
             member (a scenario's ``[monte_carlo]`` distributions).
+        executor : optional
+            Where the Monte Carlo's chunks are evaluated (:func:`schuler.study.executors.make_executor`, e.g.
+            ``make_executor(workers=2)``: two worker processes; close it when done); None: in this process. The
+            statistics are the same either way.
         **si_values
             Parameters in SI.
 
@@ -310,13 +316,14 @@ class System:
             raise InvalidParameter("monte_carlo", f"{self.name} has no random terms of its own: every member would be "
                                    "the nominal case; draw parameters with a scenario's [monte_carlo] tables")
         streams = RandomStreams(_count(seed, "seed"))
-        estimate = self.work_seconds(case, members)
+        estimate = self.work_seconds(case, members, workers=getattr(executor, "workers", 1))
         if estimate is not None:
             what = f"this {self.name} run" + (f" with {members} Monte Carlo members" if members else "")
             require_time(estimate, what, ("--monte-carlo, " if members else "") + self._work_options())
         summary = None
         if members:
-            summary = self.monte_carlo(case, members, streams, fidelity, draw=draw, progress=progress)
+            summary = self.monte_carlo(case, members, streams, fidelity, draw=draw, progress=progress,
+                                       executor=executor)
         return self.result(case, fidelity, streams if self.realisation else None, summary)
 
     def result(self, case: Case, fidelity: str | None = None, random: RandomStreams | None = None,
@@ -347,10 +354,11 @@ class System:
         result.attach_figures(self.figures)
         return result
 
-    def work_seconds(self, case: Case, members: int = 0) -> float | None:
+    def work_seconds(self, case: Case, members: int = 0, workers: int = 1) -> float | None:
         """Estimated time of :meth:`run` on ``case`` with ``members`` Monte Carlo members, s (None: not declared).
 
-        The run in full (histories for figures) counts as :data:`RUN_CASE_MEMBERS` members.
+        The run in full (histories for figures) counts as :data:`RUN_CASE_MEMBERS` members; the members share
+        ``workers`` processes, at most one per core.
 
         Parameters
         ----------
@@ -358,10 +366,14 @@ class System:
             A validated case (SI values).
         members : int
             Monte Carlo members (0: the case alone).
+        workers : int
+            Processes evaluating the members, number of.
         """
         if self.member_seconds is None:
             return None
-        return float(self.member_seconds(case)) * (members + RUN_CASE_MEMBERS)
+        sharing = max(1, min(int(workers), len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                             else os.cpu_count() or 1))
+        return float(self.member_seconds(case)) * (members / sharing + RUN_CASE_MEMBERS)
 
     def _work_options(self) -> str:
         # the options that set a system's amount of work, where it has them
@@ -370,7 +382,7 @@ class System:
 
     def monte_carlo(self, case: Case, members: int, streams: RandomStreams, fidelity: str | None = None, *,
                     draw: Callable[[np.ndarray], Mapping[str, np.ndarray]] | None = None,
-                    progress: Callable[[int, int], None] | None = None) -> MonteCarloSummary:
+                    progress: Callable[[int, int], None] | None = None, executor=None) -> MonteCarloSummary:
         """Statistics of every output over ``members`` random members of ``case`` (see :func:`monte_carlo`).
 
         Parameters
@@ -387,12 +399,18 @@ class System:
             ``draw(member_numbers) -> {parameter: values}``, SI values per member.
         progress : callable, optional
             ``progress(done, total)`` after each chunk, in members.
+        executor : optional
+            Where the chunks are evaluated (see :meth:`run`); None: in this process.
         """
         checked = None if draw is None else partial(self._checked_draw, draw)
         if self.member_seconds is None:
             progress = MeasuredPace(members, f"this {self.name} Monte Carlo", progress)
+        chunk = self._chunk_size(case)
+        workers = getattr(executor, "workers", None)
+        if workers:  # at least two chunks per worker, so that none waits while another finishes
+            chunk = min(chunk, max(1, -(-members // (2 * workers))))
         return monte_carlo(self.evaluate, self.outputs, case, members, streams, fidelity,
-                           chunk=self._chunk_size(case), draw=checked, progress=progress)
+                           chunk=chunk, draw=checked, progress=progress, executor=executor)
 
     def _checked_draw(self, draw: Callable[[np.ndarray], Mapping[str, np.ndarray]],
                       numbers: np.ndarray) -> dict[str, np.ndarray]:

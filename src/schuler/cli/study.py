@@ -26,8 +26,11 @@ from schuler.registry import SYSTEM_MODULES
 @click.option("--no-time-limit", is_flag=True, default=False,
               help="Run even when the work is estimated to take longer than the time budget (10 min, or "
                    "SCHULER_TIME_BUDGET).")
+@click.option("--workers", type=click.IntRange(min=1), default=1, metavar="N", show_default=True,
+              help="Processes evaluating the Monte Carlo's members, sharing the cores (1: this process); the "
+                   "statistics do not depend on it.")
 @json_option
-def run_scenario(scenario: Path, out_dir: Path | None, no_time_limit: bool, as_json: bool):
+def run_scenario(scenario: Path, out_dir: Path | None, no_time_limit: bool, workers: int, as_json: bool):
     """Run a scenario file: what `schuler SYSTEM run` does for its parameters.
 
     The file names the system and sets its run options by name
@@ -43,7 +46,7 @@ def run_scenario(scenario: Path, out_dir: Path | None, no_time_limit: bool, as_j
     members = table.cases if table is not None and table.cases else 0
     execute_run(loaded.definition(), loaded.values, monte_carlo=members, seed=table.seed if table else 0,
                 fidelity=loaded.fidelity, out_dir=out_dir or loaded.out_dir, as_json=as_json or loaded.as_json,
-                draw=loaded.draw if members else None, time_limit=not no_time_limit)
+                draw=loaded.draw if members else None, time_limit=not no_time_limit, workers=workers)
 
 
 @click.command("report")

@@ -39,6 +39,11 @@ NO_TIME_LIMIT = click.Option(["--no-time-limit"], is_flag=True, default=False,
                                   "(10 min, or SCHULER_TIME_BUDGET).")
 """The option that accepts work estimated past the time budget (:func:`schuler.memory.require_time`)."""
 
+WORKERS = click.Option(["--workers"], type=click.IntRange(min=1), default=1, metavar="N", show_default=True,
+                       help="Processes evaluating the --monte-carlo members, sharing the cores (1: this process); "
+                            "the statistics do not depend on it.")
+"""The option that spreads a run's Monte Carlo over local processes (:mod:`schuler.study.executors`)."""
+
 
 def system_group(system: System) -> click.Group:
     """The click group ``schuler NAME`` with ``run``, ``reproduce`` and the system's actions."""
@@ -64,18 +69,28 @@ def _given(case) -> dict:
 
 def execute_run(system: System, case: Case, *, monte_carlo: int, seed: int, fidelity: str | None,
                 out_dir: Path | None, as_json: bool, draw=None, instrument: Case | None = None,
-                time_limit: bool = True) -> None:
+                time_limit: bool = True, workers: int = 1) -> None:
     """What ``schuler NAME run`` and ``schuler run SCENARIO`` do with a parsed case.
 
     ``instrument``: the ``--imu`` options that set part of the case (shown in the JSON inputs);
-    ``time_limit``: False for ``--no-time-limit`` (work longer than the time budget accepted).
+    ``time_limit``: False for ``--no-time-limit`` (work longer than the time budget accepted);
+    ``workers``: processes for the Monte Carlo's members (``--workers``).
     """
+    from schuler.study.executors import make_executor
+
     with options_named(system.parameters + RUN_OPTIONS), no_time_limit(not time_limit):
-        estimate = system.work_seconds(case, monte_carlo)
+        estimate = system.work_seconds(case, monte_carlo, workers=workers)
         label = f"{system.name} Monte Carlo" + (f" (estimate {format_seconds(estimate)})" if estimate else "")
-        with progress_reporter(label, enabled=not as_json) as progress:
-            result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress, draw=draw,
-                                **_given(case))
+        executor = make_executor(workers=workers) if monte_carlo and workers > 1 else None
+        finished = False
+        try:
+            with progress_reporter(label, enabled=not as_json) as progress:
+                result = system.run(monte_carlo=monte_carlo, seed=seed, fidelity=fidelity, progress=progress,
+                                    draw=draw, executor=executor, **_given(case))
+            finished = True
+        finally:
+            if executor is not None:
+                executor.close(abort=not finished)
     files = _write_files(system.write, result, out_dir, f"{system.name} run")
     inputs = dict(case)
     parameters = system.parameters
@@ -127,7 +142,7 @@ def _run_command(system: System) -> click.Command:
     run_options = ParameterSet(RUN_OPTIONS, owner=system.name)
     instrument = instrument_options(system.name)  # --imu where the IMU layer maps to the system
 
-    def run(scenario: Path | None, out_dir: Path | None, as_json: bool, no_time_limit: bool,
+    def run(scenario: Path | None, out_dir: Path | None, as_json: bool, no_time_limit: bool, workers: int = 1,
             fidelity: str | None = None, **raw):
         options = run_options.parse({k: raw.pop(k) for k in run_options.names}, labels="option")
         imu_options = instrument.parse({k: raw.pop(k) for k in instrument.names}, labels="option")
@@ -145,7 +160,8 @@ def _run_command(system: System) -> click.Command:
             as_json = as_json or loaded.as_json
         case, used = _with_instrument(system, case, imu_options)
         execute_run(system, case, monte_carlo=options["monte_carlo"], seed=options["seed"], fidelity=fidelity,
-                    out_dir=out_dir, as_json=as_json, draw=draw, instrument=used, time_limit=not no_time_limit)
+                    out_dir=out_dir, as_json=as_json, draw=draw, instrument=used, time_limit=not no_time_limit,
+                    workers=workers)
 
     command = click.Command("run", callback=run, context_settings=_CONTEXT,
                             help=f"One case: {system.title}. The headline numbers; figures and data with --out.\n\n"
@@ -162,7 +178,7 @@ def _run_command(system: System) -> click.Command:
         command.params.append(click.Option(
             ["--fidelity"], type=click.Choice(system.fidelities), default=None,
             help=f"How outputs are computed: {', '.join(system.fidelities)}. [default: {system.fidelities[0]}]"))
-    command.params.append(NO_TIME_LIMIT)
+    command.params.extend([WORKERS, NO_TIME_LIMIT])
     command.params.extend(_output_params())
     return command
 
