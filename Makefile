@@ -41,7 +41,8 @@ lint: $(VENV)/.installed-test
 
 # one BLAS thread per test process: the models' matrices are small, and two
 # processes already use both cores
-PYTEST := SCHULER_PSINS_IMU="$(PSINS_IMU)" OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2 -q
+PYTEST_ONE := SCHULER_PSINS_IMU="$(PSINS_IMU)" OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -q
+PYTEST := $(PYTEST_ONE) -n 2
 
 # the suite without the tests marked slow (long horizons, 1,000-member checks, fuzz per option)
 test: lint
@@ -50,7 +51,9 @@ test: lint
 
 test-slow: $(VENV)/.installed-test
 	@echo "== pytest: the tests marked slow"
-	$(PYTEST) -m slow
+	$(PYTEST) -m "slow and not alone"
+	@echo "== pytest: the slow tests timed with the machine to themselves (commands that spread over its cores)"
+	$(PYTEST_ONE) -p no:xdist -m alone
 
 # the site: user guide, gallery (its examples run), API reference; every warning is an error
 docs: $(VENV)/.installed-docs

@@ -259,8 +259,8 @@ def write_case(folder, duration: float = 1500.0, outages=OUTAGES, seed: int = 1)
     path = drive(duration=duration)
     truth = ideal_imu(path, duration, RATE)
     dt = truth.interval_s
-    simulator = ImuSimulator(error_model(), dt, true_gyro_rad_s=truth.angle_increment_rad / dt,
-                             true_accel_m_s2=truth.velocity_increment_m_s / dt, seed=seed)
+    simulator = ImuSimulator(error_model(), dt, true_gyro=truth.angle_increment_rad / dt,
+                             true_accel=truth.velocity_increment_m_s / dt, seed=seed)
     gyro, accel = simulator.window(np.array([0]), 0, truth.t_s.size)
     t = WEEK_START + truth.t_s
     imu = ImuRecord(time_s=t, gyro=gyro[0] * dt, accel=accel[0] * dt, kind="increment", sample_interval_s=dt,

@@ -49,15 +49,15 @@ def member(batch: StaticBatch, i: int) -> StaticBatch:
 
 def main() -> int:
     errors = model()
-    align_kalman(simulated_batch(errors, latitude_rad=LATITUDE, heading_rad=HEADING, duration_s=10.0,
-                                 sample_interval_s=DT, members=2)[0], errors)   # numba compiled before timing
+    align_kalman(simulated_batch(errors, latitude=LATITUDE, heading=HEADING, duration=10.0,
+                                 sample_interval=DT, members=2)[0], errors)   # numba compiled before timing
     batched = looped = simulating = 0.0
     difference = 0.0
     headings = []
     for first in range(0, RECORDS, GROUP):
         start = time.perf_counter()
-        batch, _ = simulated_batch(errors, latitude_rad=LATITUDE, heading_rad=HEADING, duration_s=DURATION_S,
-                                   sample_interval_s=DT, members=np.arange(first, first + GROUP), seed=1)
+        batch, _ = simulated_batch(errors, latitude=LATITUDE, heading=HEADING, duration=DURATION_S,
+                                   sample_interval=DT, members=np.arange(first, first + GROUP), seed=1)
         simulating += time.perf_counter() - start
         start = time.perf_counter()
         together = align_kalman(batch, errors)

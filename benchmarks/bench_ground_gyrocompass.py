@@ -153,8 +153,8 @@ def monte_carlo_section(b: float) -> list[str]:
         ratio = t_loop / t_study
         print(f"  {unknowns} unknowns: monte_carlo {t_study * 1e3 / MC_MEMBERS:6.2f} ms per record, "
               f"loop of identify() {t_loop * 1e3 / MC_MEMBERS:6.2f} ms per record: ratio {ratio:5.2f}x "
-              f"(target >= {target:g}x); north std {result.std_error_arcsec[0, 0]:.4f} arcsec "
-              f"(loop {loop_std:.4f}, predicted {result.predicted_std_arcsec[0, 0]:.4f})")
+              f"(target >= {target:g}x); north std {result.std_error_rad[0, 0] / ARCSEC:.4f} arcsec "
+              f"(loop {loop_std:.4f}, predicted {result.predicted_std_rad[0, 0] / ARCSEC:.4f})")
         if ratio < target:
             failures.append(f"Monte Carlo with {unknowns} unknowns below {target:g}x the loop of identify()")
     print("  failure rates (1 - converged, and converged but off by more than 5 predicted sigma), 4 unknowns:")

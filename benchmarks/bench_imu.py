@@ -98,7 +98,7 @@ def every_term_model():
 def simulate(workers: int, members: int, length: int) -> tuple[float, float]:
     """Wall-clock and CPU seconds (all threads) of a simulation of ``members`` x ``length`` samples."""
     truth = static_truth(0.8, 0.3)
-    simulator = ImuSimulator(every_term_model(), DT, true_gyro_rad_s=truth[0], true_accel_m_s2=truth[1], seed=7,
+    simulator = ImuSimulator(every_term_model(), DT, true_gyro=truth[0], true_accel=truth[1], seed=7,
                              workers=workers)
     start, cpu = time.perf_counter(), time.process_time()
     for _ in iter_simulation(simulator, np.arange(members), length, member_chunk=members):

@@ -73,7 +73,7 @@ def source_by_source(setup):
 
 
 def main() -> None:
-    cruise = setup_of(imu="navigation", trajectory="cruise", duration=36000.0, alignment_duration=900.0)
+    cruise = setup_of(imu="navigation", trajectory="great-circle", duration=36000.0, alignment_duration=900.0)
     covariance_budget(cruise)  # warm-up
     budget, wall, cpu = timed(lambda: covariance_budget(cruise))
     constant, base_wall, base_cpu = timed(lambda: source_by_source(cruise), repeat=1)
@@ -84,7 +84,7 @@ def main() -> None:
           f"ratio {base_cpu / cpu:.1f}x (CPU); same variance to {abs(constant / mine - 1):.1e}")
     print(f"  final 1-sigma {budget.sigma('horizontal_position')[-1]:.1f} m")
 
-    setup = setup_of(imu="tactical", trajectory="cruise", duration=3600.0)
+    setup = setup_of(imu="tactical", trajectory="great-circle", duration=3600.0)
     members, rate = 200, 2.0
     samples = members * setup.duration * rate
     run_members(setup, np.arange(4), RandomStreams(0), rate)  # numba warm-up

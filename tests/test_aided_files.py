@@ -74,7 +74,7 @@ def test_zero_velocity_zero_rate_and_the_constraint_run_on_files_as_on_the_simul
 
 
 @pytest.mark.parametrize(("options", "words"), [({"aiding": "gnss-position,odometer"}, "odometer: on a simulated"),
-                                                ({"aiding": "gnss-position,zupt"}, "--stop-intervals")])
+                                                ({"aiding": "gnss-position,zupt"}, "`stop_intervals`")])
 def test_aiding_that_needs_data_or_a_drive_is_refused_on_files(noisy, options, words):
     with pytest.raises(InvalidParameter, match=words):
         _on_files(noisy[0], **options)

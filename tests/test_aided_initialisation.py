@@ -13,7 +13,9 @@ from schuler.aided import evaluation, initialisation
 from schuler.aided.gnss import simulate_gnss
 from schuler.aided.outputs import write_simulated_files
 from schuler.core.attitude import euler_from_quaternion, wrap_angle
+from schuler.core.earth import EARTH_RATE
 from schuler.core.random import RandomStreams
+from schuler.exceptions import InvalidParameter
 from schuler.imu.instrument import resolve_model
 from schuler.navigate.drive import drive
 from schuler.registry import get_system
@@ -41,7 +43,7 @@ def batch():
 
 def _initialise(mode, data, **options):
     return initialisation.initialise(mode, data.increments, data.truth.interval_s, data.gnss, given=None,
-                                     lever_arm=data.lever_arm, imu=resolve_model("tactical"), at_rest_s=25.0,
+                                     lever_arm=data.lever_arm, imu=resolve_model("tactical"), at_rest=25.0,
                                      **options)
 
 
@@ -143,3 +145,48 @@ def test_a_start_on_files_is_the_start_on_the_simulated_drive(mode, tmp_path):
 def test_bad_starts_are_one_line_and_exit_2(run_cli, options, words):
     out = run_cli("aided", "run", "--duration", "300", *options)
     assert out.code == 2 and out.stderr.count("\n") == 1 and words in out.stderr, out.stderr
+
+
+def test_an_in_motion_start_takes_the_gyro_bias_of_the_rest_before_it():
+    # noiseless data of the drive (at rest for its first 25 s, heading north) with a known gyro bias added: the
+    # window's mean minus (0, 0, -Omega sin L) is the bias plus the Earth rate's level part, Omega cos L about x
+    case = AIDED.case(duration=300.0, imu_rate=10.0, nominal=True)
+    data = evaluation.simulated_inputs(case, np.arange(2), None)
+    bias = np.radians([[20.0, -15.0, 10.0], [-3.0, 7.0, -20.0]])  # deg/s, each member its own
+    increments = np.array(data.increments)
+    increments[..., :3] += bias[:, None, :] * data.truth.interval_s
+    imu = resolve_model("consumer")
+    start = initialisation.initialise("in-motion", increments, data.truth.interval_s, data.gnss, given=None,
+                                      imu=imu, at_rest=25.0, alignment_duration=20.0)
+    latitude = float(data.gnss[0].latitude_rad[0])
+    assert start.gyro_bias_rad_s is not None and start.gyro_bias_sigma_rad_s is not None
+    np.testing.assert_allclose(start.gyro_bias_rad_s - bias, [[EARTH_RATE * math.cos(latitude), 0.0, 0.0]] * 2,
+                               rtol=0, atol=1e-9)
+    noise = imu.gyro.random_walk[0] ** 2 / 20.0
+    level = (EARTH_RATE * math.cos(latitude)) ** 2 / 2.0
+    np.testing.assert_allclose(start.gyro_bias_sigma_rad_s, np.sqrt([noise + level, noise + level, noise]),
+                               rtol=1e-12)
+    # no rest known (a file) or none (moving from the start): no bias; a rest shorter than the window: refused
+    for at_rest in (None, 0.0):
+        assert initialisation.initialise("in-motion", increments, data.truth.interval_s, data.gnss, given=None,
+                                         imu=imu, at_rest=at_rest).gyro_bias_rad_s is None
+    with pytest.raises(InvalidParameter, match="longer than the 10 s the data are at rest"):
+        initialisation.initialise("in-motion", increments, data.truth.interval_s, data.gnss, given=None, imu=imu,
+                                  at_rest=10.0, alignment_duration=20.0)
+
+
+def test_the_rest_s_bias_joins_the_model_s_prior_as_two_gaussians():
+    # consumer: the rest's 13 deg/h against the model's 20 deg/s prior, the rest wins; tactical: its 1 deg/h prior
+    # beats the rest's 9 deg/h about x and y and keeps most of its own 1-sigma
+    for grade in ("consumer", "tactical"):
+        case = AIDED.case(duration=300.0, imu_rate=10.0, imu=grade, initialisation="in-motion")
+        model = evaluation.filter_model(resolve_model(grade))
+        data = evaluation.simulated_inputs(case, np.arange(1), RandomStreams(4))
+        start = evaluation._initialisation(case, data.increments, data.truth.interval_s, data.gnss, None,
+                                           imu=resolve_model(grade), at_rest=25.0)
+        given = evaluation._bias_at_rest(start, model)
+        prior, rest = model.initial_sigma()[0:3] ** 2, start.gyro_bias_sigma_rad_s ** 2
+        np.testing.assert_allclose(given["initial_sensor_sigma"][0:3] ** -2, 1 / prior + 1 / rest, rtol=1e-12)
+        np.testing.assert_allclose(given["initial_sensor_errors"][0, 0:3],
+                                   start.gyro_bias_rad_s[0] * prior / (prior + rest), rtol=1e-12)
+        assert np.all(given["initial_sensor_sigma"][0:3] <= np.minimum(np.sqrt(prior), np.sqrt(rest)) * (1 + 1e-12))

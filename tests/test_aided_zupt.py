@@ -50,8 +50,8 @@ def test_detector_finds_every_stop_of_the_drive():
     ideal = ideal_imu(path, 900.0, 100.0)
     dt = ideal.interval_s
     error_model = preset("tactical")
-    simulator = ImuSimulator(error_model, dt, true_gyro_rad_s=ideal.angle_increment_rad / dt,
-                             true_accel_m_s2=ideal.velocity_increment_m_s / dt, seed=4)
+    simulator = ImuSimulator(error_model, dt, true_gyro=ideal.angle_increment_rad / dt,
+                             true_accel=ideal.velocity_increment_m_s / dt, seed=4)
     gyro, accel = simulator.window(np.array([0]), 0, ideal.t_s.size)
     increments = np.concatenate([gyro, accel], axis=-1)[0] * dt
     found = sources.detect_stops(increments, dt, error_model.gyro.random_walk[0] / np.sqrt(dt),
@@ -73,8 +73,8 @@ def _consumer_at_the_first_stop(zupt: bool):
     ideal = ideal_imu(path, duration, 100.0)
     dt = ideal.interval_s
     error_model = preset("consumer")
-    simulator = ImuSimulator(error_model, dt, true_gyro_rad_s=ideal.angle_increment_rad / dt,
-                             true_accel_m_s2=ideal.velocity_increment_m_s / dt, seed=RandomStreams(21).seed)
+    simulator = ImuSimulator(error_model, dt, true_gyro=ideal.angle_increment_rad / dt,
+                             true_accel=ideal.velocity_increment_m_s / dt, seed=RandomStreams(21).seed)
     members = np.arange(4)
     gyro, accel = simulator.window(members, 0, ideal.t_s.size)
     increments = np.concatenate([gyro, accel], axis=-1) * dt
@@ -111,7 +111,7 @@ def test_stops_given_one_by_one_equal_the_drives_own_and_a_false_one_is_refused_
 
     aided = get_system("aided")
     common = dict(duration=400.0, outage_start=250.0, aiding="gnss-position,gnss-velocity,zupt,zaru", seed=5)
-    own = drive(latitude=aided.case().get("latitude"), duration=400.0).stationary_intervals()
+    own = drive(duration=400.0).stationary_intervals()  # the simulated case is the drive from its own start
     listed = aided.run(stop_intervals=[[start, end - start] for start, end in own], **common)
     given = aided.run(**common)
     assert listed.outages == given.outages
@@ -119,5 +119,5 @@ def test_stops_given_one_by_one_equal_the_drives_own_and_a_false_one_is_refused_
     # a "stop" at road speed: every zero-velocity update there (10 Hz, 5 s) fails the gate
     moving = aided.run(stop_intervals=[[195.0, 5.0]], **common)  # at 20 m/s
     assert moving.rejected_by_source["zupt"] == 50
-    out = run_cli("aided", "run", "--stop-intervals", "0:20", "--stops", "detected")
+    out = run_cli("aided", "run", "--stop-intervals", "0:20", "--stops-from", "imu")
     assert out.code == 2 and "cannot be combined" in out.stderr

@@ -12,9 +12,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.gyrocompass_design import loop_design, loop_gains
 from schuler.core.steady_state import steady_state_gain
 from schuler.gyrocompassing import optimal as model
-from schuler.gyrocompassing.analytic import design_from_gains, gains_from_design
 from schuler.gyrocompassing.optimal_run import LOOP_KEYS
 from schuler.imu.spec import preset
 
@@ -43,20 +43,20 @@ def test_white_noise_gains_in_closed_form_equal_the_riccati_solver():
 @given(T=st.floats(2.0, 3000.0), zeta=st.floats(0.71, 5.0), latitude=st.floats(-1.3, 1.3))
 @settings(max_examples=60, deadline=None)
 def test_gains_to_t_zeta_and_noise_round_trip(T, zeta, latitude):
-    c_gamma, c_a = gains_from_design(T, zeta, latitude)
-    back_T, back_zeta = design_from_gains(c_gamma, c_a, latitude)
+    c_gamma, c_a = loop_gains(latitude, T, zeta)
+    back_T, back_zeta = loop_design(latitude, c_gamma, c_a)
     assert float(back_T) == pytest.approx(T, rel=1e-12) and float(back_zeta) == pytest.approx(zeta, rel=1e-12)
     ratios = model.noise_for_gains(float(c_gamma), float(c_a), latitude)
     np.testing.assert_allclose(model.gains_for_noise(*ratios, 1.0, latitude), (c_gamma, c_a), rtol=1e-9)
 
 
 def test_seed_design_optimal_for_and_below_the_return_difference_bound():
-    c_gamma, c_a = gains_from_design(30.0, 0.8, LATITUDE)
+    c_gamma, c_a = loop_gains(LATITUDE, 30.0, 0.8)
     q_beta, q_delta = model.noise_for_gains(float(c_gamma), float(c_a), LATITUDE)
     assert q_beta == pytest.approx((4 * 0.8**2 - 2) / 30.0**2, rel=1e-12)  # omega0^2 (4 zeta^2 - 2)
     assert q_delta == pytest.approx(float(c_a) ** 2, rel=1e-12)
     with pytest.raises(Exception, match="return-difference"):
-        model.noise_for_gains(*(float(v) for v in gains_from_design(30.0, 0.7, LATITUDE)), LATITUDE)
+        model.noise_for_gains(*(float(v) for v in loop_gains(LATITUDE, 30.0, 0.7)), LATITUDE)
 
 
 def test_constant_drift_error_of_the_seed_is_equation_1_21():

@@ -42,8 +42,8 @@ BIAS_MODEL = white(TACTICAL.gyro.bias[0], TACTICAL.accel.bias[0], "tactical bias
 
 def spreads(model: ErrorModel, seed: int):
     settings = AlignmentSettings()
-    batch, _ = simulated_batch(model, latitude_rad=LATITUDE, heading_rad=HEADING, duration_s=300.0,
-                               sample_interval_s=0.1, members=MEMBERS, seed=seed)
+    batch, _ = simulated_batch(model, latitude=LATITUDE, heading=HEADING, duration=300.0,
+                               sample_interval=0.1, members=MEMBERS, seed=seed)
     estimates = run_methods(batch, model, settings)
     limits = method_limits(model, batch, HEADING, settings)
     return estimates, limits
@@ -81,8 +81,8 @@ def test_bias_limits_of_every_method():
 
 def north_spread(method: str, axes: str, seed: int):
     model = ErrorModel(gyro=SensorErrors(bias=TACTICAL.gyro.bias, random_walk=TACTICAL.gyro.random_walk), name="gyro")
-    rates, start, end = simulate_turntable(model, method, latitude_rad=LATITUDE, heading_rad=HEADING, samples=3000,
-                                           sample_interval_s=0.1, members=MEMBERS, seed=seed, axes=axes)
+    rates, start, end = simulate_turntable(model, method, latitude=LATITUDE, heading=HEADING, samples=3000,
+                                           sample_interval=0.1, members=MEMBERS, seed=seed, axes=axes)
     estimate = find_north(rates, start, end, LATITUDE, method, axes)
     truth = abs(HEADING) if estimate.ambiguous else HEADING
     spread = np.std(wrap_angle(estimate.heading_rad - truth), ddof=1)

@@ -122,16 +122,16 @@ def test_a_rocking_base_is_followed_exactly():
     """An ideal IMU on a base that only rocks (0.05 deg at 0.3-3 Hz about every axis): the sway's increments are
     exact, the gyros follow it, so the loop ends on the true final attitude to 0.01 arcmin."""
     latitude, heading = math.radians(34.0), math.radians(90.0)
-    batch, _ = simulated_batch(IDEAL, latitude_rad=latitude, heading_rad=heading, duration_s=300.0,
-                               sample_interval_s=0.02, members=3, seed=1)
-    rocked, truth = sway_batch(batch, Sway(angle_rad=math.radians(0.05), displacement_m=0.0), heading_rad=heading,
+    batch, _ = simulated_batch(IDEAL, latitude=latitude, heading=heading, duration=300.0,
+                               sample_interval=0.02, members=3, seed=1)
+    rocked, truth = sway_batch(batch, Sway(angle_rad=math.radians(0.05), displacement_m=0.0), heading=heading,
                                members=np.arange(3), seed=1)
     assert np.max(np.abs(truth[:, 2] - heading)) > math.radians(0.01)   # the base did turn
     estimate = align_staged_gyrocompass(rocked, staged_design(NAVIGATION, rocked))
     assert np.max(np.abs(wrap_angle(estimate.heading_rad - truth[:, 2]))) < 0.01 * ARCMIN
     assert np.max(np.abs(estimate.roll_rad - truth[:, 0])) < 0.01 * ARCMIN
     assert np.max(np.abs(estimate.pitch_rad - truth[:, 1])) < 0.01 * ARCMIN
-    unchanged, _ = sway_batch(batch, Sway(angle_rad=0.0, displacement_m=0.0), heading_rad=heading,
+    unchanged, _ = sway_batch(batch, Sway(angle_rad=0.0, displacement_m=0.0), heading=heading,
                               members=np.arange(3), seed=1)
     np.testing.assert_allclose(unchanged.gyro_increment, batch.gyro_increment, rtol=0, atol=1e-18)
     np.testing.assert_allclose(unchanged.accel_increment, batch.accel_increment, rtol=0, atol=1e-15)
@@ -145,10 +145,10 @@ def test_on_a_swaying_base_the_loop_stays_inside_its_limit():
     sigma); the KPI design (T = 30 s, zeta = 0.8), torqued by the specific force, is inside for fewer than 30
     (measured: 16)."""
     latitude, heading, members = math.radians(34.0), math.radians(90.0), 100
-    batch, _ = simulated_batch(NAVIGATION_WHITE, latitude_rad=latitude, heading_rad=heading, duration_s=300.0,
-                               sample_interval_s=0.02, members=members, seed=5)
+    batch, _ = simulated_batch(NAVIGATION_WHITE, latitude=latitude, heading=heading, duration=300.0,
+                               sample_interval=0.02, members=members, seed=5)
     swaying, truth = sway_batch(batch, Sway(angle_rad=math.radians(0.02), displacement_m=0.0005),
-                                heading_rad=heading, members=np.arange(members), seed=5)
+                                heading=heading, members=np.arange(members), seed=5)
     staged_limit_rad = method_limits(NAVIGATION_WHITE, swaying, heading, AlignmentSettings())["gyrocompass"]
     kpi_limit = method_limits(NAVIGATION_WHITE, swaying, heading,
                               AlignmentSettings(gyrocompass_design="kpi"))["gyrocompass"]
@@ -169,8 +169,8 @@ def test_align_compare_keeps_the_kpi_design():
     assert staged.gyrocompass_design == "staged" and kpi.gyrocompass_design == "kpi"
     assert [stage["name"] for stage in staged.gyrocompass_stages][-1] == "fine azimuth"
     assert kpi.gyrocompass_stages == []
-    batch, _ = simulated_batch(preset("tactical"), latitude_rad=math.radians(45.0), heading_rad=math.radians(30.0),
-                               duration_s=60.0, sample_interval_s=0.05, members=[0], seed=2)
+    batch, _ = simulated_batch(preset("tactical"), latitude=math.radians(45.0), heading=math.radians(30.0),
+                               duration=60.0, sample_interval=0.05, members=[0], seed=2)
     assert kpi.methods["gyrocompass"]["heading_rad"] == pytest.approx(float(align_gyrocompass(batch).heading_rad[0]),
                                                                       abs=1e-12)
     assert kpi.methods["kalman"]["heading_rad"] == staged.methods["kalman"]["heading_rad"]

@@ -37,7 +37,7 @@ METHOD_NAMES = ("coarse", "inertial_frame", "kalman", "gyrocompass")
 def test_north_finders_recover_the_azimuth_of_noise_free_rates(method, axes, heading_deg):
     """Exact Earth rates plus a bias per gyro in, the azimuth out to rounding (1e-9 rad)."""
     heading = math.radians(heading_deg)
-    start, end = schedule(method, samples=400, sample_interval_s=0.5)
+    start, end = schedule(method, samples=400, sample_interval=0.5)
     rates = turntable_rates(LATITUDE, heading, start, end, 0.5)[:, :len(axes)]
     rates = rates + np.array([3e-6, -2e-6])[:len(axes)]   # a bias per gyro, rad/s
     estimate = find_north(rates[None], start, end, LATITUDE, method, axes)
@@ -70,8 +70,8 @@ def test_north_comparison_puts_system_5_on_the_same_time_axis():
         calls.append((np.asarray(durations).copy(), noise, latitude))
         return noise / np.sqrt(np.asarray(durations))
 
-    result = compare_north("tactical", latitude_rad=LATITUDE, heading_rad=math.radians(30), duration_s=120.0,
-                           sample_interval_s=0.5, members=4, seed=3, ground_gyrocompass=ground_gyrocompass)
+    result = compare_north("tactical", latitude=LATITUDE, heading=math.radians(30), duration=120.0,
+                           sample_interval=0.5, members=4, seed=3, ground_gyrocompass=ground_gyrocompass)
     assert set(result.methods) == set(NORTH_METHODS)
     assert len(result.versus_time["ground_gyrocompass"]) == len(result.versus_time["duration_s"])
     assert result.ground_gyrocompass["sigma_rad"] == pytest.approx(calls[-1][1] / math.sqrt(120.0))
@@ -108,7 +108,7 @@ def test_multi_static_calibration_is_exact_without_noise():
     gyro_matrix = np.eye(3) + rng.normal(0, 2e-3, (3, 3))
     accel_bias = rng.normal(0, 0.05, 3)
     fit = calibrate_multi_static(gyro_true @ gyro_matrix.T, accel_true @ accel_matrix.T + accel_bias,
-                                 plan.sample_interval_s, initial_s=plan.initial_s, gravity_m_s2=plan.gravity)
+                                 plan.sample_interval_s, initial=plan.initial_s, gravity=plan.gravity)
     truth = identifiable_truth(accel_matrix, accel_bias, gyro_matrix)
     assert fit.accel_bias == pytest.approx(truth["accel_bias"], abs=1e-6)
     assert fit.accel_scale == pytest.approx(truth["accel_scale"], abs=1e-6)
@@ -145,7 +145,7 @@ def test_calibration_round_trip_within_the_predicted_accuracy():
     matrix's 108 within 0.78-1.23; the multi-static accelerometer biases come out at 1.35 here, 1.02 over the
     200 records of the slow test.)
     """
-    records = [compare_calibration("industrial", latitude_rad=LATITUDE, seed=seed) for seed in range(12)]
+    records = [compare_calibration("industrial", latitude=LATITUDE, seed=seed) for seed in range(12)]
     _check_normalised_errors(_normalised_errors(records, "multi_static"))
     _check_normalised_errors(_normalised_errors(records, "six_position"))
     assert min(r.multi_static["static_intervals"] for r in records) >= 37   # every orientation and the initial one
@@ -153,7 +153,7 @@ def test_calibration_round_trip_within_the_predicted_accuracy():
 
 @pytest.fixture(scope="module")
 def two_hundred_calibrations():
-    return [compare_calibration("industrial", latitude_rad=LATITUDE, seed=seed) for seed in range(200)]
+    return [compare_calibration("industrial", latitude=LATITUDE, seed=seed) for seed in range(200)]
 
 
 @pytest.mark.slow
@@ -189,10 +189,10 @@ def test_multi_static_slow_terms_widen_the_1_sigma():
     plan = MultiStaticPlan(positions=12, sample_interval_s=0.02, latitude_rad=LATITUDE)
     gyro_true, accel_true = plan.truth(seed=2)
     white, full = calibration_model("industrial"), preset("industrial")
-    gyro, accel = ImuSimulator(white, plan.sample_interval_s, true_gyro_rad_s=gyro_true, true_accel_m_s2=accel_true,
+    gyro, accel = ImuSimulator(white, plan.sample_interval_s, true_gyro=gyro_true, true_accel=accel_true,
                                seed=2).window([0], 0, gyro_true.shape[0])
-    fits = [calibrate_multi_static(gyro[0], accel[0], plan.sample_interval_s, initial_s=plan.initial_s,
-                                   gravity_m_s2=plan.gravity, latitude_rad=LATITUDE, error_model=model)
+    fits = [calibrate_multi_static(gyro[0], accel[0], plan.sample_interval_s, initial=plan.initial_s,
+                                   gravity=plan.gravity, latitude=LATITUDE, error_model=model)
             for model in (None, white, full)]
     for name in ("accel_bias_sigma", "gyro_matrix_sigma", "gyro_bias_sigma"):
         assert getattr(fits[1], name) == pytest.approx(getattr(fits[0], name), rel=1e-12)
@@ -210,12 +210,12 @@ def test_multi_static_monte_carlo_with_slow_terms():
     for seed in range(200):
         plan = MultiStaticPlan(positions=36, sample_interval_s=0.01, latitude_rad=LATITUDE)
         gyro_true, accel_true = plan.truth(seed)
-        simulator = ImuSimulator(model, plan.sample_interval_s, true_gyro_rad_s=gyro_true,
-                                 true_accel_m_s2=accel_true, seed=seed)
+        simulator = ImuSimulator(model, plan.sample_interval_s, true_gyro=gyro_true,
+                                 true_accel=accel_true, seed=seed)
         gyro, accel = simulator.window([0], 0, gyro_true.shape[0])
         constants = simulator.constants([0])
-        fit = calibrate_multi_static(gyro[0], accel[0], plan.sample_interval_s, initial_s=plan.initial_s,
-                                     gravity_m_s2=plan.gravity, latitude_rad=LATITUDE, error_model=model)
+        fit = calibrate_multi_static(gyro[0], accel[0], plan.sample_interval_s, initial=plan.initial_s,
+                                     gravity=plan.gravity, latitude=LATITUDE, error_model=model)
         truth = identifiable_truth(constants["accel_matrix"][0], constants["accel_bias"][0],
                                    constants["gyro_matrix"][0])
         start = plan.attitudes(seed)[0]
@@ -235,7 +235,7 @@ def test_imu_simulator_and_six_position_agree_on_the_truth():
     model = preset("navigation")
     plan = SixPositionPlan(latitude_rad=LATITUDE, dwell_s=60.0, turn_s=36.0, sample_interval_s=0.05)
     gyro_true, accel_true = plan.truth()
-    simulator = ImuSimulator(model, plan.sample_interval_s, true_gyro_rad_s=gyro_true, true_accel_m_s2=accel_true,
+    simulator = ImuSimulator(model, plan.sample_interval_s, true_gyro=gyro_true, true_accel=accel_true,
                              seed=8)
     gyro, accel = simulator.window([0], 0, gyro_true.shape[0])
     constants = simulator.constants([0])
@@ -309,8 +309,8 @@ def test_comparisons_plot_and_write_their_table(tmp_path):
     assert "kalman" in str(estimate) and estimate.to_dict()["method"] == "kalman"
     history = estimate.to_dataframe()
     assert len(history) == estimate.time_s.size and "heading_sigma_rad" in history
-    north = compare_north("tactical", latitude_rad=math.radians(45.0), heading_rad=0.5, duration_s=60.0,
-                          sample_interval_s=0.5, members=3)
+    north = compare_north("tactical", latitude=math.radians(45.0), heading=0.5, duration=60.0,
+                          sample_interval=0.5, members=3)
     assert list(north.to_dataframe().columns) == list(north.versus_time)
     figures = comparison_figures(north)
     assert set(figures) == {"north_compare_accuracy"} and comparison_figures(estimate) == {}

@@ -64,4 +64,6 @@ def test_ci_runs_every_test():
                 if line.strip().startswith("make ")]
     assert commands == ["make test", "make test-slow", "make docs"]
     makefile = (root / "Makefile").read_text(encoding="utf-8")
-    assert '$(PYTEST) -m "not slow"' in makefile and "$(PYTEST) -m slow" in makefile
+    # the slow ones in two runs: beside each other, then those timed with the machine to themselves
+    assert '$(PYTEST) -m "not slow"' in makefile and '$(PYTEST) -m "slow and not alone"' in makefile
+    assert "$(PYTEST_ONE) -p no:xdist -m alone" in makefile

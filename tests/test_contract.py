@@ -51,7 +51,7 @@ VARIATIONS = {
     "calibrate": [{"latitude": math.radians(40.0), "azimuth": math.radians(200.0)}],
     "align": [{"latitude": math.radians(20.0), "drift_east": 1e-7}, {"model": "simplified", "azimuth": 1.0}],
     "north": [{"latitude": math.radians(30.0)}],
-    "imu": [{"grade": "industrial", "azimuth": 1.0}, {"imu_rate": 200.0, "latitude": math.radians(-30.0)}],
+    "imu": [{"imu": "industrial", "azimuth": 1.0}, {"imu_rate": 200.0, "latitude": math.radians(-30.0)}],
     "navigate": [{"mode": "platform", "heading_error": 1e-3, "vertical_channel": "free"},
                  {"trajectory": "great-circle", "speed": 200.0, "heading": 1.0, "gyro_bias_x": 1e-7,
                   "imu": "tactical"}],

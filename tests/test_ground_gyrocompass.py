@@ -155,7 +155,7 @@ def test_noise_free_identification_recovers_source_values(record, unknowns):
     assert estimate.alpha0_dot == pytest.approx(motion.SOURCE_ALPHA0_DOT, rel=1e-9)
     assert estimate.decay_rate == pytest.approx(LAM, rel=1e-9)
     assert estimate.Hm == pytest.approx(motion.SOURCE_HM, rel=1e-9)
-    assert estimate.north_deg == pytest.approx(-3.69 / 3.0, rel=1e-9)  # -3.69 pi/540 rad = -1.23 deg
+    assert math.degrees(estimate.north_rad) == pytest.approx(-3.69 / 3.0, rel=1e-9)  # -3.69 pi/540 rad = -1.23 deg
     assert estimate.misfit < 1e-20
     assert abs(estimate.torque) < 1e-15
 
@@ -204,20 +204,20 @@ def test_standard_errors_agree_with_monte_carlo():
     # issue 7: Jacobian standard errors within 20 % of the Monte Carlo scatter (seeded, 400 runs)
     study = monte_carlo(TRUE, [120.0, 300.0], [5 * ARCSEC], members=400, unknowns=4, seed=11)
     assert np.all(study.converged_fraction == 1.0)
-    np.testing.assert_allclose(study.std_error_arcsec, study.predicted_std_arcsec, rtol=0.2)
+    np.testing.assert_allclose(study.std_error_rad, study.predicted_std_rad, rtol=0.2)
     # the standard error reported by a single fit (residual-based) also matches the scatter
     t = time_grid(300.0, 1.0)
     clean = motion.closed_form(t, TRUE["alpha0"], TRUE["alpha0_dot"], LAM, B) - TRUE["alpha0"]
     noisy = clean + 5 * ARCSEC * np.random.default_rng(5).standard_normal(t.size)
     est = identify(t, noisy, 4, decay_rate=LAM, **INSTRUMENT)
-    assert est.north_std_arcsec == pytest.approx(study.std_error_arcsec[1, 0], rel=0.2)
+    assert est.north_std_rad == pytest.approx(study.std_error_rad[1, 0], rel=0.2)
 
 
 def test_two_unknown_standard_error_matches_monte_carlo():
     study = monte_carlo(TRUE, [60.0, 600.0], [2 * ARCSEC, 20 * ARCSEC], members=400, unknowns=2, seed=2)
-    np.testing.assert_allclose(study.std_error_arcsec, study.predicted_std_arcsec, rtol=0.2)
+    np.testing.assert_allclose(study.std_error_rad, study.predicted_std_rad, rtol=0.2)
     # longer windows are more accurate: the trade-off the source is about
-    assert np.all(study.predicted_std_arcsec[1] < study.predicted_std_arcsec[0])
+    assert np.all(study.predicted_std_rad[1] < study.predicted_std_rad[0])
 
 
 @pytest.mark.parametrize("unknowns", [2, 4])
@@ -294,7 +294,7 @@ def test_monte_carlo_failure_rate_is_that_of_identify_and_off_nominal_starts_fit
     off = monte_carlo(TRUE, [60.0], [10 * ARCSEC], members=200, unknowns=4, seed=4,
                       nominal={"decay_rate": 1.3 * LAM, "coefficient": 0.8 * B})
     assert off.converged_fraction[0, 0] == 1.0 and off.gross_error_fraction[0, 0] == 0.0
-    assert off.std_error_arcsec[0, 0] == pytest.approx(off.predicted_std_arcsec[0, 0], rel=0.2)
+    assert off.std_error_rad[0, 0] == pytest.approx(off.predicted_std_rad[0, 0], rel=0.2)
 
 
 def test_quantisation_enters_predicted_error():

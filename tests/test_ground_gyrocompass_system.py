@@ -160,7 +160,7 @@ def test_memory_is_estimated_before_allocating(monkeypatch, tmp_path):
     monkeypatch.setenv("SCHULER_TIME_BUDGET", "none")  # the time estimate would refuse these first
     huge = SYSTEM.case(duration=1e9, output_step=1e-3)
     assert member_bytes(huge) > 2**40  # estimated, not allocated
-    with pytest.raises(MemoryBudgetExceeded, match="--duration or --output-step"):
+    with pytest.raises(MemoryBudgetExceeded, match="`duration` or `output_step`"):
         SYSTEM.run(duration=1e9, output_step=1e-3)
     monkeypatch.setenv("SCHULER_MEMORY_BUDGET", "1 MB")
     with pytest.raises(MemoryBudgetExceeded, match="this run"):

@@ -195,7 +195,7 @@ def test_memory_is_refused_before_allocating(monkeypatch):
     monkeypatch.setenv("SCHULER_TIME_BUDGET", "none")  # the time estimate would refuse these first
     tracemalloc.start()
     try:
-        with pytest.raises(MemoryBudgetExceeded, match="change --duration or --output-step"):
+        with pytest.raises(MemoryBudgetExceeded, match="change `duration` or `output_step`"):
             SYSTEM.run(output_step=1e-3)  # 48 h at 1 ms: 1.7e8 points
         with pytest.raises(MemoryBudgetExceeded, match="this friction run would hold"):
             friction(duration=720 * HOUR, output_step=1e-3)  # 2.6e9 points: 24 GB of time grid alone

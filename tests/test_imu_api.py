@@ -45,7 +45,7 @@ def industrial_csv(tmp_path_factory):
 
     path = tmp_path_factory.mktemp("imu") / "industrial.csv"
     with pytest.raises(SystemExit) as done:
-        main(["imu", "simulate", "--grade", "industrial", "--duration", "300", "-o", str(path)])
+        main(["imu", "simulate", "--imu", "industrial", "--duration", "300", "-o", str(path)])
     assert done.value.code == 0
     return path
 

@@ -25,7 +25,7 @@ def navigation_csv(tmp_path_factory):
 
     path = tmp_path_factory.mktemp("imu") / "navigation.csv"
     with pytest.raises(SystemExit) as done:
-        main(["imu", "simulate", "--grade", "navigation", "--duration", "600", "--imu-rate", "100", "--latitude", "45",
+        main(["imu", "simulate", "--imu", "navigation", "--duration", "600", "--imu-rate", "100", "--latitude", "45",
               "--azimuth", "90", "-o", str(path)])
     assert done.value.code == 0
     return path
@@ -66,10 +66,10 @@ def test_allan_of_a_file_has_the_issues_json_keys_and_writes_figures(navigation_
 
 
 def test_run_json_has_flat_outputs_and_the_nested_noise(run_cli):
-    out = run_cli("imu", "run", "--grade", "industrial", "--duration", "10 min", "--json")
+    out = run_cli("imu", "run", "--imu", "industrial", "--duration", "10 min", "--json")
     assert out.code == 0, out.stderr
     data = out.json()
-    assert data["inputs"]["grade"] == "industrial" and data["inputs"]["duration"] == 600.0
+    assert data["inputs"]["imu"] == "industrial" and data["inputs"]["duration"] == 600.0
     for channel in CHANNELS:
         for term in TERMS:
             assert f"noise_{channel}_{term}" in data and term in data["noise"][channel]
@@ -81,7 +81,7 @@ def test_run_json_has_flat_outputs_and_the_nested_noise(run_cli):
 
 
 def test_run_monte_carlo_adds_the_statistics_of_independent_records(run_cli, tmp_path):
-    out = run_cli("imu", "run", "--grade", "consumer", "--duration", "120", "--monte-carlo", "3", "--seed", "4",
+    out = run_cli("imu", "run", "--imu", "consumer", "--duration", "120", "--monte-carlo", "3", "--seed", "4",
                   "--json", "--out", tmp_path)  # --out: the Allan figures of the nominal record and the Monte Carlo
     assert out.code == 0, out.stderr
     data = out.json()
@@ -92,7 +92,7 @@ def test_run_monte_carlo_adds_the_statistics_of_independent_records(run_cli, tmp
 
 
 def test_simulate_writes_parquet_and_refuses_other_suffixes_and_memory(run_cli, tmp_path, monkeypatch):
-    out = run_cli("imu", "simulate", "--grade", "industrial", "--duration", "60", "--imu-rate", "200", "-o",
+    out = run_cli("imu", "simulate", "--imu", "industrial", "--duration", "60", "--imu-rate", "200", "-o",
                   tmp_path / "r.parquet", "--json")
     assert out.code == 0, out.stderr
     data = out.json()
@@ -123,10 +123,12 @@ def test_errors_name_the_option_file_line_and_column(run_cli, tmp_path):
                    "0.01,0,0,0,0,0,-9.8\n0.02,0,0,nan,0,0,-9.8\n0.03,0,0,0,0,0,-9.8\n", encoding="utf-8")
     out = run_cli("imu", "info", bad)
     assert out.code == 2 and "bad.csv, line 3, column 4" in out.stderr, out.stderr
-    out = run_cli("imu", "run", "--grade", "tactical", "--spec", "x.toml")
-    assert out.code == 2 and "--grade: cannot be combined with --spec" in out.stderr
-    out = run_cli("imu", "run", "--grade", "tactcal")
-    assert out.code == 2 and "--grade" in out.stderr
+    out = run_cli("imu", "run", "--grade", "tactical")
+    assert out.code == 2 and "--grade: renamed to '--imu'" in out.stderr
+    out = run_cli("imu", "simulate", "--spec", "x.toml", "-o", "x.csv")
+    assert out.code == 2 and "--spec: renamed to '--imu'" in out.stderr
+    out = run_cli("imu", "run", "--imu", "tactcal")
+    assert out.code == 2 and "--imu: 'tactcal' is neither a grade" in out.stderr
     out = run_cli("imu", "info", bad, "--units", "gyro=deg/s,speed=m/s")
     assert out.code == 2 and "--units: unknown channel 'speed'" in out.stderr
     out = run_cli("imu", "info", bad, "--columns", "gyro_x")
@@ -157,7 +159,7 @@ def test_imu_on_align_changes_the_drifts_as_the_mapping_says(run_cli):
     out = run_cli("align", "run", "--duration", "600", "--azimuth", "20", "--imu", "tactical", "--json")
     assert out.code == 0, out.stderr
     data = out.json()
-    expected = align_inputs(preset("tactical"), heading_rad=math.radians(20.0)).values
+    expected = align_inputs(preset("tactical"), heading=math.radians(20.0)).values
     for name in ("drift_east", "drift_north", "drift_z", "accel_bias_x", "accel_bias_y", "sigma_drift"):
         assert data["inputs"][name] == pytest.approx(expected[name], rel=1e-12), name
     assert data["inputs"]["imu"] == "tactical" and plain["inputs"]["drift_east"] == 0.0
@@ -178,7 +180,7 @@ def test_imu_on_calibrate_north_and_errors(run_cli, tmp_path):
     assert north.code == 0, north.stderr
     step = north.json()["inputs"]["output_step"]
     assert north.json()["inputs"]["readout_noise"] == pytest.approx(
-        north_inputs(preset("navigation"), step_s=step).values["readout_noise"])
+        north_inputs(preset("navigation"), step=step).values["readout_noise"])
     errors = run_cli("errors", "run", "--imu", "tactical", "--source", "accelerometer", "--json")
     assert errors.code == 0, errors.stderr
     # HG1700 accelerometer: 1 mg turn-on bias and its 50 ug flicker change: ~1 mg
@@ -196,8 +198,8 @@ def test_imu_option_errors(run_cli):
     assert out.code == 2 and "--imu-window: applies with --imu only" in out.stderr
     out = run_cli("north", "run", "--imu", "nothing.toml")
     assert out.code == 2 and "--imu: 'nothing.toml' is neither a grade" in out.stderr
-    out = run_cli("vertical", "run", "--imu", "tactical")
-    assert out.code == 2 and "No such option '--imu'" in out.stderr
+    out = run_cli("vertical", "run", "--imu-window", "1 h")
+    assert out.code == 2 and "--imu-window: applies with --imu only" in out.stderr
 
 
 @pytest.mark.skipif(not HAS_PSINS, reason="set SCHULER_PSINS_IMU to the PSINS lasergyro.imu file to run")

@@ -61,7 +61,7 @@ def test_simulated_white_noise_has_the_per_sample_std():
 
     n, dt = 3.6361e-5, 0.005
     gyro, _ = simulate_members(ErrorModel(gyro=SensorErrors(random_walk=n)), samples=200_000,
-                               sample_interval_s=dt, members=1, seed=4)
+                               sample_interval=dt, members=1, seed=4)
     # 200,000 samples: the sample std is within 3 x sqrt(1/(2n)) = 0.5 % of the truth
     assert gyro[0].std(axis=0) == pytest.approx(np.full(3, n / math.sqrt(dt)), rel=0.005)
 
@@ -92,7 +92,7 @@ def test_simulated_gauss_markov_follows_its_closed_form():
 
     sigma, t, dt = 1e-5, 2.0, 0.05
     gyro, _ = simulate_members(ErrorModel(gyro=SensorErrors(gm_sigma=sigma, gm_correlation_time_s=t)),
-                               samples=400_000, sample_interval_s=dt, members=1, seed=9)
+                               samples=400_000, sample_interval=dt, members=1, seed=9)
     curve = allan_deviation(gyro[0, :, 0], dt)
     exact = np.sqrt(gauss_markov_allan_variance(curve.tau_s, sigma, t))
     # point samples of a random-walk-like process exceed the continuous formula by (1 + 1/(2 m^2)) in

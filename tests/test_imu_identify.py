@@ -58,7 +58,7 @@ def test_too_few_points_is_an_identification_error():
 def test_fast_round_trip_tactical():
     # 30 min at 100 Hz: N (0.125 deg/sqrt(h)) and the accelerometer B are resolved, each within 3 sigma
     # plus the method's bias on the exact model curve
-    result = round_trip("tactical", duration_s=1800.0, sample_interval_s=0.01, seed=1)
+    result = round_trip("tactical", duration=1800.0, sample_interval=0.01, seed=1)
     assert result.all_within
     n_checks = [c for c in result.checks if c.term == "N"]
     assert len(n_checks) == 6
@@ -78,7 +78,7 @@ ROUND_TRIP_MODEL = ErrorModel(
 @pytest.mark.parametrize("seed, duration_s, dt", [(1, 3600.0, 0.01), (2, 3600.0, 0.01), (3, 7200.0, 0.02),
                                                   (4, 1200.0, 0.0025), (5, 4 * 3600.0, 0.05)])
 def test_round_trips_over_seeds_durations_and_rates(seed, duration_s, dt):
-    result = round_trip(ROUND_TRIP_MODEL, duration_s=duration_s, sample_interval_s=dt, seed=seed)
+    result = round_trip(ROUND_TRIP_MODEL, duration=duration_s, sample_interval=dt, seed=seed)
     assert result.all_within, str(result)
     terms = {c.term for c in result.checks}
     assert {"Q", "N"} <= terms          # always resolved
@@ -96,7 +96,7 @@ def test_reported_sigma_covers_the_scatter_on_fresh_seeds():
     model = ROUND_TRIP_MODEL.gyro
     scores = {"Q": [], "N": []}
     for member in range(8):
-        gyro, _ = simulate_members(ErrorModel(gyro=model), samples=360_000, sample_interval_s=0.01,
+        gyro, _ = simulate_members(ErrorModel(gyro=model), samples=360_000, sample_interval=0.01,
                                    members=[member], seed=4242)
         for axis in range(3):
             curve = allan_deviation(gyro[0, :, axis], 0.01)
@@ -109,7 +109,7 @@ def test_reported_sigma_covers_the_scatter_on_fresh_seeds():
 
 def test_short_record_leaves_rate_random_walk_unresolved_under_its_bound():
     model = ErrorModel(gyro=SensorErrors(random_walk=1e-4, rate_random_walk=1e-8))
-    record = simulate_record(model, duration_s=120.0, sample_interval_s=0.01, seed=3)
+    record = simulate_record(model, duration=120.0, sample_interval=0.01, seed=3)
     terms = analyse_record(record).noise["gyro_x"].terms
     assert terms.resolved["N"] and not terms.resolved["K"]
     assert terms.upper_bound["K"] >= 1e-8
@@ -120,7 +120,7 @@ def test_gauss_markov_sigma_for_a_bias_instability_gives_its_floor():
     b, t, dt = 2e-5, 1.0, 0.02
     sigma = gauss_markov_for_bias_instability(b)
     gyro, _ = simulate_members(ErrorModel(gyro=SensorErrors(gm_sigma=sigma, gm_correlation_time_s=t)),
-                               samples=300_000, sample_interval_s=dt, members=1, seed=8)
+                               samples=300_000, sample_interval=dt, members=1, seed=8)
     curve = allan_deviation(gyro[0, :, 0], dt, lags=np.unique(np.geomspace(20, 400, 25).astype(int)))
     peak = curve.adev.max()
     # near the peak (tau ~ 1.9 s, ~100 lags) the edf is ~1e4: 2 % covers the estimate and the grid
@@ -138,12 +138,12 @@ def test_a_least_squares_fit_of_a_gauss_markov_bump_is_not_the_peak_read_off():
 
 @pytest.mark.parametrize("grade", ["tactical", "industrial", "consumer"])
 def test_a_clean_record_of_a_grade_is_classified_as_it(grade):
-    record = simulate_record(preset(grade), duration_s=1200.0, sample_interval_s=0.01, seed=6)
+    record = simulate_record(preset(grade), duration=1200.0, sample_interval=0.01, seed=6)
     assert analyse_record(record).grade == grade
 
 
 def test_identified_terms_become_an_error_model():
-    record = simulate_record(preset("industrial"), duration_s=600.0, sample_interval_s=0.01, seed=2)
+    record = simulate_record(preset("industrial"), duration=600.0, sample_interval=0.01, seed=2)
     result = analyse_record(record)
     model = model_from_analysis(result)
     assert model.gyro.random_walk[1] == result.noise["gyro_y"].terms.values["N"]
@@ -152,7 +152,7 @@ def test_identified_terms_become_an_error_model():
 
 
 def test_allan_result_json_keys_and_units():
-    record = simulate_record(preset("tactical"), duration_s=120.0, sample_interval_s=0.01, seed=2)
+    record = simulate_record(preset("tactical"), duration=120.0, sample_interval=0.01, seed=2)
     data = analyse_record(record).to_dict()
     gyro_x = data["noise"]["gyro_x"]
     assert {"N", "B", "K", "Q", "R", "tau_s", "adev", "adev_lower", "adev_upper", "edf"} <= set(gyro_x)

@@ -33,14 +33,14 @@ TRUTH = static_truth(math.radians(50.0), math.radians(30.0))
 
 @pytest.fixture(scope="module")
 def whole():
-    return simulate_members(every_term_model(), samples=9000, sample_interval_s=0.01, members=[0, 1, 2, 5], seed=11,
-                            true_gyro_rad_s=TRUTH[0], true_accel_m_s2=TRUTH[1])
+    return simulate_members(every_term_model(), samples=9000, sample_interval=0.01, members=[0, 1, 2, 5], seed=11,
+                            true_gyro=TRUTH[0], true_accel=TRUTH[1])
 
 
 @settings(max_examples=5, deadline=None)
 @given(window=st.integers(min_value=700, max_value=9000), member_chunk=st.integers(min_value=1, max_value=4))
 def test_any_cut_in_time_and_members_gives_the_same_samples(whole, window, member_chunk):
-    simulator = ImuSimulator(every_term_model(), 0.01, true_gyro_rad_s=TRUTH[0], true_accel_m_s2=TRUTH[1], seed=11)
+    simulator = ImuSimulator(every_term_model(), 0.01, true_gyro=TRUTH[0], true_accel=TRUTH[1], seed=11)
     gyro, accel = np.empty_like(whole[0]), np.empty_like(whole[1])
     members = np.array([0, 1, 2, 5])
     for group, start, g, a in iter_simulation(simulator, members, 9000, window=window, member_chunk=member_chunk):
@@ -51,7 +51,7 @@ def test_any_cut_in_time_and_members_gives_the_same_samples(whole, window, membe
 
 
 def test_windows_out_of_order_and_threads_give_the_same_samples(whole):
-    simulator = ImuSimulator(every_term_model(), 0.01, true_gyro_rad_s=TRUTH[0], true_accel_m_s2=TRUTH[1], seed=11,
+    simulator = ImuSimulator(every_term_model(), 0.01, true_gyro=TRUTH[0], true_accel=TRUTH[1], seed=11,
                              workers=2)
     late, _ = simulator.window([5, 0], 6000, 9000)
     early, _ = simulator.window([5, 0], 0, 6000)
@@ -59,8 +59,8 @@ def test_windows_out_of_order_and_threads_give_the_same_samples(whole):
 
 
 def test_members_and_seeds_differ(whole):
-    other, _ = simulate_members(every_term_model(), samples=100, sample_interval_s=0.01, members=[0], seed=12,
-                                true_gyro_rad_s=TRUTH[0], true_accel_m_s2=TRUTH[1])
+    other, _ = simulate_members(every_term_model(), samples=100, sample_interval=0.01, members=[0], seed=12,
+                                true_gyro=TRUTH[0], true_accel=TRUTH[1])
     assert not np.array_equal(whole[0][0, :100], whole[0][1, :100])
     assert not np.array_equal(whole[0][0, :100], other[0])
 
@@ -72,7 +72,7 @@ def test_quantised_increments_are_whole_steps(whole):
 
 
 def test_static_truth_is_earth_rate_and_gravity_in_the_body_frame():
-    gyro, accel = static_truth(math.radians(50.0), math.radians(90.0), gravity_m_s2=9.81)
+    gyro, accel = static_truth(math.radians(50.0), math.radians(90.0), gravity=9.81)
     omega = 7.292115e-5
     # heading 90 deg: x points east (no north rate), y points south (-Omega cos L), z down (-Omega sin L)
     assert gyro == pytest.approx([0.0, -omega * math.cos(math.radians(50)), -omega * math.sin(math.radians(50))],
@@ -94,7 +94,7 @@ def test_constants_are_drawn_per_member_with_the_model_sigmas():
 
 def test_deterministic_errors_follow_the_measurement_equation():
     model = ErrorModel(gyro=SensorErrors(bias=1e-5, scale_factor=1e-3, misalignment=1e-3, g_sensitivity=1e-5))
-    simulator = ImuSimulator(model, 0.01, true_gyro_rad_s=TRUTH[0], true_accel_m_s2=TRUTH[1], seed=5)
+    simulator = ImuSimulator(model, 0.01, true_gyro=TRUTH[0], true_accel=TRUTH[1], seed=5)
     gyro, accel = simulator.window([7], 0, 10)
     c = simulator.constants([7])
     expected = c["gyro_matrix"][0] @ TRUTH[0] + c["gyro_bias"][0] + c["gyro_g"][0] @ TRUTH[1]
@@ -104,7 +104,7 @@ def test_deterministic_errors_follow_the_measurement_equation():
 
 def test_time_varying_truth_and_its_length():
     truth = np.column_stack([np.linspace(0, 1, 50), np.zeros(50), np.zeros(50)])
-    simulator = ImuSimulator(ErrorModel(), 0.1, true_gyro_rad_s=truth, seed=0)
+    simulator = ImuSimulator(ErrorModel(), 0.1, true_gyro=truth, seed=0)
     gyro, _ = simulator.window([0], 10, 20)
     assert gyro[0, :, 0] == pytest.approx(truth[10:20, 0])
     with pytest.raises(InvalidParameter, match="cover 50 samples"):
@@ -120,15 +120,15 @@ def test_slow_processes_use_a_coarse_grid_only_under_white_noise():
 
 def test_memory_is_estimated_before_allocating():
     with pytest.raises(InvalidParameter, match="GB, above"):
-        simulate_members(preset("tactical"), samples=10**9, sample_interval_s=0.01, members=100)
+        simulate_members(preset("tactical"), samples=10**9, sample_interval=0.01, members=100)
 
 
 def test_streamed_file_equals_the_in_memory_record(tmp_path):
     from schuler.imu.simulate import simulate_record
 
-    path = write_simulation(tmp_path / "s.parquet", preset("industrial"), duration_s=30.0, sample_interval_s=0.01,
+    path = write_simulation(tmp_path / "s.parquet", preset("industrial"), duration=30.0, sample_interval=0.01,
                             seed=4)
-    record = simulate_record(preset("industrial"), duration_s=30.0, sample_interval_s=0.01, seed=4)
+    record = simulate_record(preset("industrial"), duration=30.0, sample_interval=0.01, seed=4)
     streamed = read_record(path)
     assert np.array_equal(streamed.gyro, record.gyro) and np.array_equal(streamed.time_s, record.time_s)
 
@@ -169,7 +169,7 @@ SLOW_MODEL = ErrorModel(accel=SensorErrors(random_walk=1e-3, gm_sigma=2e-4, gm_c
 def test_slow_processes_are_their_grid_values_interpolated_linearly():
     """The channel equals white noise plus each process drawn as documented and interpolated with np.interp."""
     dt, samples, seed, member = 0.01, 2 * BLOCK + 777, 21, 3
-    accel = simulate_members(SLOW_MODEL, samples=samples, sample_interval_s=dt, members=[member], seed=seed)[1]
+    accel = simulate_members(SLOW_MODEL, samples=samples, sample_interval=dt, members=[member], seed=seed)[1]
     errors = SLOW_MODEL.accel
     steps = ImuSimulator(SLOW_MODEL, dt).coarse_steps()
     sigmas, times = flicker_terms(errors.bias_instability[0], errors.flicker_tau_range_s)
@@ -204,7 +204,7 @@ def test_slow_processes_are_their_grid_values_interpolated_linearly():
 @given(window=st.sampled_from([BLOCK - 1, BLOCK, 50_000, 100_003]), first=st.integers(min_value=1, max_value=BLOCK))
 def test_slow_processes_over_blocks_do_not_depend_on_the_windows(window, first):
     samples = 2 * BLOCK + 5000
-    whole = simulate_members(SLOW_MODEL, samples=samples, sample_interval_s=0.01, members=[0, 4], seed=2)[1]
+    whole = simulate_members(SLOW_MODEL, samples=samples, sample_interval=0.01, members=[0, 4], seed=2)[1]
     simulator = ImuSimulator(SLOW_MODEL, 0.01, seed=2)
     cuts = [0, first, *range(first + window, samples, window), samples]
     pieces = [simulator.window([0, 4], start, stop)[1] for start, stop in zip(cuts[:-1], cuts[1:])]
@@ -221,7 +221,7 @@ def test_slow_processes_draw_only_their_grid_points(monkeypatch):
 
     monkeypatch.setattr(RandomStreams, "normal_block", counted)
     samples = 3 * BLOCK
-    simulate_members(preset("tactical"), samples=samples, sample_interval_s=0.01, members=1)
+    simulate_members(preset("tactical"), samples=samples, sample_interval=0.01, members=1)
     steps = np.array(list(ImuSimulator(preset("tactical"), 0.01).coarse_steps().values()))
     # one initial value per process, then one innovation per grid point after sample 0
     assert sum(drawn) == steps.size + np.sum(samples // steps)
@@ -234,7 +234,7 @@ def test_allan_deviation_of_the_coarse_grid_simulation_follows_the_model(sensor)
     from schuler.imu.allan import allan_deviation
 
     model, dt = preset("tactical"), 0.01
-    gyro, accel = simulate_members(model, samples=360_000, sample_interval_s=dt, members=[1], seed=5)
+    gyro, accel = simulate_members(model, samples=360_000, sample_interval=dt, members=[1], seed=5)
     rates = {"gyro": gyro, "accel": accel}[sensor][0]
     errors = getattr(model, sensor)
     for axis in range(3):

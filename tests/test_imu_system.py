@@ -16,7 +16,7 @@ from schuler.contract import monte_carlo
 from schuler.core.earth import EARTH_RATE
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter, SchulerError
-from schuler.imu import evaluation
+from schuler.imu import actions, evaluation
 from schuler.imu.api import SYSTEM
 from schuler.imu.reproduction import PSINS_ENVIRONMENT, reproduce
 from schuler.imu.static import static_attitude
@@ -50,7 +50,7 @@ def test_the_nominal_record_is_monte_carlo_member_zero_of_seed_zero():
 
 
 def test_outputs_are_the_identified_terms_and_nan_where_not_resolved():
-    result = SYSTEM.run(grade="tactical", **SHORT)
+    result = SYSTEM.run(imu="tactical", **SHORT)
     truth = math.radians(0.125) / 60  # HG1700 ARW 0.125 deg/sqrt(h) in rad/sqrt(s)
     for axis in "xyz":
         # 5 min at 100 Hz: N is known to ~0.5 % (3 sigma + method bias ~ 1.5 %)
@@ -77,15 +77,21 @@ def test_a_spec_file_is_simulated_and_identified(tmp_path):
     spec = tmp_path / "part.toml"
     spec.write_text('name = "test part"\n[gyro]\nrandom_walk = "0.3 deg/sqrt(h)"\n'
                     '[accel]\nrandom_walk = "100 ug/sqrt(Hz)"\n', encoding="utf-8")
-    result = SYSTEM.run(spec=str(spec), **SHORT)
+    result = SYSTEM.run(imu=str(spec), **SHORT)
     assert result.model == "test part"
     assert result.outputs["noise_gyro_y_N"] == pytest.approx(math.radians(0.3) / 60, rel=0.015)
     assert result.outputs["noise_accel_z_N"] == pytest.approx(100e-6 * 9.80665, rel=0.015)
     assert math.isnan(result.outputs["noise_gyro_y_B"])  # no bias instability in the spec
-    with pytest.raises(InvalidParameter, match="grade: cannot be combined with spec"):
-        SYSTEM.run(grade="tactical", spec=str(spec))
-    with pytest.raises(SchulerError, match="missing.toml: cannot read"):
-        SYSTEM.run(spec=str(tmp_path / "missing.toml"), **SHORT)
+    for old in ("grade", "spec"):  # the one IMU parameter of every system, the old names refused
+        with pytest.raises(InvalidParameter, match=f"{old}: renamed to 'imu'"):
+            SYSTEM.run(**{old: str(spec)})
+    with pytest.raises(SchulerError, match="missing.toml' is neither a grade"):
+        SYSTEM.run(imu=str(tmp_path / "missing.toml"), **SHORT)
+    # a recording stands for the model of its identified terms: simulated and identified again
+    recording = tmp_path / "part.parquet"
+    actions.simulate(recording, imu=str(spec), duration=1800.0, imu_rate=100.0, seed=3)
+    again = SYSTEM.run(imu=str(recording), **SHORT)
+    assert again.outputs["noise_gyro_y_N"] == pytest.approx(math.radians(0.3) / 60, rel=0.03)
 
 
 def test_too_short_records_and_memory_are_refused_before_simulating(budget):
@@ -93,7 +99,7 @@ def test_too_short_records_and_memory_are_refused_before_simulating(budget):
         SYSTEM.run(duration=1.0)
     # 30 days at 1 kHz: 2.6e9 samples, ~660 GB: refused at once, nothing allocated
     with pytest.raises(SchulerError, match=r"this record would hold .* more than the memory budget of 64 MiB; "
-                                           r"change --duration or --imu-rate"):
+                                           r"change `duration` or `imu_rate`"):
         SYSTEM.run(duration=30 * 86400.0, imu_rate=1000.0)
     case = SYSTEM.case(duration=3600.0, imu_rate=100.0)
     assert SYSTEM.member_bytes(case) == 360_000 * evaluation.BYTES_PER_SAMPLE
@@ -103,7 +109,7 @@ def test_too_short_records_and_memory_are_refused_before_simulating(budget):
 def test_round_trip_over_seeds_and_rates_through_the_system():
     # the system's Monte Carlo: 6 records per rate, industrial grade (N and B resolved in 20 min)
     for rate in (50.0, 200.0):
-        summary = SYSTEM.monte_carlo(SYSTEM.case(grade="industrial", duration=1200.0, imu_rate=rate), 6,
+        summary = SYSTEM.monte_carlo(SYSTEM.case(imu="industrial", duration=1200.0, imu_rate=rate), 6,
                                      RandomStreams(3))
         stats = summary.statistics["fraction_within_tolerance"]
         assert stats["min"] == 1.0, (rate, stats)

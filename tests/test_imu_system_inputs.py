@@ -38,7 +38,7 @@ def test_platform_drift_is_minus_the_bias_resolved_in_ned():
     assert inputs.values["sigma_drift_z"] == pytest.approx(3e-6)
     assert inputs.values["sigma_accel"] == pytest.approx(math.sqrt((1e-6 + 4e-6) / 2))
     # heading 90 deg: body x = east, y = south
-    turned = align_inputs(constant_bias_model(), heading_rad=math.pi / 2, calibrated_gyros=False)
+    turned = align_inputs(constant_bias_model(), heading=math.pi / 2, calibrated_gyros=False)
     assert turned.values["drift_east"] == pytest.approx(-1e-6)
     assert turned.values["drift_north"] == pytest.approx(2e-6)
     assert turned.sigmas["drift_north"] == pytest.approx(2e-6) and turned.sigmas["drift_east"] == pytest.approx(1e-6)
@@ -49,7 +49,7 @@ def test_the_mapping_names_the_ported_systems_parameters():
 
     tactical = preset("tactical")
     mapped = {"align": align_inputs(tactical), "calibrate": calibrate_inputs(tactical),
-              "north": north_inputs(tactical, step_s=1.0)}
+              "north": north_inputs(tactical, step=1.0)}
     for name, inputs in mapped.items():
         parameters = get_system(name).parameters
         assert set(inputs.values) <= set(parameters.names), (name, set(inputs.values) - set(parameters.names))
@@ -59,7 +59,7 @@ def test_the_mapping_names_the_ported_systems_parameters():
     # errors: one magnitude per source of the system
     from schuler.navigation_errors.single_channel import SOURCES
 
-    assert set(errors_inputs(tactical, latitude_rad=0.8).values) == set(SOURCES)
+    assert set(errors_inputs(tactical, latitude=0.8).values) == set(SOURCES)
 
 
 def test_calibration_removes_the_turn_on_gyro_bias_but_not_the_accelerometer_one():
@@ -88,10 +88,10 @@ def test_calibrate_north_and_errors_inputs():
     skewed = calibrate_inputs(ErrorModel(gyro=SensorErrors(bias=(1e-6, 2e-6, 0.0), random_walk=(3e-6, 4e-6, 0.0))))
     assert (skewed.values["drift_x"], skewed.values["drift_y"]) == pytest.approx((-2e-6, -1e-6))
     assert skewed.values["angle_random_walk"] == pytest.approx(math.sqrt((9e-12 + 16e-12) / 2))
-    north = north_inputs(ErrorModel(gyro=SensorErrors(random_walk=2e-5, quantization=3e-6)), step_s=4.0)
+    north = north_inputs(ErrorModel(gyro=SensorErrors(random_walk=2e-5, quantization=3e-6)), step=4.0)
     assert north.values["readout_noise"] == pytest.approx(math.sqrt(9e-12 + 4e-10 * 4.0))
     latitude = math.radians(60.0)
-    errors = errors_inputs(constant_bias_model(accel_bias=(3e-3, 4e-3, 0.0)), latitude_rad=latitude)
+    errors = errors_inputs(constant_bias_model(accel_bias=(3e-3, 4e-3, 0.0)), latitude=latitude)
     bias = math.sqrt((9e-6 + 16e-6) / 2)
     assert errors.values["accelerometer"] == pytest.approx(bias)
     assert errors.values["tilt"] == pytest.approx(bias / 9.80665)
@@ -101,15 +101,15 @@ def test_calibrate_north_and_errors_inputs():
 
 
 def test_first_order_scaling_halves_every_input():
-    full = align_inputs(preset("industrial"), heading_rad=0.4)
-    half = align_inputs(preset("industrial").scaled(0.5), heading_rad=0.4)
+    full = align_inputs(preset("industrial"), heading=0.4)
+    half = align_inputs(preset("industrial").scaled(0.5), heading=0.4)
     for name, value in full.values.items():
         assert half.values[name] == pytest.approx(value / 2)
 
 
 def test_bad_arguments():
     with pytest.raises(InvalidParameter, match="window"):
-        align_inputs(preset("tactical"), window_s=0.0)
+        align_inputs(preset("tactical"), window=0.0)
     with pytest.raises(InvalidParameter, match="latitude"):
-        errors_inputs(preset("tactical"), latitude_rad=math.pi / 2)
+        errors_inputs(preset("tactical"), latitude=math.pi / 2)
     assert "drift_east" in str(align_inputs(preset("tactical")))

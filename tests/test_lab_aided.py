@@ -12,6 +12,7 @@ import pytest
 from schuler.aided.evaluation import AIDING
 from schuler.imu.spec import GRADES
 from schuler.lab import controls, figures, system_page
+from schuler.navigate.evaluation import TRAJECTORIES
 from schuler.registry import get_system
 from test_lab import attribute, walk
 
@@ -36,6 +37,8 @@ def test_the_page_offers_the_grades_and_the_aiding_names_of_the_parameters():
     assert controls_found == [*AIDED.parameters.names, "monte_carlo", "seed"]
     (suggestions,) = [c for c in walk(_control(page, "imu")) if type(c).__name__ == "Datalist"]
     assert [option.value for option in suggestions.children] == list(GRADES)
+    (paths,) = [c for c in walk(_control(page, "trajectory")) if type(c).__name__ == "Datalist"]
+    assert [option.value for option in paths.children] == list(TRAJECTORIES)
     (boxes,) = [c for c in walk(_control(page, "aiding")) if type(c).__name__ == "Checklist"]
     assert boxes.options == list(AIDING) and boxes.value == []  # none ticked: not set, both GNSS measurements
     for name in ("gnss_rate", "outage_start", "outage_duration", "initialisation"):
@@ -58,6 +61,17 @@ def test_a_typed_run_is_the_api_s(result):
                          aiding="gnss-position")
     assert result.outputs == expected.outputs
     assert result.outages[0]["start_s"] == 120.0 and result.outages[0]["duration_s"] == 45.0
+
+
+def test_a_typed_trajectory_runs_as_the_api_s():
+    typed = {"duration": "300", "outage_start": "120", "trajectory": "great-circle", "speed": "120",
+             "heading": "45", "imu": "tactical"}
+    ran = system_page.run_typed(AIDED, typed)
+    expected = AIDED.run(duration=300.0, outage_start=120.0, trajectory="great-circle", speed=120.0,
+                         heading=math.radians(45.0), imu="tactical")
+    assert ran.outputs == expected.outputs
+    drive = AIDED.run(duration=300.0, outage_start=120.0, imu="tactical")
+    assert ran.outputs != drive.outputs
 
 
 def test_the_error_figure_draws_three_sigma_and_shades_the_outage(result):

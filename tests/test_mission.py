@@ -26,7 +26,7 @@ def setup_of(**values):
 
 
 MISSIONS = {
-    "kalman-cruise": {"imu": "tactical", "trajectory": "cruise", "duration": 3600.0},
+    "kalman-cruise": {"imu": "tactical", "trajectory": "great-circle", "duration": 3600.0},
     "gyrocompass-stationary": {"imu": "navigation", "alignment": "gyrocompass", "trajectory": "stationary",
                                "duration": 7200.0, "alignment_duration": 900.0},
     "ground-flight": {"imu": "industrial", "alignment": "ground-gyrocompass", "calibration": "multi-position",
@@ -95,7 +95,7 @@ def test_calibration_residuals_follow_their_closed_forms():
 
 
 def test_the_monte_carlo_starts_from_the_attitude_error_the_covariance_assumes():
-    setup = setup_of(imu="tactical", trajectory="cruise", duration=600.0, heading=math.radians(30.0))
+    setup = setup_of(imu="tactical", trajectory="great-circle", duration=600.0, heading=math.radians(30.0))
     trajectory = setup.trajectory()
     q0 = trajectory.kinematics(np.array([0.0]))[1][0]
     members = np.arange(6)
@@ -131,7 +131,7 @@ LONG_MISSIONS = {
                        "alignment_duration": 900.0, "output_step": 600.0, "imu_rate": 0.5},
     "flight-2h": {"imu": "navigation", "trajectory": "flight", "duration": 7200.0, "alignment_duration": 900.0,
                   "imu_rate": 1.0},
-    "cruise-10h": {"imu": "navigation", "trajectory": "cruise", "duration": 36000.0, "alignment_duration": 900.0,
+    "cruise-10h": {"imu": "navigation", "trajectory": "great-circle", "duration": 36000.0, "alignment_duration": 900.0,
                    "output_step": 600.0, "imu_rate": 0.5},
 }
 """The issue's three missions; reduced IMU rates (exact for the noise increments, ample for the smooth paths)."""

@@ -52,7 +52,7 @@ def test_a_batch_of_budgets_is_each_budget_alone(batch_steps, monkeypatch):
     headings = np.radians([0.0, 75.0, 200.0])
     setups = [setup_of(imu="tactical", trajectory="flight", duration=2400.0, heading=h) for h in headings]
     setups.append(setup_of(imu="consumer", alignment="ground-gyrocompass", calibration="multi-position",
-                           trajectory="cruise", duration=2400.0, speed=20.0))
+                           trajectory="great-circle", duration=2400.0, speed=20.0))
     for batched, setup in zip(covariance_budgets(setups), setups):
         alone = covariance_budget(setup)
         for channel in ("horizontal_position", "horizontal_velocity", "heading"):

@@ -62,7 +62,7 @@ def white_imu(tmp_path_factory):
     folder = tmp_path_factory.mktemp("instrument")
     spec = folder / "white.toml"
     spec.write_text(WHITE_SPEC)
-    record = simulate_record(load_spec_file(spec), duration_s=120.0, sample_interval_s=0.01, seed=7)
+    record = simulate_record(load_spec_file(spec), duration=120.0, sample_interval=0.01, seed=7)
     return spec, write_record(record, folder / "white.csv")
 
 

@@ -108,3 +108,21 @@ def test_the_drive_is_navigates_drive_and_its_covariance_agrees_with_the_nonline
 def test_a_drive_too_short_for_its_stops_is_refused_by_duration():
     with pytest.raises(InvalidParameter, match="^duration: 120 s is too short: 4 stops of 25 s"):
         SYSTEM.run(trajectory="drive", duration=120.0)
+
+
+def test_the_geodesic_is_navigates_great_circle_and_the_former_name_is_refused_naming_it(run_cli):
+    """One trajectory vocabulary: mission's geodesic is navigate's ``great-circle``, the same path from one start."""
+    from schuler.navigate.evaluation import DRIVE_OPTIONS, trajectory_of
+
+    setup = mission_setup(PARAMETERS.case({"trajectory": "great-circle", "duration": 600.0, "speed": 200.0}))
+    ours = setup.trajectory()
+    theirs, _ = trajectory_of("great-circle", {"latitude": setup.latitude, "longitude": setup.longitude,
+                                               "height": setup.height, "heading": setup.heading, "speed": 200.0,
+                                               "duration": 600.0, **dict.fromkeys(DRIVE_OPTIONS)})
+    times = np.linspace(0.0, 600.0, 7)
+    for mine, navigates in zip(ours.kinematics(times), theirs.kinematics(times), strict=True):
+        np.testing.assert_allclose(mine, navigates, rtol=0.0, atol=1e-12)  # velocity m/s, attitude quaternion
+    with pytest.raises(InvalidParameter, match="^trajectory: 'cruise' is renamed to 'great-circle'"):
+        SYSTEM.run(trajectory="cruise")
+    out = run_cli("mission", "run", "--trajectory", "cruise", "--json")
+    assert out.code == 2 and "renamed to 'great-circle'" in out.stderr

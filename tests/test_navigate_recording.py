@@ -32,8 +32,8 @@ SITE = ("--latitude", "45", "--heading", "30", "--output-step", "10")
 
 def _record(model, path: Path, seed: int = 11) -> Path:
     """90 s at 50 Hz of a level IMU at rest at 45 deg, heading 30 deg, written to the project's CSV."""
-    record = simulate_record(model, duration_s=90.0, sample_interval_s=0.02, seed=seed, latitude_rad=LATITUDE,
-                             heading_rad=HEADING)
+    record = simulate_record(model, duration=90.0, sample_interval=0.02, seed=seed, latitude=LATITUDE,
+                             heading=HEADING)
     return write_record(record, path / "static.csv")
 
 

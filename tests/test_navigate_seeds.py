@@ -7,15 +7,16 @@ import math
 import numpy as np
 import pytest
 
+from schuler.core.gyrocompass_design import loop_gains
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
-from schuler.gyrocompassing.analytic import full_steady_state, gains_from_design
+from schuler.gyrocompassing.analytic import full_steady_state
 from schuler.gyrocompassing.models import full_mu_nu_model, initial_state
 from schuler.navigate.alignment import gyrocompass_alignment, kpi_gyrocompassing
 from schuler.navigate.seeds import bollay_error_sources, drozdovich_worked_example
 
 LATITUDE = math.radians(50.0)
-C_GAMMA, C_A = (float(x) for x in gains_from_design(30.0, 0.8, LATITUDE))
+C_GAMMA, C_A = (float(x) for x in loop_gains(LATITUDE, 30.0, 0.8))
 MICRO_G = 9.80665e-6
 
 

@@ -157,8 +157,8 @@ def test_imu_noise_is_the_imu_layers_simulation():
     members = np.array([3, 7])
     first = noise.increments(members, 0, 600, 0.01)
     second = noise.increments(members, 600, 1000, 0.01)
-    gyro, accel = simulate_members(imu_noise.noise_model(model), samples=1000, sample_interval_s=0.01,
-                                   members=members, seed=9, true_gyro_rad_s=rate, true_accel_m_s2=force)
+    gyro, accel = simulate_members(imu_noise.noise_model(model), samples=1000, sample_interval=0.01,
+                                   members=members, seed=9, true_gyro=rate, true_accel=force)
     np.testing.assert_allclose(np.concatenate([first[0], second[0]], axis=1), (gyro - rate) * 0.01,
                                rtol=0, atol=1e-18)
     np.testing.assert_allclose(np.concatenate([first[1], second[1]], axis=1), (accel - force) * 0.01,
@@ -221,7 +221,7 @@ def test_memory_is_refused_before_allocating(monkeypatch):
     memory._budget_from_environment.cache_clear()
     tracemalloc.start()
     try:
-        with pytest.raises(MemoryBudgetExceeded, match="change --duration or --output-step"):
+        with pytest.raises(MemoryBudgetExceeded, match="change `duration` or `output_step`"):
             SYSTEM.run(duration=86400.0, output_step=0.01)  # 8.6 million outputs of 23 values
         peak = tracemalloc.get_traced_memory()[1]
     finally:

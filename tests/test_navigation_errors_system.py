@@ -12,6 +12,7 @@ import pytest
 from schuler import get_system
 from schuler.contract import Cases, monte_carlo
 from schuler.core.earth import BOLLAY, FOOT, MEAN_RADIUS, STANDARD_GRAVITY, STATUTE_MILE
+from schuler.core.geometry import grid_points, time_grid
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
 from schuler.memory import MemoryBudgetExceeded
@@ -23,7 +24,7 @@ from schuler.navigation_errors.actions import (
 )
 from schuler.navigation_errors.api import SYSTEM
 from schuler.navigation_errors.evaluation import OUTPUTS, PARAMETERS, evaluate
-from schuler.navigation_errors.inputs import FLIGHT_TIME, grid_points, time_grid
+from schuler.navigation_errors.inputs import FLIGHT_TIME
 from schuler.navigation_errors.reproduction import plot
 from schuler.navigation_errors.single_channel import SOURCES
 
@@ -254,7 +255,7 @@ def test_a_monte_carlo_needs_random_terms_or_drawn_parameters():
 
 def test_memory_is_refused_before_allocating(monkeypatch):
     monkeypatch.setenv("SCHULER_MEMORY_BUDGET", "64 MiB")
-    with pytest.raises(MemoryBudgetExceeded, match="--duration or --output-step"):
+    with pytest.raises(MemoryBudgetExceeded, match="`duration` or `output_step`"):
         SYSTEM.run(duration=1e9, output_step=1e-3)
     # the closed fidelity evaluates without a grid: a sweep of such cases stays small
     out = SYSTEM.evaluate_values({"duration": 1e9, "output_step": 1e-3}, fidelity="closed")

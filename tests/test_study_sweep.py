@@ -85,9 +85,9 @@ def test_axis_units_lists_and_errors():
     assert parse_axis("method=closed,table", fake.PARAMETERS).values.tolist() == ["closed", "table"]
     assert parse_axis("members=1:7:3", fake.PARAMETERS).values.tolist() == [1, 4, 7]
     for text, message in [
-        ("colour=1:2:1", "--param colour: unknown parameter"),
+        ("colour=1:2:1", "`param` colour: unknown parameter"),
         ("latitude", "expected NAME=START:STOP:STEP"),
-        ("latitude=0:100:10", "--param latitude: 100.0 is outside [-89, 89] deg"),
+        ("latitude=0:100:10", "`param` latitude: 100.0 is outside [-89, 89] deg"),
         ("latitude=0:10", "is not START:STOP:STEP"),
         ("latitude=0:10:0", "the step must be a finite non-zero number"),
         ("latitude=0:10:-1", "the step goes away from the stop value"),
@@ -102,12 +102,12 @@ def test_plan_counts_cases_and_refuses_inconsistent_requests(scenario):
     plan = plan_sweep(scenario, fake.FAKE, GRID, monte_carlo=5, chunk_size=8)
     assert plan.grid_shape == (7, 2) and plan.total == 70 and plan.chunks == 9
     assert plan.chunk_range(8) == (64, 70)
-    with pytest.raises(ScenarioError, match="--param latitude: given more than once"):
+    with pytest.raises(ScenarioError, match="`param` latitude: given more than once"):
         plan_sweep(scenario, fake.FAKE, ("latitude=0:1:1", "latitude=2,3"))
-    with pytest.raises(ScenarioError, match="--param gain: already random"):
+    with pytest.raises(ScenarioError, match="`param` gain: already random"):
         plan_sweep(scenario, fake.FAKE, ("gain=1,2",), monte_carlo=3)
     plain = parse_scenario('system = "fake"\n')
-    with pytest.raises(ScenarioError, match="--monte-carlo: the scenario has no random parameters"):
+    with pytest.raises(ScenarioError, match="`monte_carlo`: the scenario has no random parameters"):
         plan_sweep(plain, fake.FAKE, (), monte_carlo=3)
 
 

@@ -32,10 +32,10 @@ from schuler.study.plan import plan_sweep
 from schuler.study.scenario import parse_scenario
 
 LONG_RUNS = [
-    ("north", {"monte_carlo": 1_000_000_000}, "--monte-carlo"),
-    ("navigate", {"duration": 864_000.0, "imu_rate": 100_000.0}, "--imu-rate"),
-    ("navigate", {"monte_carlo": 100_000}, "--monte-carlo"),
-    ("mission", {"monte_carlo": 1_000_000}, "--monte-carlo"),
+    ("north", {"monte_carlo": 1_000_000_000}, "`monte_carlo`"),
+    ("navigate", {"duration": 864_000.0, "imu_rate": 100_000.0}, "`imu_rate`"),
+    ("navigate", {"monte_carlo": 100_000}, "`monte_carlo`"),
+    ("mission", {"monte_carlo": 1_000_000}, "`monte_carlo`"),
 ]
 """Runs that took over 90 s with neither a refusal nor an estimate, and an option the refusal must name."""
 
@@ -49,7 +49,7 @@ def test_long_runs_are_refused_with_the_estimate_in_well_under_a_second(system, 
     seconds = time.perf_counter() - started
     message = str(caught.value)
     assert "would take about" in message and "more than the time budget of 10 min" in message
-    assert option in message and "--no-time-limit" in message and "\n" not in message
+    assert option in message and "`no_time_limit`" in message and "\n" not in message
     assert seconds < 0.5
 
 

@@ -365,6 +365,6 @@ class MeasuredPace:
         elif done > self.first[0] and done < self.members:
             pace = (now - self.first[1]) / (done - self.first[0])
             require_time(pace * (self.members - done), f"{self.what} ({self.members} members; pace measured)",
-                         "--monte-carlo")
+                         "`monte_carlo`")
         if self.progress is not None:
             self.progress(done, total)

@@ -319,7 +319,7 @@ class System:
         estimate = self.work_seconds(case, members, workers=getattr(executor, "workers", 1))
         if estimate is not None:
             what = f"this {self.name} run" + (f" with {members} Monte Carlo members" if members else "")
-            require_time(estimate, what, ("--monte-carlo, " if members else "") + self._work_options())
+            require_time(estimate, what, ("`monte_carlo`, " if members else "") + self._work_options())
         summary = None
         if members:
             summary = self.monte_carlo(case, members, streams, fidelity, draw=draw, progress=progress,
@@ -376,8 +376,8 @@ class System:
         return float(self.member_seconds(case)) * (members / sharing + RUN_CASE_MEMBERS)
 
     def _work_options(self) -> str:
-        # the options that set a system's amount of work, where it has them
-        names = [p.option for p in self.parameters if p.name in ("duration", "imu_rate", "output_step")]
+        # the parameters that set a system's amount of work, where it has them (quoted: the CLI shows options)
+        names = [f"`{p.name}`" for p in self.parameters if p.name in ("duration", "imu_rate", "output_step")]
         return ", ".join(names[:-1]) + f" or {names[-1]}" if len(names) > 1 else (names or ["the case"])[0]
 
     def monte_carlo(self, case: Case, members: int, streams: RandomStreams, fidelity: str | None = None, *,

@@ -16,8 +16,8 @@ calls :func:`require_time` before it starts. The time budget is
 
 Examples
 --------
->>> require(10 * 2**20, "a small run", "--duration")  # 10 MiB: fine
->>> require(2**60, "this run", "--duration or --output-step")  # doctest: +ELLIPSIS
+>>> require(10 * 2**20, "a small run", "`duration`")  # 10 MiB: fine
+>>> require(2**60, "this run", "`duration` or `output_step`")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
 schuler.memory.MemoryBudgetExceeded: this run would hold 1 EiB, more than the memory budget ...
@@ -127,7 +127,8 @@ def require(nbytes: float, what: str, change: str) -> None:
     what : str
         What would hold them (``"this run"``).
     change : str
-        The options that reduce it (``"--duration or --output-step"``).
+        The parameters that reduce it, each quoted as `name` (``"`duration` or `output_step`"``: the command
+        line shows their options).
     """
     limit = budget()
     if nbytes > limit:
@@ -215,11 +216,11 @@ def require_time(seconds: float, what: str, change: str) -> None:
     what : str
         What would take it (``"this run (1e+09 members)"``).
     change : str
-        The options that shorten it (``"--monte-carlo or --duration"``).
+        The parameters that shorten it, each quoted as `name` (``"`monte_carlo` or `duration`"``).
 
     Examples
     --------
-    >>> require_time(1e7, "this run", "--monte-carlo")  # doctest: +ELLIPSIS
+    >>> require_time(1e7, "this run", "`monte_carlo`")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     schuler.memory.TimeBudgetExceeded: this run would take about 116 days, more than the time budget of 10 min; ...
@@ -228,4 +229,4 @@ def require_time(seconds: float, what: str, change: str) -> None:
     if seconds > limit:
         raise TimeBudgetExceeded(
             f"{what} would take about {format_seconds(seconds)}, more than the time budget of "
-            f"{format_seconds(limit)}; change {change}, or add --no-time-limit (or set {TIME_ENVIRONMENT})")
+            f"{format_seconds(limit)}; change {change}, or add `no_time_limit` (or set {TIME_ENVIRONMENT})")

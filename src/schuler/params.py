@@ -78,6 +78,8 @@ class Parameter:
         Whether the bounds themselves are excluded.
     choices : tuple of str
         Allowed values of a ``choice`` (which must have some); empty for other kinds.
+    renamed_choices : tuple of (str, str)
+        Former values of a ``choice`` with the value that replaced each; a former value is refused naming it.
     kind : {"quantity", "choice", "integer", "flag", "text"}
     """
 
@@ -91,6 +93,7 @@ class Parameter:
     exclusive_maximum: bool = False
     choices: tuple[str, ...] = ()
     kind: Kind = "quantity"
+    renamed_choices: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self):
         if self.kind == "choice" and not self.choices:
@@ -176,6 +179,9 @@ class Parameter:
         label = label or self.name
         if self.kind == "choice":
             text = str(value).strip().lower()
+            renamed = dict(self.renamed_choices)
+            if text in renamed:
+                raise InvalidParameter(label, f"{value!r} is renamed to {renamed[text]!r} (see CHANGELOG.md)")
             if text not in self.choices:
                 raise InvalidParameter(label, f"{value!r} is not one of {', '.join(self.choices)}")
             return text
@@ -327,24 +333,17 @@ class Parameter:
             return "not set"
         if self.kind == "flag":
             return "on" if self.parse(self.default) else "off"
-        if isinstance(self.default, float):
-            shown = f"{self.default:.6g}"
-        else:
-            shown = str(self.default)
+        shown = f"{self.default:.6g}" if isinstance(self.default, float) else str(self.default)
         if self.kind == "quantity" and self.unit and not isinstance(self.default, str):
             shown += f" {self.unit}"
         return shown
 
     def help_text(self) -> str:
         parts = [self.help]
-        bounded = self.minimum is not None or self.maximum is not None
-        if self.kind == "quantity" and bounded:
-            parts.append(f"Range {self.range_text()}.")
-        elif self.kind == "integer" and bounded:
+        if self.kind in ("quantity", "integer") and (self.minimum is not None or self.maximum is not None):
             parts.append(f"Range {self.range_text()}.")
         parts.append(f"[default: {self.default_text()}]")
         return " ".join(parts)
-
 
 
 @dataclass(frozen=True)
@@ -419,6 +418,7 @@ class IntervalsParameter(Parameter):
 
     def help_text(self) -> str:
         return f"{self.help} [default: {self.default_text()}]"
+
 
 class Case(Mapping):
     """One validated case: every parameter of a system in SI, and which of them were given.

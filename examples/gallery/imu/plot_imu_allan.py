@@ -23,7 +23,7 @@ from schuler.imu.simulate import simulate_record
 from schuler.imu.spec import preset
 
 model = preset("industrial")
-record = simulate_record(model, duration_s=3600.0, sample_interval_s=0.01, seed=1)
+record = simulate_record(model, duration=3600.0, sample_interval=0.01, seed=1)
 curve = allan_deviation(record.gyro[:, 0], record.sample_interval_s)
 terms = identify_terms(curve)
 

@@ -32,4 +32,4 @@ print(f"sum of the shares: {sum(r.budget.values()):.9f}")
 # Carlo of the nonlinear INS beside it with ``--monte-carlo``)::
 #
 #     schuler run examples/mission_navigation.toml
-#     schuler mission run --imu navigation --trajectory cruise --duration '10 h' --monte-carlo 1000 --json
+#     schuler mission run --imu navigation --trajectory great-circle --duration '10 h' --monte-carlo 1000 --json

@@ -43,9 +43,10 @@ plt.show()
 # %%
 # North is −α0 from the rotor axis at release; its standard error comes from
 # the Jacobian of the fit (λ and B are strongly correlated):
-error = (estimate.north_deg - math.degrees(-alpha0)) * 3600
-print(f"true north {math.degrees(-alpha0):.6f} deg, identified {estimate.north_deg:.6f} deg: "
-      f"error {error:+.3f} arcsec, standard error {estimate.north_std_arcsec:.3f} arcsec")
+error = math.degrees(estimate.north_rad + alpha0) * 3600
+assert estimate.north_std_rad is not None  # alpha0 is identified, so it has a standard error
+print(f"true north {math.degrees(-alpha0):.6f} deg, identified {math.degrees(estimate.north_rad):.6f} deg: "
+      f"error {error:+.3f} arcsec, standard error {math.degrees(estimate.north_std_rad) * 3600:.3f} arcsec")
 print(f"lambda {estimate.decay_rate:.6g} 1/s (true {decay_rate}), H_m {estimate.Hm:.5g} N m s (true {hm})")
 
 # %%

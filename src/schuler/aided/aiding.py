@@ -3,8 +3,8 @@
 ``--aiding`` names, beside ``gnss-position`` and ``gnss-velocity``:
 
 * ``zupt`` and ``zaru``: zero velocity and zero angular rate at ``zupt_rate`` during the stops, the
-  drive's own stationary intervals (``stops given``), those of ``stop_intervals``, or those found in each
-  member's IMU data (``stops detected``: :func:`schuler.aided.sources.detect_stops`, window
+  trajectory's own stationary intervals (``stops_from trajectory``), those of ``stop_intervals``, or those found
+  in each member's IMU data (``stops_from imu``: :func:`schuler.aided.sources.detect_stops`, window
   :data:`~schuler.aided.sources.STOP_WINDOW_S`, threshold :data:`~schuler.aided.sources.STOP_THRESHOLD`;
   on the drive's vibration-free cruises it also marks the cruises, whose false updates the gate must refuse);
 * ``nhc``: the wheel point's lateral and vertical velocities zero, at the odometer's epochs;
@@ -24,6 +24,7 @@ over the record's span; ``odometer`` and ``baro`` need data the files do not car
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -38,6 +39,8 @@ from schuler.aided.epochs import (
 from schuler.aided.error_state import ErrorProcess, FilterModel
 from schuler.aided.measurements import mounting_matrix
 from schuler.exceptions import InvalidParameter
+from schuler.navigate.drive import GroundVehicleProfile
+from schuler.navigate.trajectory import Stationary, stationary_intervals
 from schuler.params import Case, IntervalsParameter, Parameter
 
 NAMES = ("zupt", "zaru", "nhc", "odometer", "baro")
@@ -53,10 +56,11 @@ BAROMETER_BIAS_SIGMA_M = 10.0
 """Initial 1-sigma of the barometer bias state, m."""
 
 PARAMETERS = (
-    Parameter("stops", "", "given", "Stops for zupt and zaru: the drive's own (given) or found in the IMU data by a "
-              "moving-variance test (detected).", kind="choice", choices=("given", "detected")),
+    Parameter("stops_from", "", "trajectory", "Where zupt and zaru take the stops from: the simulated trajectory's "
+              "stationary intervals (trajectory) or the IMU data, by a moving-variance test (imu).", kind="choice",
+              choices=("trajectory", "imu")),
     IntervalsParameter("stop_intervals", "s", None, "Stops for zupt and zaru given one by one, start:duration pairs "
-                       "(0:25,300:20; on files, times as in the data), in place of --stops."),
+                       "(0:25,300:20; on files, times as in the data), in place of --stops-from."),
     Parameter("zupt_rate", "Hz", 10.0, "Rate of the zero-velocity and zero-rate updates during a stop.",
               minimum=0.01, maximum=100.0),
     Parameter("zupt_sigma", "m/s", 0.01, "1-sigma of the velocity at a stop.", minimum=0.0, exclusive_minimum=True,
@@ -119,8 +123,7 @@ def with_states(model: FilterModel, case: Case) -> FilterModel:
         if case["odometer_scale_state"] and "odometer" in names else None
     barometer = ErrorProcess("constant", BAROMETER_BIAS_SIGMA_M, axes=1) \
         if case["baro_bias_state"] and "baro" in names else None
-    return FilterModel(model.angle_random_walk, model.velocity_random_walk, model.gyro_bias, model.accel_bias,
-                       model.gyro_scale, model.accel_scale, odometer, barometer)
+    return dataclasses.replace(model, odometer_scale=odometer, barometer_bias=barometer)
 
 
 def simulated_sources(case: Case, path, increments: np.ndarray, interval: float, members: np.ndarray, streams,
@@ -131,10 +134,10 @@ def simulated_sources(case: Case, path, increments: np.ndarray, interval: float,
     ----------
     case : Case
         A validated simulated case (SI).
-    path : GroundVehicleProfile
-        The drive.
+    path : Stationary, GreatCircle or WaypointProfile
+        The trajectory (``nhc`` and ``odometer`` need a ground vehicle's: a drive or at rest).
     increments : ndarray, shape (N, n, 6)
-        The members' IMU increments, rad and m/s (for ``stops detected``).
+        The members' IMU increments, rad and m/s (for ``stops_from imu``).
     interval : float
         IMU interval, s.
     members : ndarray of int
@@ -146,9 +149,13 @@ def simulated_sources(case: Case, path, increments: np.ndarray, interval: float,
     """
     names = named(case["aiding"])
     duration, imu_rate = case["duration"], case["imu_rate"]
-    built = _stop_sources(case, names, increments, interval, model, 0.0, path.stationary_intervals)
+    built = _stop_sources(case, names, increments, interval, model, 0.0, lambda: stationary_intervals(path, duration))
     arm = (case["wheel_lever_arm_x"], case["wheel_lever_arm_y"], case["wheel_lever_arm_z"])
     if "odometer" in names or "nhc" in names:
+        if not isinstance(path, GroundVehicleProfile | Stationary):
+            wheeled = [name for name in ("nhc", "odometer") if name in names]
+            raise InvalidParameter("aiding", f"{', '.join(wheeled)}: a ground vehicle's (trajectory drive or "
+                                             "stationary), not a flight's")
         records = [simulate_odometer(path, duration, imu_rate=imu_rate, rate=case["odometer_rate"], lever_arm=arm,
                                      scale_factor_error=case["odometer_scale_error"], sigma=case["odometer_sigma"],
                                      streams=streams, member=int(m)) for m in members]
@@ -170,8 +177,9 @@ def file_sources(case: Case, increments: np.ndarray, interval: float, t0: float,
     """The sources besides GNSS of a case on files: stops and the non-holonomic constraint, which need no data.
 
     ``zupt`` and ``zaru`` at the stops of ``stop_intervals`` (times as in the data) or found in the record
-    (``stops detected``); ``nhc`` at ``odometer_rate`` over the record's span. ``odometer`` and ``baro`` need
-    data the files do not carry and are refused, as is ``stops given`` (a record has no drive to take them from).
+    (``stops_from imu``); ``nhc`` at ``odometer_rate`` over the record's span. ``odometer`` and ``baro`` need
+    data the files do not carry and are refused, as is ``stops_from trajectory`` (a record has no simulated
+    trajectory to take them from).
 
     Parameters
     ----------
@@ -193,8 +201,9 @@ def file_sources(case: Case, increments: np.ndarray, interval: float, t0: float,
                                          "and GNSS data); zupt, zaru and nhc work on files")
 
     def refused():
-        raise InvalidParameter("stops", "a record has no drive to take its stops from: give them "
-                                        "(--stop-intervals, times as in the data) or find them (--stops detected)")
+        raise InvalidParameter("stops_from", "a record has no simulated trajectory to take its stops from: give "
+                                             "them (`stop_intervals`, times as in the data) or find them "
+                                             "(`stops_from` imu)")
 
     built = _stop_sources(case, names, increments[None], interval, model, t0, refused)
     if "nhc" in names:
@@ -208,18 +217,18 @@ def file_sources(case: Case, increments: np.ndarray, interval: float, t0: float,
 
 def _stop_sources(case: Case, names, increments: np.ndarray, interval: float, model: FilterModel, t0: float,
                   given) -> list[sources.Source]:
-    """ZUPT and ZARU sources at the case's stops (``given()`` supplies ``stops given``; detected ones are shifted
+    """ZUPT and ZARU sources at the case's stops (``given()`` supplies ``stops_from trajectory``; found ones are shifted
     by t0, the record's start)."""
     if "zupt" not in names and "zaru" not in names:
         return []
     if case["stop_intervals"] is not None:
         stops = [(start, start + length) for start, length in case["stop_intervals"]]
-    elif case["stops"] == "given":
+    elif case["stops_from"] == "trajectory":
         stops = given()
     else:
         if increments.shape[0] > 1 and not np.array_equal(increments[0], increments[-1]):
-            raise InvalidParameter("stops", "detected stops are one record's: run the members one by one or "
-                                            "give the drive's stops (--stops given)")
+            raise InvalidParameter("stops_from", "stops found in the IMU data are one record's: run the members "
+                                                 "one by one or take the trajectory's (`stops_from` trajectory)")
         noise = math.sqrt(interval)
         stops = [(t0 + start, t0 + end) for start, end in
                  sources.detect_stops(increments[0], interval, float(np.max(model.angle_random_walk)) / noise,

@@ -18,7 +18,9 @@ Navigation*, Wiley, 2001, Sec. 5.4.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,6 +28,7 @@ import scipy.stats
 
 from schuler.aided.ekf import FilterRun
 from schuler.aided.error_state import ATTITUDE, POSITION, VELOCITY
+from schuler.aided.initialisation import LARGEST_SIGMA
 from schuler.core.attitude import (
     conjugate,
     euler_from_quaternion,
@@ -148,6 +151,28 @@ def _rms(values) -> float:
     return float(np.sqrt(np.mean(np.square(values))))
 
 
+def member(value, m: int):
+    """Member ``m`` alone of a filter run or of its errors (leading axis kept, length 1).
+
+    Parameters
+    ----------
+    value : FilterRun or Errors
+        Runs or errors of several members, batched on the leading axis.
+    m : int
+        The member's index in the batch.
+    """
+    fields = {}
+    for f in dataclasses.fields(value):
+        item = getattr(value, f.name)
+        per_member = isinstance(item, np.ndarray) and item.ndim >= 2 and f.name not in ("t_s", "covariance_t_s",
+                                                                                         "epoch_t_s")
+        if isinstance(item, dict):  # a run's other sources: each log alone
+            fields[f.name] = {name: member(log, m) for name, log in item.items()}
+            continue
+        fields[f.name] = item[m:m + 1] if per_member else item
+    return dataclasses.replace(value, **fields)
+
+
 def outage_drift(run: FilterRun, run_errors: Errors | None, outages) -> list[OutageDrift]:
     """How far the solution drifted in each outage, beside the filter's own 1-sigma at its end.
 
@@ -235,3 +260,33 @@ def consistency(run: FilterRun, run_errors: Errors, probability: float = 0.99) -
         nees[name] = np.einsum("mki,mki->mk", e, solved).mean(axis=0)
         inside[name] = float(np.mean((nees[name] >= low) & (nees[name] <= high)))
     return Consistency(run_errors.t_s[rows], nees, (float(low), float(high)), inside)
+
+
+class FilterLinearityWarning(UserWarning):
+    """The filter's attitude uncertainty grew past its small-angle model: its solution is not to be trusted."""
+
+
+def warn_if_nonlinear(run: FilterRun) -> None:
+    """Warn (:class:`FilterLinearityWarning`) when any member's psi 1-sigma passes
+    :data:`~schuler.aided.initialisation.LARGEST_SIGMA`, the limit of its small-angle model.
+
+    A gyro bias no measurement sees, such as a consumer IMU's 20 deg/s at a stop with GNSS alone, turns the
+    heading by hundreds of degrees while the filter's model stays linear; its covariance says so first.
+
+    Parameters
+    ----------
+    run : FilterRun
+        A filter run (its stored covariances).
+    """
+    variance = np.diagonal(run.covariance[..., ATTITUDE, ATTITUDE], axis1=-2, axis2=-1)
+    past = np.any(variance > LARGEST_SIGMA**2, axis=(0, 2))
+    if not past.any():
+        return
+    k = int(np.argmax(past))
+    sigma = math.degrees(math.sqrt(float(variance[:, k].max())))
+    t = float(run.covariance_t_s[k])
+    warnings.warn(f"the filter's attitude 1-sigma reached {sigma:.3g} deg at t = {t:g} s, past the "
+                  f"{math.degrees(LARGEST_SIGMA):g} deg of its small-angle model: its solution is not to be "
+                  "trusted (a gyro bias unseen at a stop needs zero-rate updates there, --aiding ...,zupt,zaru, or "
+                  "an in-motion start, which takes it from the rest before: --initialisation in-motion)",
+                  FilterLinearityWarning, stacklevel=2)

@@ -453,8 +453,8 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
         Chi-square gate probability, a plain number in (0, 1] (1: no gate).
     output_every : int
         IMU samples per stored solution (1: every IMU epoch).
-    initial_sensor_errors : ndarray, shape (12,), optional
-        Initial estimates b_g (rad/s), b_a (m/s^2), s_g, s_a compensated from the start.
+    initial_sensor_errors : ndarray, shape (12,) or (N, 12), optional
+        Initial estimates b_g (rad/s), b_a (m/s^2), s_g, s_a compensated from the start (shared, or each member's).
     initial_sensor_sigma : ndarray, shape (6,) or (12,), optional
         1-sigma of the sensor-error states at the start (rad/s, m/s^2, then the scale factors, 1; the aiding
         states' follow from the model); default the model's
@@ -504,8 +504,8 @@ def run_filter(increments: np.ndarray, interval: float, start: Start, model: Fil
     navigator = _Navigator(start, increments, interval, t0, output_every, n_out, earth_rate, aiding_states)
     if initial_sensor_errors is not None:
         guess = np.asarray(initial_sensor_errors, dtype=float)
-        navigator.gyro_bias[:], navigator.accel_bias[:] = guess[0:3], guess[3:6]
-        navigator.gyro_scale[:], navigator.accel_scale[:] = guess[6:9], guess[9:12]
+        navigator.gyro_bias[:], navigator.accel_bias[:] = guess[..., 0:3], guess[..., 3:6]
+        navigator.gyro_scale[:], navigator.accel_scale[:] = guess[..., 6:9], guess[..., 9:12]
     sensor_sigma = model.initial_sigma()
     if initial_sensor_sigma is not None:
         sensor_sigma = np.concatenate([np.asarray(initial_sensor_sigma, float).reshape(-1),

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from schuler.aided import aiding as more_aiding
-from schuler.aided import analysis, files, initialisation, smoother
+from schuler.aided import analysis, files, initialisation, smoother, sources
 from schuler.aided.ekf import Start, run_filter
 from schuler.aided.error_state import KINDS, FilterModel, filter_model, overridden
 from schuler.aided.gnss import scheduled_outages, simulate_gnss
@@ -55,9 +55,17 @@ from schuler.exceptions import InvalidParameter
 from schuler.imu.instrument import resolve_model
 from schuler.imu.simulate import ImuSimulator
 from schuler.memory import require
-from schuler.navigate.drive import GroundVehicleProfile, drive
+from schuler.navigate.evaluation import DRIVE_OPTIONS, trajectory_of
+from schuler.navigate.evaluation import PARAMETERS as NAVIGATE_PARAMETERS
+from schuler.navigate.trajectory import GreatCircle, Stationary, WaypointProfile, stationary_intervals
 from schuler.navigate.truth import IdealImu, ideal_imu, sample_count
 from schuler.params import Case, IntervalsParameter, Parameter, ParameterSet
+
+TRAJECTORY_OPTIONS = ("longitude", "height", "heading", "speed", *DRIVE_OPTIONS)
+"""``schuler navigate``'s options of the simulated trajectory, taken with their names and units."""
+
+SIMULATED_ONLY = ("trajectory", "latitude", *TRAJECTORY_OPTIONS)
+"""Options of a simulated case only: a record and its reference carry their own trajectory."""
 
 AIDING = ("gnss-position", "gnss-velocity") + more_aiding.NAMES
 """The measurements ``aiding`` may name."""
@@ -75,9 +83,14 @@ START_SIGMA = (1.0, 0.1, (math.radians(0.1), math.radians(0.1), math.radians(1.0
 """The filter's initial 1-sigma: position (m, each axis), velocity (m/s), psi (rad: north, east, down)."""
 
 PARAMETERS = ParameterSet((
-    Parameter("duration", "s", 1500.0, "Length of the drive (stops, turns, town and road speeds).",
-              minimum=300.0, maximum=4 * 3600.0),
-    Parameter("latitude", "deg", 30.5, "Latitude of the drive's start.", minimum=-80.0, maximum=80.0),
+    Parameter("trajectory", "", None, "The simulated vehicle's path: drive (a car's drive with stops, speed changes "
+              "and 90-deg turns: schuler.navigate.drive), stationary, great-circle, or a waypoint profile FILE.toml "
+              "(format: schuler.navigate.profile) (not set: drive).", kind="text"),
+    Parameter("duration", "s", 1500.0, "Simulated time (the drive's length: its stops, turns, town and road "
+              "speeds).", minimum=300.0, maximum=4 * 3600.0),
+    Parameter("latitude", "deg", None, "Latitude of the start (not set: the drive's 30.5 deg, 45 deg on the other "
+              "trajectories; a profile sets its own).", minimum=-80.0, maximum=80.0),
+    *(NAVIGATE_PARAMETERS[name] for name in TRAJECTORY_OPTIONS),
     Parameter("imu", "", None, "IMU: a grade (navigation, tactical, industrial, consumer), a TOML spec file "
               "or a recording whose identified noise terms are used (not set: tactical; with --kf-gins-config its "
               "imunoise).", kind="text"),
@@ -123,8 +136,9 @@ PARAMETERS = ParameterSet((
               "(not set: from the IMU's bias terms; with --kf-gins-config its gbstd).", minimum=0.0, maximum=1e4),
     Parameter("filter_accel_bias", "mg", None, "The filter's accelerometer bias 1-sigma (not set: from the IMU's "
               "bias terms; with --kf-gins-config its abstd).", minimum=0.0, maximum=1e3),
-    Parameter("filter_bias_model", "", None, "The filter's bias model (not set: gauss-markov, the IMU's "
-              "correlation time).", kind="choice", choices=KINDS),
+    Parameter("filter_bias_model", "", None, "The filter's bias model (not set: random-walk, the turn-on "
+              "bias a constant walked by the in-run terms; with --kf-gins-config gauss-markov).", kind="choice",
+              choices=KINDS),
     Parameter("filter_correlation_time", "h", None, "T of the filter's Gauss-Markov biases (not set: the IMU's "
               "longest; with --kf-gins-config its corrtime).", minimum=0.0, exclusive_minimum=True, maximum=1e3),
     Parameter("nominal", "", False, "Ideal sensors and noiseless GNSS (every random term zero).", kind="flag"),
@@ -141,7 +155,7 @@ PARAMETERS = ParameterSet((
               kind="flag"),
     *initialisation.PARAMETERS,
 ), owner="aided", exclusive=(("outages", "outage_start"), ("outages", "outage_duration"),
-                               ("outages", "outage_every"), ("stop_intervals", "stops")))
+                               ("outages", "outage_every"), ("stop_intervals", "stops_from")))
 
 OUTPUTS = (
     Output("position_error_horizontal_rms_m", "m", "", "RMS of the horizontal position error"),
@@ -262,8 +276,8 @@ class SimulatedInputs:
 
     Attributes
     ----------
-    path : GroundVehicleProfile
-        The drive (:func:`schuler.navigate.drive.drive`).
+    path : Stationary, GreatCircle or WaypointProfile
+        The trajectory (:func:`trajectory`; a drive: :func:`schuler.navigate.drive.drive`).
     truth : IdealImu
         Its truth and ideal increments at every IMU sample.
     increments : ndarray, shape (N, n, 6)
@@ -278,13 +292,26 @@ class SimulatedInputs:
         Whether the GNSS velocities are simulated and used.
     """
 
-    path: GroundVehicleProfile
+    path: Stationary | GreatCircle | WaypointProfile
     truth: IdealImu
     increments: np.ndarray
     gnss: list
     outages: tuple[tuple[float, float], ...]
     lever_arm: tuple[float, float, float]
     use_velocity: bool
+
+
+def trajectory(case: Case) -> Stationary | GreatCircle | WaypointProfile:
+    """A simulated case's trajectory (``schuler navigate``'s, :func:`schuler.navigate.evaluation.trajectory_of`),
+    not set a drive; its duration is the case's.
+
+    Parameters
+    ----------
+    case : Case
+        A validated simulated case (SI).
+    """
+    path, _ = trajectory_of("drive" if case["trajectory"] is None else case["trajectory"].strip(), case)
+    return path
 
 
 def simulated_inputs(case: Case, members: np.ndarray, streams) -> SimulatedInputs:
@@ -300,14 +327,14 @@ def simulated_inputs(case: Case, members: np.ndarray, streams) -> SimulatedInput
         Where the IMU errors and the GNSS noise come from; None (or ``nominal``): none.
     """
     _, use_velocity = aiding_of(case["aiding"])
-    path = drive(latitude=case["latitude"], duration=case["duration"])
+    path = trajectory(case)
     truth = ideal_imu(path, case["duration"], case["imu_rate"])
     dt = truth.interval_s
     ideal = np.concatenate([truth.angle_increment_rad, truth.velocity_increment_m_s], axis=1)
     noisy = streams is not None and not case["nominal"]
     if noisy:
-        simulator = ImuSimulator(resolve_model(_imu(case)), dt, true_gyro_rad_s=truth.angle_increment_rad / dt,
-                                 true_accel_m_s2=truth.velocity_increment_m_s / dt, seed=streams.seed)
+        simulator = ImuSimulator(resolve_model(_imu(case)), dt, true_gyro=truth.angle_increment_rad / dt,
+                                 true_accel=truth.velocity_increment_m_s / dt, seed=streams.seed)
         gyro, accel = simulator.window(members, 0, ideal.shape[0])
         increments = np.concatenate([gyro, accel], axis=-1) * dt
     else:
@@ -330,28 +357,54 @@ def _imu(case: Case) -> str:
 def _simulated_group(case: Case, members: np.ndarray, streams, smooth: bool = False):
     """One group of members of the same simulated case: the filter run, its errors and the outages; with ``smooth``
     a fourth item, member 0's smoothed run and its errors."""
-    require(member_bytes(case) * members.size, f"{members.size} members of this aided run", "--duration or --imu-rate")
+    require(member_bytes(case) * members.size, f"{members.size} members of this aided run", "`duration` or `imu_rate`")
     data = simulated_inputs(case, members, streams)
     imu = resolve_model(_imu(case))
     model = more_aiding.with_states(assumed(case, filter_model(imu)), case)
-    first_stop = data.path.stationary_intervals()[0]
+    stops = stationary_intervals(data.path, case["duration"])
     start = _initialisation(case, data.increments, data.truth.interval_s, data.gnss, lambda: _start(data.path,
                             members.size), lever_arm=data.lever_arm, imu=imu,
-                            at_rest_s=first_stop[1] if first_stop[0] == 0.0 else 0.0)
+                            at_rest=stops[0][1] if stops and stops[0][0] == 0.0 else 0.0)
     noisy = streams is not None and not case["nominal"]
     extra = more_aiding.simulated_sources(case, data.path, data.increments, data.truth.interval_s, members,
                                           streams if noisy else None, model)
     run = run_filter(data.increments[:, start.first_sample:], data.truth.interval_s, start.start, model, data.gnss,
                      t0=start.t0_s, lever_arm=data.lever_arm, covariance_interval=case["covariance_interval"],
-                     use_velocity=data.use_velocity, sources=extra, keep_for_smoother=smooth)
+                     use_velocity=data.use_velocity, sources=extra, keep_for_smoother=smooth,
+                     **_bias_at_rest(start, model))
     truth = data.truth
     true = _at(analysis.Truth(truth.latitude_rad, truth.longitude_rad, truth.height_m, truth.velocity_ned_m_s,
                               truth.quaternion), run.t_s, truth.t_s)
     if not smooth:
         return run, analysis.errors(run, true), data.outages
-    smoothed = smoother.smooth(_member(run, 0))
+    smoothed = smoother.smooth(analysis.member(run, 0))
     return dataclasses.replace(run, prior_covariance=None, transition=None, correction=None), \
         analysis.errors(run, true), data.outages, (smoothed, analysis.errors(smoothed, true))
+
+
+def _rest_at_start(increments: np.ndarray, interval: float, model: FilterModel) -> float | None:
+    """How long a record is at rest from its start, s, by the stop detector (None: it starts moving)."""
+    noise = math.sqrt(interval)
+    stops = sources.detect_stops(increments, interval, float(np.max(model.angle_random_walk)) / noise,
+                                 float(np.max(model.velocity_random_walk)) / noise)
+    return stops[0][1] if stops and stops[0][0] == 0.0 else None
+
+
+def _bias_at_rest(start: initialisation.Initialisation, model: FilterModel) -> dict:
+    """``run_filter``'s initial sensor errors and 1-sigma from a gyro bias found at rest (none: no arguments).
+
+    The rest's estimate b_r (1-sigma s_r) and the model's prior (zero, s_m) combine per axis as two Gaussians:
+    b = b_r s_m^2 / (s_m^2 + s_r^2), sigma^2 = s_m^2 s_r^2 / (s_m^2 + s_r^2), so that a tactical gyro's bias, known
+    better than the Earth rate's level part that hides in the rest's estimate, keeps its own 1-sigma.
+    """
+    if start.gyro_bias_rad_s is None or start.gyro_bias_sigma_rad_s is None:
+        return {}
+    sigma = model.initial_sigma()[:model.sensor_size - 9].copy()
+    prior, rest = sigma[0:3] ** 2, start.gyro_bias_sigma_rad_s ** 2
+    errors = np.zeros((start.gyro_bias_rad_s.shape[0], 12))
+    errors[:, 0:3] = start.gyro_bias_rad_s * prior / (prior + rest)
+    sigma[0:3] = np.sqrt(prior * rest / (prior + rest))
+    return {"initial_sensor_errors": errors, "initial_sensor_sigma": sigma}
 
 
 def _initialisation(case: Case, increments, interval: float, gnss, given, **options) -> initialisation.Initialisation:
@@ -370,6 +423,9 @@ def _file_group(case: Case, members: np.ndarray, smooth: bool = False):
     """
     if members.size > 1:
         raise InvalidParameter("monte_carlo", "a run on files has no random terms: every member would be the same")
+    given = [name for name in SIMULATED_ONLY if case[name] is not None]
+    if given:
+        raise InvalidParameter(given[0], "applies to a simulated case: the files carry their own trajectory")
     inputs = files.read_inputs(case)
     config = inputs.configuration
     kfgins_model = config is not None and case["imu"] is None
@@ -384,13 +440,16 @@ def _file_group(case: Case, members: np.ndarray, smooth: bool = False):
     dt = inputs.interval_s
     steps = max(round(case["covariance_interval"] / dt), 1)  # a whole number of the data's IMU intervals
     lever = files.lever_arm_of(case, config)
+    at_rest = _rest_at_start(np.asarray(inputs.increments), dt, model) \
+        if case["initialisation"] == "in-motion" and not kfgins_model else None
     start = _initialisation(case, inputs.increments, dt, inputs.gnss, lambda: files.start_of(inputs, START_SIGMA),
-                            t0=inputs.t0_s, lever_arm=lever, imu=None if kfgins_model else resolve_model(_imu(case)))
+                            t0=inputs.t0_s, lever_arm=lever, imu=None if kfgins_model else resolve_model(_imu(case)),
+                            at_rest=at_rest)
     extra = more_aiding.file_sources(case, np.asarray(inputs.increments), dt, inputs.t0_s, model)
+    sensors = _bias_at_rest(start, model) or {"initial_sensor_errors": initial, "initial_sensor_sigma": sigma}
     run = run_filter(np.asarray(inputs.increments)[..., start.first_sample:, :], dt, start.start, model, inputs.gnss,
                      t0=start.t0_s, lever_arm=lever, covariance_interval=steps * dt,
-                     use_velocity=use_velocity, initial_sensor_errors=initial, initial_sensor_sigma=sigma,
-                     sources=extra, keep_for_smoother=smooth)
+                     use_velocity=use_velocity, sources=extra, keep_for_smoother=smooth, **sensors)
     smoothed_run = smoother.smooth(run) if smooth else None
     if inputs.reference is None:
         return run, None, inputs.outages, run, None if smoothed_run is None else (smoothed_run, None)
@@ -419,8 +478,8 @@ def _rms(values: np.ndarray) -> np.ndarray:
 
 def _summaries(run, errors, outages) -> dict[str, np.ndarray]:
     members = run.solution.shape[0]
-    drifts = [analysis.outage_drift(_member(run, m), None if errors is None else _member(errors, m), outages)
-              for m in range(members)]
+    drifts = [analysis.outage_drift(analysis.member(run, m), None if errors is None else analysis.member(errors, m),
+                                    outages) for m in range(members)]
 
     def largest(member):
         return max(member, key=lambda d: d.horizontal_error_max_m if errors is not None
@@ -444,20 +503,6 @@ def _summaries(run, errors, outages) -> dict[str, np.ndarray]:
     return {**summary, "outage_horizontal_error_max_m": worst, "outage_horizontal_error_sigma_m": sigma,
             "rejected_measurements": run.rejected.astype(float), "start_heading_error_rad": start,
             "start_heading_sigma_rad": np.sqrt(run.covariance[:, 0, 8, 8])}
-
-
-def _member(value, m: int):
-    """Member ``m`` alone of a filter run or of its errors (leading axis kept, length 1)."""
-    fields = {}
-    for f in dataclasses.fields(value):
-        item = getattr(value, f.name)
-        per_member = isinstance(item, np.ndarray) and item.ndim >= 2 and f.name not in ("t_s", "covariance_t_s",
-                                                                                         "epoch_t_s")
-        if isinstance(item, dict):  # a run's other sources: each log alone
-            fields[f.name] = {name: _member(log, m) for name, log in item.items()}
-            continue
-        fields[f.name] = item[m:m + 1] if per_member else item
-    return dataclasses.replace(value, **fields)
 
 
 def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
@@ -487,12 +532,13 @@ def evaluate(cases: Cases, histories: bool = False) -> Evaluation:
         else:
             run, errors, outages = _simulated_group(case, group.members, cases.random)
             full = run
+        analysis.warn_if_nonlinear(run)
         for name, values in _summaries(run, errors, outages).items():
             outputs[name][index] = values
         if first:
             # the navigation at every IMU epoch (full), the errors where the reference covers the run (run)
-            kept = (_member(run, 0), None if errors is None else _member(errors, 0), outages, _member(full, 0),
-                    smoothed, case["initialisation"])
+            kept = (analysis.member(run, 0), None if errors is None else analysis.member(errors, 0), outages,
+                    analysis.member(full, 0), smoothed, case["initialisation"])
     if not histories or kept is None:
         return Evaluation(outputs)
     run, errors, outages, full, smoothed, mode = kept

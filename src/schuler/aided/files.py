@@ -257,9 +257,9 @@ def read_inputs(case) -> FileInputs:
     imu_path = case["record"] if case["record"] is not None else (config.imu_path if config else None)
     gnss_path = case["gnss_file"] if case["gnss_file"] is not None else (config.gnss_path if config else None)
     if imu_path is None:
-        raise InvalidParameter("record", "give the IMU data: --record FILE (or --kf-gins-config with imupath)")
+        raise InvalidParameter("record", "give the IMU data: `record` FILE (or `kf_gins_config` with imupath)")
     if gnss_path is None:
-        raise InvalidParameter("gnss_file", "give the GNSS data: --gnss-file FILE (or --kf-gins-config with "
+        raise InvalidParameter("gnss_file", "give the GNSS data: `gnss_file` FILE (or `kf_gins_config` with "
                                             "gnsspath)")
     imu_name = "record" if case["record"] is not None else "imupath"
     imu = read_imu_file(imu_path, imu_rate=config.imu_rate_hz if config else None,
@@ -343,10 +343,10 @@ def start_of(inputs: FileInputs, sigma) -> Start:
         kept, lat, lon, h, v, q = reference_at(inputs.reference, np.array([inputs.t0_s]))
         if not kept[0]:
             raise InvalidParameter("reference", f"does not reach back to the IMU data's start, {inputs.t0_s:.3f} s: "
-                                                "the start is taken from it (or give --kf-gins-config)")
+                                                "the start is taken from it (or give `kf_gins_config`)")
         return Start(lat, lon, h, v, q, np.full(3, position), np.full(3, velocity), np.asarray(attitude))
-    raise InvalidParameter("kf_gins_config", "a run on files needs its initial state: give --kf-gins-config "
-                                             "(initpos, initvel, initatt) or --reference (its state at the start)")
+    raise InvalidParameter("kf_gins_config", "a run on files needs its initial state: give `kf_gins_config` "
+                                             "(initpos, initvel, initatt) or `reference` (its state at the start)")
 
 
 def lever_arm_of(case, config: KfGinsConfiguration | None) -> tuple[float, float, float]:

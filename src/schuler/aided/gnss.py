@@ -33,21 +33,22 @@ import numpy as np
 from schuler.aided.epochs import draws, epoch_schedule, offset_position, positive, truth_at, vector3
 from schuler.core.earth import EARTH_RATE
 from schuler.core.random import RandomStreams
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 
 DEFAULT_POSITION_SIGMA_M = (0.5, 0.5, 1.0)
 """Default 1-sigma of simulated GNSS positions, north, east, down, m (a differential code solution)."""
 
-def validate_epochs(t_s, position_sigma_m, velocity_sigma_m_s=None, *, name: str = "gnss", locate=None) -> None:
+@renamed_keywords(position_sigma_m="position_sigma", velocity_sigma_m_s="velocity_sigma")
+def validate_epochs(t_s, position_sigma, velocity_sigma=None, *, name: str = "gnss", locate=None) -> None:
     """Refuse unsorted or repeated epoch times and NaN, zero or negative sigmas, naming the first bad epoch.
 
     Parameters
     ----------
     t_s : ndarray, shape (n,)
         Epoch times, s.
-    position_sigma_m : ndarray, shape (n, 3)
+    position_sigma : ndarray, shape (n, 3)
         1-sigma north, east, down, m.
-    velocity_sigma_m_s : ndarray, shape (n, 3), optional
+    velocity_sigma : ndarray, shape (n, 3), optional
         1-sigma of v_N, v_E, v_D, m/s.
     name : str
         The input's name in messages (an option or configuration key).
@@ -70,7 +71,7 @@ def validate_epochs(t_s, position_sigma_m, velocity_sigma_m_s=None, *, name: str
         row = int(np.flatnonzero(steps <= 0)[0]) + 1
         kind = "repeats the one before" if steps[row - 1] == 0 else "is earlier than the one before"
         raise InvalidParameter(name, f"{where(row)}: time {t[row]:.6f} s {kind} (times must increase strictly)")
-    for label, sigma in (("position", position_sigma_m), ("velocity", velocity_sigma_m_s)):
+    for label, sigma in (("position", position_sigma), ("velocity", velocity_sigma)):
         if sigma is None:
             continue
         bad = ~(np.asarray(sigma, dtype=float) > 0)  # NaN compares false: refused with zeros and negatives
@@ -297,14 +298,15 @@ def in_outages(t_s, outages) -> np.ndarray:
     return inside
 
 
-def detect_outages(t_s, nominal_interval_s: float | None = None) -> tuple[tuple[float, float], ...]:
+@renamed_keywords(nominal_interval_s="nominal_interval")
+def detect_outages(t_s, nominal_interval: float | None = None) -> tuple[tuple[float, float], ...]:
     """The gaps between epochs longer than twice the nominal interval, as (start_s, duration_s) outages.
 
     Parameters
     ----------
     t_s : array_like, shape (n,)
         Epoch times, s, increasing.
-    nominal_interval_s : float, optional
+    nominal_interval : float, optional
         The interval between epochs, s; default the median interval.
 
     Returns
@@ -316,7 +318,7 @@ def detect_outages(t_s, nominal_interval_s: float | None = None) -> tuple[tuple[
     if t.size < 2:
         return ()
     steps = np.diff(t)
-    interval = float(np.median(steps)) if nominal_interval_s is None else positive(nominal_interval_s,
+    interval = float(np.median(steps)) if nominal_interval is None else positive(nominal_interval,
                                                                                      "nominal_interval_s")
     gaps = np.flatnonzero(steps > 2.0 * interval)
     return tuple((float(t[k] + interval), float(steps[k] - interval)) for k in gaps)

@@ -25,7 +25,13 @@
   side, v = (r_k+1 - r_k-1) / (t_k+1 - t_k-1), sigma_v^2 = (sigma_k+1^2 + sigma_k-1^2) / (t_k+1 - t_k-1)^2
   (its error from the change of acceleration, jerk dt^2 / 6, is left out). Position and velocity are those
   of the fix, moved from the antenna to the IMU through the lever arm (v - C (omega_ib x l); the Earth and
-  transport rates' part, below 1e-4 m/s per metre of arm, left out).
+  transport rates' part, below 1e-4 m/s per metre of arm, left out). When the data are known to be at rest from
+  their start for at least ``alignment_duration`` (a simulated drive's first stop; on files the first stop the
+  moving-variance detector, :func:`schuler.aided.sources.detect_stops`, finds at the record's start), the gyros'
+  mean over that window is also the initial gyro bias: b_hat = mean(omega_tilde) - (0, 0, -Omega sin L) in the
+  level body axes, with 1-sigma sqrt(N_g^2 / T + (Omega cos L)^2 / 2) about x and y (the Earth rate's level
+  part, whose direction the unknown heading hides) and N_g / sqrt(T) about z. A consumer IMU's 20 deg/s turn-on
+  bias, which GNSS alone never sees at a stop, is so known to about 13 deg/h before the filter starts.
 
 The filter's error model is the psi angle's first-order one: a heading error of a few degrees from the GNSS
 course leaves second-order terms (1 - cos 5 deg = 0.4 %) well below the measurement noise, and the first turns
@@ -45,6 +51,7 @@ sec. 5.3 (heading from the GNSS velocity of a land vehicle).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -57,8 +64,8 @@ from schuler.aided.measurements import Solution, antenna_position, antenna_veloc
 from schuler.alignment.coarse import coarse_attitude
 from schuler.alignment.limits import accuracy_limit
 from schuler.core.attitude import dcm_from_euler, quaternion_from_euler
-from schuler.core.earth import radii_of_curvature
-from schuler.exceptions import InvalidParameter
+from schuler.core.earth import EARTH_RATE, radii_of_curvature
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu.error_model import ErrorModel
 from schuler.params import Parameter
 
@@ -85,7 +92,8 @@ LARGEST_SIGMA = math.radians(10.0)
 PARAMETERS = (
     Parameter("initialisation", "", "given", "How the filter starts: given (the truth, a configuration's or "
               "reference's state), static (coarse alignment over --alignment-duration at rest) or in-motion "
-              "(heading from the GNSS course above --speed-threshold).", kind="choice", choices=MODES),
+              "(heading from the GNSS course above --speed-threshold; on a drive at rest from its start, the gyro bias "
+              "of its first --alignment-duration).", kind="choice", choices=MODES),
     Parameter("speed_threshold", "m/s", DEFAULT_SPEED_THRESHOLD, "GNSS horizontal speed an in-motion start "
               "waits for.", minimum=0.5, maximum=100.0),
     Parameter("alignment_duration", "s", DEFAULT_ALIGNMENT_DURATION, "Stationary window of a static start, from "
@@ -110,6 +118,10 @@ class Initialisation:
         Time of the start, s (the data's time scale).
     attitude_sigma_rad : ndarray, shape (3,)
         1-sigma of the start's roll, pitch and heading, rad.
+    gyro_bias_rad_s : ndarray, shape (N, 3), or None
+        Each member's gyro bias found at rest before an in-motion start (module docstring), rad/s; None: none.
+    gyro_bias_sigma_rad_s : ndarray, shape (3,), or None
+        Its 1-sigma, rad/s.
     """
 
     mode: str
@@ -117,13 +129,16 @@ class Initialisation:
     first_sample: int
     t0_s: float
     attitude_sigma_rad: np.ndarray
+    gyro_bias_rad_s: np.ndarray | None = None
+    gyro_bias_sigma_rad_s: np.ndarray | None = None
 
 
+@renamed_keywords(at_rest_s="at_rest")
 def initialise(mode: str, increments: np.ndarray, interval: float, gnss: GnssRecord | Sequence[GnssRecord], *,
                given: Callable[[], Start], t0: float = 0.0, lever_arm=(0.0, 0.0, 0.0),
                imu: ErrorModel | None = None, speed_threshold: float = DEFAULT_SPEED_THRESHOLD,
                alignment_duration: float = DEFAULT_ALIGNMENT_DURATION,
-               at_rest_s: float | None = None) -> Initialisation:
+               at_rest: float | None = None) -> Initialisation:
     """The filter's start by ``mode`` (module docstring).
 
     Parameters
@@ -147,9 +162,10 @@ def initialise(mode: str, increments: np.ndarray, interval: float, gnss: GnssRec
     speed_threshold : float
         Horizontal GNSS speed an in-motion start waits for, m/s.
     alignment_duration : float
-        Length of a static start's window, s.
-    at_rest_s : float or None
-        How long the data are known to be at rest from their start, s (None: not known, not checked).
+        Length of a static start's window, and of the rest window an in-motion start takes its gyro bias from, s.
+    at_rest : float or None
+        How long the data are known to be at rest from their start, s (None: not known, not checked): ``static``
+        and ``in-motion`` refuse a window longer than a rest; ``in-motion`` takes the gyro bias of the window.
 
     Returns
     -------
@@ -158,8 +174,8 @@ def initialise(mode: str, increments: np.ndarray, interval: float, gnss: GnssRec
     Raises
     ------
     InvalidParameter
-        An unknown mode; no GNSS speed reaching the threshold; a window longer than the rest or the data, or
-        without a GNSS fix; a start attitude 1-sigma above :data:`LARGEST_SIGMA`.
+        An unknown mode; no GNSS speed reaching the threshold; a window longer than the rest (in-motion: a rest
+        that is not zero) or the data, or without a GNSS fix; a start attitude 1-sigma above :data:`LARGEST_SIGMA`.
     """
     increments = np.asarray(increments, dtype=float)
     records = [gnss] if isinstance(gnss, GnssRecord) else list(gnss)
@@ -169,9 +185,16 @@ def initialise(mode: str, increments: np.ndarray, interval: float, gnss: GnssRec
         return Initialisation(mode, start, 0, t0, np.array([max(sigma[0], sigma[1])] * 2 + [sigma[2]]))
     if mode == "static":
         return _static(increments, interval, records, t0, np.asarray(lever_arm, float), imu, alignment_duration,
-                       at_rest_s)
+                       at_rest)
     if mode == "in-motion":
-        return _in_motion(increments, interval, records, t0, np.asarray(lever_arm, float), speed_threshold)
+        if at_rest is not None and 0.0 < at_rest < alignment_duration - 1e-9:
+            raise InvalidParameter("alignment_duration", f"{alignment_duration:g} s is longer than the {at_rest:g} s "
+                                   "the data are at rest from their start, whose gyro bias an in-motion start takes: "
+                                   f"give {at_rest:g} s or less")
+        moving = _in_motion(increments, interval, records, t0, np.asarray(lever_arm, float), speed_threshold)
+        if at_rest is None or imu is None or at_rest == 0.0:
+            return moving
+        return _with_bias_at_rest(moving, increments, interval, records, imu, alignment_duration)
     raise InvalidParameter("initialisation", f"{mode!r} is not one of {', '.join(MODES)}")
 
 
@@ -197,12 +220,12 @@ def _imu_position(latitude, longitude, height, body_to_ned, lever_arm):
     return antenna_position(at_antenna, -lever_arm)
 
 
-def _static(increments, interval, records, t0, lever_arm, imu, duration, at_rest_s) -> Initialisation:
+def _static(increments, interval, records, t0, lever_arm, imu, duration, at_rest) -> Initialisation:
     if imu is None:
         raise InvalidParameter("initialisation", "a static start needs the IMU's error model for its 1-sigma: "
-                               "give --imu")
-    if at_rest_s is not None and duration > at_rest_s + 1e-9:
-        raise InvalidParameter("alignment_duration", f"{duration:g} s is longer than the {at_rest_s:g} s the data "
+                               "give `imu`")
+    if at_rest is not None and duration > at_rest + 1e-9:
+        raise InvalidParameter("alignment_duration", f"{duration:g} s is longer than the {at_rest:g} s the data "
                                "are at rest from their start")
     samples = int(round(duration / interval))
     if not 2 <= samples < increments.shape[1]:
@@ -231,6 +254,23 @@ def _static(increments, interval, records, t0, lever_arm, imu, duration, at_rest
                   first.position_sigma_m[k], np.full(3, AT_REST_VELOCITY_SIGMA), psi_sigma)
     return Initialisation("static", start, samples, end,
                           np.array([limit.roll_rad, limit.pitch_rad, limit.heading_rad]))
+
+
+def _with_bias_at_rest(start: Initialisation, increments, interval, records, imu: ErrorModel,
+                       duration: float) -> Initialisation:
+    """``start`` with the gyro bias of the first ``duration`` seconds at rest (module docstring)."""
+    samples = int(round(duration / interval))
+    if samples > start.first_sample:
+        return start  # the rest overlaps the motion the start waits for: no window
+    span = samples * interval
+    latitude = _stack(records, "latitude_rad")[:, 0]
+    mean = increments[:, :samples, :3].sum(axis=1) / span
+    bias = mean.copy()
+    bias[:, 2] += EARTH_RATE * np.sin(latitude)  # the gyros read -Omega sin L about a level body's z (down)
+    noise = np.asarray(imu.gyro.random_walk, dtype=float) ** 2 / span
+    level = (EARTH_RATE * math.cos(float(np.mean(latitude)))) ** 2 / 2.0
+    sigma = np.sqrt(noise + np.array([level, level, 0.0]))
+    return dataclasses.replace(start, gyro_bias_rad_s=bias, gyro_bias_sigma_rad_s=sigma)
 
 
 def _track(records: list[GnssRecord]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -269,7 +309,7 @@ def _in_motion(increments, interval, records, t0, lever_arm, threshold) -> Initi
         inside = valid & (first.t_s > t0)
         largest = float(speed[:, inside].max()) if inside.any() else 0.0
         raise InvalidParameter("speed_threshold", f"the GNSS speed never reaches {threshold:g} m/s (at most "
-                               f"{largest:.3g} m/s): lower it or start otherwise (--initialisation given or static)")
+                               f"{largest:.3g} m/s): lower it or start otherwise (`initialisation` given or static)")
     k = int(np.argmax(fast))
     t_k = float(first.t_s[k])
     i = int(round((t_k - t0) / interval))

@@ -46,7 +46,7 @@ import numpy as np
 
 from schuler.aided.gnss import GnssRecord, validate_epochs
 from schuler.core.earth import STANDARD_GRAVITY
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu.record import ImuRecord
 
 RATE_TOLERANCE = 0.01
@@ -139,7 +139,8 @@ def _check_times(t: np.ndarray, raw: bytes, path: Path, name: str) -> None:
                                      "(times must increase strictly)")
 
 
-def check_specific_force(values, interval_s: float, kind: str = "increment", name: str = "imu_file") -> None:
+@renamed_keywords(interval_s="interval")
+def check_specific_force(values, interval: float, kind: str = "increment", name: str = "imu_file") -> None:
     """Refuse specific force given as increments where rates are expected, or the reverse (a magnitude check).
 
     The median of |value| over the samples must lie within a factor :data:`MAGNITUDE_FACTOR` of what ``kind``
@@ -150,7 +151,7 @@ def check_specific_force(values, interval_s: float, kind: str = "increment", nam
     ----------
     values : array_like, shape (n, 3)
         Accelerometer columns: velocity increments, m/s, or specific force, m/s^2 (see ``kind``).
-    interval_s : float
+    interval : float
         Sample interval dt, s.
     kind : {"increment", "rate"}
         What the values should be.
@@ -162,18 +163,18 @@ def check_specific_force(values, interval_s: float, kind: str = "increment", nam
     InvalidParameter
         Saying what was expected and what the median is.
     """
-    expected = STANDARD_GRAVITY * (interval_s if kind == "increment" else 1.0)
+    expected = STANDARD_GRAVITY * (interval if kind == "increment" else 1.0)
     median = float(np.median(np.linalg.norm(np.asarray(values, dtype=float), axis=1)))
     ratio = median / expected
     if 1.0 / MAGNITUDE_FACTOR <= ratio <= MAGNITUDE_FACTOR:
         return
     if kind == "increment":
-        what = f"velocity increments over {interval_s:g}-s intervals: median |dv| should be near g dt = " \
+        what = f"velocity increments over {interval:g}-s intervals: median |dv| should be near g dt = " \
                f"{expected:.4g} m/s, it is {median:.4g} m/s"
         hint = " (specific force in m/s^2?)" if ratio > MAGNITUDE_FACTOR else ""
     else:
         what = f"specific force: median |f| should be near g = {expected:.4g} m/s^2, it is {median:.4g} m/s^2"
-        hint = f" (velocity increments over {interval_s:g}-s intervals?)" if ratio < 1 / MAGNITUDE_FACTOR else ""
+        hint = f" (velocity increments over {interval:g}-s intervals?)" if ratio < 1 / MAGNITUDE_FACTOR else ""
     raise InvalidParameter(name, f"expected {what}, {ratio:.3g} times that{hint}")
 
 

@@ -62,7 +62,7 @@ from schuler.aided.ekf import FilterRun
 from schuler.aided.error_state import ATTITUDE, POSITION, VELOCITY
 from schuler.core.attitude import quaternion_from_rotation_vector, quaternion_multiply
 from schuler.core.earth import radii_of_curvature
-from schuler.exceptions import InvalidParameter, SimulationError
+from schuler.exceptions import InvalidParameter, SimulationError, renamed_keywords
 from schuler.memory import require
 
 NAVIGATION_STATES = 9
@@ -152,17 +152,18 @@ def _between(stored_t: np.ndarray, t_s: np.ndarray):
     return previous, following, fraction
 
 
-def output_variances(smoothed: FilterRun, t_s: np.ndarray) -> np.ndarray:
+@renamed_keywords(t_s="t")
+def output_variances(smoothed: FilterRun, t: np.ndarray) -> np.ndarray:
     """The smoothed variances of position, velocity and psi at output times, interpolated, shape (N, n_t, 9).
 
     Parameters
     ----------
     smoothed : FilterRun
         What :func:`smooth` returned (its ``covariance`` is P^s at the stored times).
-    t_s : ndarray, shape (n_t,)
+    t : ndarray, shape (n_t,)
         Times, s.
     """
-    previous, following, fraction = _between(smoothed.covariance_t_s, np.asarray(t_s, dtype=float))
+    previous, following, fraction = _between(smoothed.covariance_t_s, np.asarray(t, dtype=float))
     variance = np.diagonal(smoothed.covariance[..., :NAVIGATION_STATES, :NAVIGATION_STATES], axis1=-2, axis2=-1)
     return (1.0 - fraction)[:, None] * variance[:, previous] + fraction[:, None] * variance[:, following]
 

@@ -25,6 +25,7 @@ import numpy as np
 from schuler.alignment.multi_static import MultiStaticPlan, calibrate_multi_static, identifiable_truth
 from schuler.alignment.six_position import SixPositionPlan, calibrate_six_position
 from schuler.core.earth import earth_rate_ned
+from schuler.exceptions import renamed_keywords
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.simulate import ImuSimulator
 from schuler.imu.spec import preset
@@ -69,7 +70,7 @@ def _entry(estimate, truth, sigma) -> dict[str, list[float]]:
 
 
 def _record(model: ErrorModel, gyro_truth, accel_truth, dt: float, seed: int):
-    simulator = ImuSimulator(model, dt, true_gyro_rad_s=gyro_truth, true_accel_m_s2=accel_truth, seed=seed)
+    simulator = ImuSimulator(model, dt, true_gyro=gyro_truth, true_accel=accel_truth, seed=seed)
     gyro, accel = simulator.window([0], 0, gyro_truth.shape[0])
     return gyro[0], accel[0], simulator.constants([0])
 
@@ -136,7 +137,7 @@ class CalibrationComparison(Result):
 def _six_position(model: ErrorModel, latitude_rad: float, dwell_s: float, turn_s: float, dt: float, seed: int):
     plan = SixPositionPlan(latitude_rad=latitude_rad, dwell_s=dwell_s, turn_s=turn_s, sample_interval_s=dt)
     require(plan.samples * BYTES_PER_SAMPLE, f"the six-position record of {plan.samples:,} samples",
-            "--dwell, --turn or --imu-rate")
+            "`dwell`, `turn` or `imu_rate`")
     gyro_truth, accel_truth = plan.truth()
     gyro, accel, constants = _record(model, gyro_truth, accel_truth, dt, seed)
     fit = calibrate_six_position(gyro, accel, plan, model.gyro.random_walk, model.accel.random_walk)
@@ -158,11 +159,11 @@ def _multi_static(model: ErrorModel, latitude_rad: float, positions: int, static
     plan = MultiStaticPlan(positions=positions, static_s=static_s, sample_interval_s=dt, latitude_rad=latitude_rad)
     samples = (plan.initial_s + positions * (static_s + plan.move_s)) / dt
     require(samples * BYTES_PER_SAMPLE, f"the multi-static record of {samples:,.0f} samples",
-            "--positions, --static or --imu-rate")
+            "`positions`, `static` or `imu_rate`")
     gyro_truth, accel_truth = plan.truth(seed)
     gyro, accel, constants = _record(model, gyro_truth, accel_truth, dt, seed)
-    fit = calibrate_multi_static(gyro, accel, dt, initial_s=plan.initial_s, gravity_m_s2=plan.gravity,
-                                 latitude_rad=latitude_rad)
+    fit = calibrate_multi_static(gyro, accel, dt, initial=plan.initial_s, gravity=plan.gravity,
+                                 latitude=latitude_rad)
     truth = identifiable_truth(constants["accel_matrix"][0], constants["accel_bias"][0], constants["gyro_matrix"][0])
     # the initial period's mean holds the Earth rate seen in the first attitude: the bias it estimates
     start = plan.attitudes(seed)[0]
@@ -178,9 +179,11 @@ def _multi_static(model: ErrorModel, latitude_rad: float, positions: int, static
     return out
 
 
-def compare_calibration(grade: str, *, latitude_rad: float, seed: int = 0, dwell_s: float = 60.0,
-                        turn_s: float = 36.0, positions: int = 36, static_s: float = 3.0,
-                        sample_interval_s: float = 0.01, pulse_method: Callable | None = None,
+@renamed_keywords(latitude_rad="latitude", dwell_s="dwell", turn_s="turn", static_s="static",
+                  sample_interval_s="sample_interval")
+def compare_calibration(grade: str, *, latitude: float, seed: int = 0, dwell: float = 60.0,
+                        turn: float = 36.0, positions: int = 36, static: float = 3.0,
+                        sample_interval: float = 0.01, pulse_method: Callable | None = None,
                         pulse_members: int = 100) -> CalibrationComparison:
     """Both multi-position procedures on one simulated IMU of ``grade``, and the pulse method beside them.
 
@@ -188,15 +191,15 @@ def compare_calibration(grade: str, *, latitude_rad: float, seed: int = 0, dwell
     ----------
     grade : str
         An IMU preset.
-    latitude_rad : float
+    latitude : float
         L, rad.
     seed : int
         Address of the IMU's draws (member 0).
-    dwell_s, turn_s : float
+    dwell, turn : float
         Six-position dwell and rate-test turn, s.
-    positions, static_s : float
+    positions, static : float
         Multi-static orientations and their static time, s.
-    sample_interval_s : float
+    sample_interval : float
         dt, s.
     pulse_method : callable, optional
         schuler calibrate's spread: ``f(angle_random_walk, drift, latitude, members, seed) -> dict``.
@@ -204,17 +207,17 @@ def compare_calibration(grade: str, *, latitude_rad: float, seed: int = 0, dwell
         Its Monte Carlo members.
     """
     model = calibration_model(grade)
-    six = _six_position(model, latitude_rad, dwell_s, turn_s, sample_interval_s, seed)
-    multi = _multi_static(model, latitude_rad, positions, static_s, sample_interval_s, seed)
+    six = _six_position(model, latitude, dwell, turn, sample_interval, seed)
+    multi = _multi_static(model, latitude, positions, static, sample_interval, seed)
     pulse = None
     notes = ["multi-static gyro bias: the initial static period's mean, Earth rate included (compared with the "
              "bias plus the Earth rate seen there); its frame is the accelerometers' calibrated frame"]
     if pulse_method is not None:
-        pulse = dict(pulse_method(float(model.gyro.random_walk[0]), float(preset(grade).gyro.bias[0]), latitude_rad,
+        pulse = dict(pulse_method(float(model.gyro.random_walk[0]), float(preset(grade).gyro.bias[0]), latitude,
                                   pulse_members, seed))
         pulse["members"] = int(pulse_members)
         notes.append("pulse method (schuler calibrate): the x gyro's drift from alternating torque pulses at two "
                      "platform positions, with the grade's angle random walk and schuler calibrate's own default "
                      "error budget")
-    return CalibrationComparison(grade=grade, latitude_rad=latitude_rad, seed=seed, six_position=six,
+    return CalibrationComparison(grade=grade, latitude_rad=latitude, seed=seed, six_position=six,
                                  multi_static=multi, pulse=pulse, notes=notes)

@@ -33,6 +33,7 @@ import numpy as np
 from schuler.alignment.data import MethodEstimate, StaticBatch
 from schuler.core.attitude import euler_from_dcm, triad
 from schuler.core.earth import earth_rate_ned
+from schuler.exceptions import renamed_keywords
 
 DOWN = np.array([0.0, 0.0, 1.0])
 
@@ -82,13 +83,14 @@ def coarse_attitude(specific_force, angular_rate, latitude):
     return euler_from_dcm(coarse_dcm(specific_force, angular_rate, latitude))
 
 
-def align_coarse(batch: StaticBatch, history_step_s: float = 1.0) -> MethodEstimate:
+@renamed_keywords(history_step_s="history_step")
+def align_coarse(batch: StaticBatch, history_step: float = 1.0) -> MethodEstimate:
     """Coarse alignment of every record of ``batch`` over its whole window, with the growing-window history.
 
     Parameters
     ----------
     batch : StaticBatch
-    history_step_s : float
+    history_step : float
         Step of the histories, s: the attitude from the samples up to each time.
 
     Returns
@@ -96,7 +98,7 @@ def align_coarse(batch: StaticBatch, history_step_s: float = 1.0) -> MethodEstim
     MethodEstimate
         No 1-sigma of its own (``sigma_rad`` None): its accuracy is the static limit.
     """
-    ends = batch.history_indices(history_step_s)
+    ends = batch.history_indices(history_step)
     starts = np.concatenate([[0], ends[:-1]])
     gyro = np.add.reduceat(batch.gyro_increment, starts, axis=1).cumsum(axis=1)
     accel = np.add.reduceat(batch.accel_increment, starts, axis=1).cumsum(axis=1)

@@ -39,6 +39,7 @@ from schuler.alignment.north_comparison import NorthComparison, compare_north
 from schuler.alignment.plots import comparison_figures, write_files
 from schuler.contract import Action, Cases
 from schuler.core.attitude import wrap_angle
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
 from schuler.imu.files import read_record
@@ -72,9 +73,10 @@ ALIGN_COMPARE_PARAMETERS = ParameterSet((
     Parameter("gyrocompass_design", "", "staged", "Design of the gyrocompass loop: staged (levelling, then azimuth, "
               "driven by velocity; stages from the error model and the window) or kpi (the KPI manual's platform "
               "design, --time-constant and --damping).", choices=GYROCOMPASS_DESIGNS, kind="choice"),
-    Parameter("time_constant", "s", 30.0, "Time constant T of the gyrocompass loop's KPI design.",
+    Parameter("time_constant", "s", DESIGN_TIME_CONSTANT, "Time constant T of the gyrocompass loop's KPI design.",
               minimum=1, maximum=1e5),
-    Parameter("damping", "", 0.8, "Damping zeta of the gyrocompass loop's KPI design.", minimum=0.05, maximum=10),
+    Parameter("damping", "", DESIGN_DAMPING, "Damping zeta of the gyrocompass loop's KPI design.", minimum=0.05,
+              maximum=10),
     Parameter("velocity_noise", "m/s", 0.01, "Kalman filter's zero-velocity measurement noise (sway at rest).",
               minimum=0, exclusive_minimum=True, maximum=10),
     Parameter("update_interval", "s", 1.0, "Time between Kalman updates.", minimum=0, exclusive_minimum=True,
@@ -147,14 +149,14 @@ def align_compare(**values) -> AlignmentComparison:
     if case["record"] is None:
         grade = case["imu"]
         if grade is None:
-            raise InvalidParameter("record", "give --record FILE (a recording at rest) or --imu GRADE "
+            raise InvalidParameter("record", "give `record` FILE (a recording at rest) or `imu` GRADE "
                                    "(a simulated one)")
         model = preset(grade)
         latitude = math.radians(SIMULATED_LATITUDE_DEG) if case["latitude"] is None else case["latitude"]
         heading = float(wrap_angle(case["heading"]))
         duration = SIMULATED_DURATION_S if case["duration"] is None else case["duration"]
-        batch, constants = simulated_batch(model, latitude_rad=latitude, heading_rad=heading, duration_s=duration,
-                                           sample_interval_s=1.0 / case["imu_rate"], members=[0], seed=case["seed"])
+        batch, constants = simulated_batch(model, latitude=latitude, heading=heading, duration=duration,
+                                           sample_interval=1.0 / case["imu_rate"], members=[0], seed=case["seed"])
         gyro_true, accel_true = static_truth(latitude, heading, batch.gravity)
         # every constant error acts as a bias at rest: (K - I) u + b (+ G f for the gyros)
         gyro_bias = (constants["gyro_matrix"][0] - np.eye(3)) @ gyro_true + constants["gyro_bias"][0] \
@@ -163,11 +165,11 @@ def align_compare(**values) -> AlignmentComparison:
         return compare_alignment(batch, model, settings, source=f"simulated {grade} record (seed {case['seed']})",
                                  model_source="grade given", truth=(0.0, 0.0, heading), biases=(gyro_bias, accel_bias))
     record = read_record(case["record"])
-    batch = StaticBatch.from_record(record, latitude_rad=case["latitude"], start_s=case["start"],
-                                    duration_s=case["duration"])
+    batch = StaticBatch.from_record(record, latitude=case["latitude"], start=case["start"],
+                                    duration=case["duration"])
     model, model_source = record_model(window_record(record, case["start"], case["duration"]), case["imu"])
     return compare_alignment(batch, model, settings, source=record.source or str(case["record"]),
-                             start_s=case["start"], model_source=model_source)
+                             start=case["start"], model_source=model_source)
 
 
 def evaluate_with(parameters: ParameterSet, evaluate: Callable, common: dict, varying: dict | None = None, *,
@@ -229,9 +231,9 @@ def north_compare_action(parameters: ParameterSet, evaluate: Callable) -> Action
 
     def north_compare(**values) -> NorthComparison:
         case = NORTH_COMPARE_PARAMETERS.case(values)
-        return compare_north(case["imu"], latitude_rad=case["latitude"], heading_rad=float(wrap_angle(case["heading"])),
-                             duration_s=case["duration"], sample_interval_s=1.0 / case["imu_rate"], axes=case["axes"],
-                             carousel_period_s=case["carousel_period"], members=case["monte_carlo"],
+        return compare_north(case["imu"], latitude=case["latitude"], heading=float(wrap_angle(case["heading"])),
+                             duration=case["duration"], sample_interval=1.0 / case["imu_rate"], axes=case["axes"],
+                             carousel_period=case["carousel_period"], members=case["monte_carlo"],
                              seed=case["seed"], ground_gyrocompass=ground_gyrocompass)
 
     return Action("compare",
@@ -270,9 +272,9 @@ def calibrate_compare_action(parameters: ParameterSet, evaluate: Callable) -> Ac
     def calibrate_compare(**values) -> CalibrationComparison:
         case = CALIBRATE_COMPARE_PARAMETERS.case(values)
         members = case["monte_carlo"]
-        return compare_calibration(case["imu"], latitude_rad=case["latitude"], seed=case["seed"],
-                                   dwell_s=case["dwell"], turn_s=case["turn"], positions=case["positions"],
-                                   static_s=case["static"], sample_interval_s=1.0 / case["imu_rate"],
+        return compare_calibration(case["imu"], latitude=case["latitude"], seed=case["seed"],
+                                   dwell=case["dwell"], turn=case["turn"], positions=case["positions"],
+                                   static=case["static"], sample_interval=1.0 / case["imu_rate"],
                                    pulse_method=pulse_method if members >= 2 else None, pulse_members=members)
 
     return Action("compare",

@@ -26,7 +26,7 @@ import numpy as np
 
 from schuler.alignment.coarse import align_coarse
 from schuler.alignment.data import BYTES_PER_SAMPLE, MethodEstimate, StaticBatch, convergence_time, window_indices
-from schuler.alignment.gyrocompass import DEFAULT_DAMPING, DEFAULT_TIME_CONSTANT, align_gyrocompass, loop_gains
+from schuler.alignment.gyrocompass import align_gyrocompass
 from schuler.alignment.inertial import align_inertial, net_rotation
 from schuler.alignment.kalman import align_kalman
 from schuler.alignment.limits import METHODS, accuracy_limit, horizontal_rate, static_errors
@@ -37,7 +37,8 @@ from schuler.alignment.staged_gyrocompass import (
     staged_limit,
 )
 from schuler.core.attitude import wrap_angle
-from schuler.exceptions import InvalidParameter
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT, loop_gains
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.record import ImuRecord
 from schuler.imu.simulate import ImuSimulator, simulate_members, static_truth
@@ -75,8 +76,8 @@ class AlignmentSettings:
         Step of the heading histories, s.
     """
 
-    time_constant_s: float = DEFAULT_TIME_CONSTANT
-    damping: float = DEFAULT_DAMPING
+    time_constant_s: float = DESIGN_TIME_CONSTANT
+    damping: float = DESIGN_DAMPING
     velocity_noise: float = 0.01
     update_interval_s: float = 1.0
     initial_window_s: float = 30.0
@@ -108,10 +109,10 @@ def staged_design(model: ErrorModel, batch: StaticBatch) -> GyrocompassDesign:
 
 def _gyrocompass(batch: StaticBatch, model: ErrorModel, settings: AlignmentSettings) -> MethodEstimate:
     if settings.gyrocompass_design == "kpi":
-        return align_gyrocompass(batch, time_constant_s=settings.time_constant_s, damping=settings.damping,
-                                 initial_window_s=settings.initial_window_s, history_step_s=settings.history_step_s)
-    return align_staged_gyrocompass(batch, staged_design(model, batch), initial_window_s=settings.initial_window_s,
-                                    history_step_s=settings.history_step_s)
+        return align_gyrocompass(batch, time_constant=settings.time_constant_s, damping=settings.damping,
+                                 initial_window=settings.initial_window_s, history_step=settings.history_step_s)
+    return align_staged_gyrocompass(batch, staged_design(model, batch), initial_window=settings.initial_window_s,
+                                    history_step=settings.history_step_s)
 
 
 def run_methods(batch: StaticBatch, model: ErrorModel, settings: AlignmentSettings) -> dict[str, MethodEstimate]:
@@ -135,8 +136,8 @@ def run_methods(batch: StaticBatch, model: ErrorModel, settings: AlignmentSettin
         "coarse": align_coarse(batch, settings.history_step_s),
         "inertial_frame": align_inertial(batch, settings.history_step_s),
         "kalman": align_kalman(batch, model, velocity_noise=settings.velocity_noise,
-                               update_interval_s=settings.update_interval_s,
-                               initial_window_s=settings.initial_window_s, history_step_s=settings.history_step_s),
+                               update_interval=settings.update_interval_s,
+                               initial_window=settings.initial_window_s, history_step=settings.history_step_s),
         "gyrocompass": _gyrocompass(batch, model, settings),
     }
 
@@ -205,8 +206,8 @@ class AlignmentComparison(Result):
     body_rotation_rad: tuple[float, float, float] = (0.0, 0.0, 0.0)
     coarse_disturbance_rad: float = 0.0
     true_attitude_rad: tuple[float, float, float] | None = None
-    time_constant_s: float = DEFAULT_TIME_CONSTANT
-    damping: float = DEFAULT_DAMPING
+    time_constant_s: float = DESIGN_TIME_CONSTANT
+    damping: float = DESIGN_DAMPING
     c_gamma: float = 0.0
     c_a: float = 0.0
     notes: list[str] = field(default_factory=list)
@@ -291,8 +292,9 @@ def _row(estimate: MethodEstimate, limit, truth, predicted) -> dict[str, Any]:
     return row
 
 
+@renamed_keywords(start_s="start")
 def compare_alignment(batch: StaticBatch, model: ErrorModel, settings: AlignmentSettings = AlignmentSettings(), *,
-                      source: str = "", start_s: float = 0.0, model_source: str = "", truth=None,
+                      source: str = "", start: float = 0.0, model_source: str = "", truth=None,
                       biases=None) -> AlignmentComparison:
     """Run every method on a batch of one record and compare them (module notes).
 
@@ -305,7 +307,7 @@ def compare_alignment(batch: StaticBatch, model: ErrorModel, settings: Alignment
     settings : AlignmentSettings
     source, model_source : str
         What the data and the error model are, for the table.
-    start_s : float
+    start : float
         Where the window starts in the record, s.
     truth : (roll, pitch, heading), optional
         The true attitude, rad (simulated records).
@@ -351,7 +353,7 @@ def compare_alignment(batch: StaticBatch, model: ErrorModel, settings: Alignment
                      "error model, driven by the sensors' white noise only, allows for")
     stages = staged_design(model, batch).as_dicts() if settings.gyrocompass_design == "staged" else []
     return AlignmentComparison(
-        source=source, latitude_rad=batch.latitude_rad, start_s=start_s, duration_s=batch.duration_s,
+        source=source, latitude_rad=batch.latitude_rad, start_s=start, duration_s=batch.duration_s,
         sample_interval_s=batch.sample_interval_s, error_model=model.name, error_model_source=model_source,
         methods=methods, agreement=agreement,
         true_attitude_rad=None if truth is None else (float(truth[0]), float(truth[1]), float(truth[2])),
@@ -362,9 +364,11 @@ def compare_alignment(batch: StaticBatch, model: ErrorModel, settings: Alignment
         estimates=estimates)
 
 
-def simulated_batch(model: ErrorModel, *, latitude_rad: float, heading_rad: float, duration_s: float,
-                    sample_interval_s: float, members, seed: int = 0):
-    """Records of ``model`` at rest, level, at ``heading_rad``: (batch, constants) with each member's true errors.
+@renamed_keywords(latitude_rad="latitude", heading_rad="heading", duration_s="duration",
+                  sample_interval_s="sample_interval")
+def simulated_batch(model: ErrorModel, *, latitude: float, heading: float, duration: float,
+                    sample_interval: float, members, seed: int = 0):
+    """Records of ``model`` at rest, level, at ``heading``: (batch, constants) with each member's true errors.
 
     ``members`` is a count or a sequence of member numbers (the addresses of the draws).
 
@@ -372,13 +376,13 @@ def simulated_batch(model: ErrorModel, *, latitude_rad: float, heading_rad: floa
     ----------
     model : ErrorModel
         The simulated sensors' errors.
-    latitude_rad : float
+    latitude : float
         Site latitude L, rad.
-    heading_rad : float
+    heading : float
         True heading of the body x axis, rad, clockwise from north (roll and pitch zero).
-    duration_s : float
+    duration : float
         Length of each record, s.
-    sample_interval_s : float
+    sample_interval : float
         Sample interval dt, s.
     members : int or array_like of int
         Number of members (numbered 0, 1, ...), or the member numbers themselves.
@@ -400,29 +404,30 @@ def simulated_batch(model: ErrorModel, *, latitude_rad: float, heading_rad: floa
         The records would exceed the memory budget (:func:`schuler.memory.require`).
     """
     ids = np.arange(members) if np.ndim(members) == 0 else np.asarray(members, dtype=np.int64)
-    samples = int(round(duration_s / sample_interval_s))
+    samples = int(round(duration / sample_interval))
     require(ids.size * samples * BYTES_PER_SAMPLE * 2, f"simulating {ids.size:,} records of {samples:,} samples",
-            "--duration, --imu-rate or the number of members")
-    gyro_true, accel_true = static_truth(latitude_rad, heading_rad)
-    gyro, accel = simulate_members(model, samples=samples, sample_interval_s=sample_interval_s, members=ids,
-                                   seed=seed, true_gyro_rad_s=gyro_true, true_accel_m_s2=accel_true,
+            "`duration`, `imu_rate` or the number of members")
+    gyro_true, accel_true = static_truth(latitude, heading)
+    gyro, accel = simulate_members(model, samples=samples, sample_interval=sample_interval, members=ids,
+                                   seed=seed, true_gyro=gyro_true, true_accel=accel_true,
                                    max_memory_bytes=ids.size * samples * BYTES_PER_SAMPLE * 2 + 1)
-    gyro *= sample_interval_s
-    accel *= sample_interval_s
-    constants = ImuSimulator(model, sample_interval_s, seed=seed).constants(ids)
-    return StaticBatch(gyro, accel, sample_interval_s, latitude_rad, float(-accel_true[2])), constants
+    gyro *= sample_interval
+    accel *= sample_interval
+    constants = ImuSimulator(model, sample_interval, seed=seed).constants(ids)
+    return StaticBatch(gyro, accel, sample_interval, latitude, float(-accel_true[2])), constants
 
 
-def window_record(record: ImuRecord, start_s: float, duration_s: float | None) -> ImuRecord:
+@renamed_keywords(start_s="start", duration_s="duration")
+def window_record(record: ImuRecord, start: float, duration: float | None) -> ImuRecord:
     """The samples of [start, start + duration) of a record, as a record.
 
     Parameters
     ----------
     record : ImuRecord
         The recording.
-    start_s : float
+    start : float
         Start of the window, s from the record's first sample.
-    duration_s : float or None
+    duration : float or None
         Length of the window, s (None: to the record's end).
 
     Returns
@@ -430,7 +435,7 @@ def window_record(record: ImuRecord, start_s: float, duration_s: float | None) -
     ImuRecord
         The same record restricted to the window.
     """
-    first, stop = window_indices(record.samples, record.sample_interval_s, start_s, duration_s)
+    first, stop = window_indices(record.samples, record.sample_interval_s, start, duration)
     return replace(record, time_s=record.time_s[first:stop], gyro=record.gyro[first:stop],
                    accel=record.accel[first:stop])
 

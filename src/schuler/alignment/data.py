@@ -28,7 +28,7 @@ import numpy as np
 
 from schuler.core.attitude import wrap_angle
 from schuler.core.earth import normal_gravity
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu.record import ImuRecord
 from schuler.results import Result
 
@@ -83,19 +83,20 @@ class StaticBatch:
                 raise InvalidParameter(name, "holds NaN or infinite samples")
 
     @classmethod
-    def from_record(cls, record: ImuRecord, *, latitude_rad: float | None = None, start_s: float = 0.0,
-                    duration_s: float | None = None) -> StaticBatch:
+    @renamed_keywords(latitude_rad="latitude", start_s="start", duration_s="duration")
+    def from_record(cls, record: ImuRecord, *, latitude: float | None = None, start: float = 0.0,
+                    duration: float | None = None) -> StaticBatch:
         """The window [start, start + duration) of a record as a batch of one.
 
         Parameters
         ----------
         record : ImuRecord
             The recording at rest (increments, body axes).
-        latitude_rad : float, optional
+        latitude : float, optional
             Site latitude L, rad (default: the record's).
-        start_s : float
+        start : float
             Start of the window, s from the record's first sample.
-        duration_s : float, optional
+        duration : float, optional
             Length of the window, s (default: to the record's end).
 
         Returns
@@ -108,10 +109,10 @@ class StaticBatch:
         InvalidParameter
             No latitude (neither in the record nor given), or a window outside the record.
         """
-        latitude = record.latitude_rad if latitude_rad is None else latitude_rad
+        latitude = record.latitude_rad if latitude is None else latitude
         if latitude is None:
             raise InvalidParameter("latitude", f"{record.source or 'the record'} states no site latitude; give one")
-        first, stop = window_indices(record.samples, record.sample_interval_s, start_s, duration_s)
+        first, stop = window_indices(record.samples, record.sample_interval_s, start, duration)
         return cls(record.gyro_increment_rad[None, first:stop], record.accel_increment_m_s[None, first:stop],
                    record.sample_interval_s, float(latitude), record.gravity_m_s2)
 
@@ -170,7 +171,8 @@ class StaticBatch:
 
 
 
-def window_indices(samples: int, dt: float, start_s: float, duration_s: float | None) -> tuple[int, int]:
+@renamed_keywords(start_s="start", duration_s="duration")
+def window_indices(samples: int, dt: float, start: float, duration: float | None) -> tuple[int, int]:
     """Sample range [first, stop) of the window [start, start + duration) of a record of ``samples`` samples.
 
     Parameters
@@ -179,9 +181,9 @@ def window_indices(samples: int, dt: float, start_s: float, duration_s: float | 
         Number of samples in the record.
     dt : float
         Sample interval, s.
-    start_s : float
+    start : float
         Start of the window, s from the record's first sample (rounded to a whole sample).
-    duration_s : float or None
+    duration : float or None
         Length of the window, s (None: to the record's end).
 
     Returns
@@ -195,19 +197,19 @@ def window_indices(samples: int, dt: float, start_s: float, duration_s: float | 
         A start outside the record, a window past its end or one of fewer than 2 samples.
     """
     total = samples * dt
-    if not (math.isfinite(start_s) and 0 <= start_s < total):
-        raise InvalidParameter("start", f"{start_s:g} s must be within the record's [0, {total:g}) s")
-    first = int(round(start_s / dt))
-    if duration_s is None:
+    if not (math.isfinite(start) and 0 <= start < total):
+        raise InvalidParameter("start", f"{start:g} s must be within the record's [0, {total:g}) s")
+    first = int(round(start / dt))
+    if duration is None:
         return first, samples
-    if not (math.isfinite(duration_s) and duration_s > 0):
-        raise InvalidParameter("duration", f"must be finite and > 0 s, got {duration_s!r}")
-    stop = first + int(round(duration_s / dt))
+    if not (math.isfinite(duration) and duration > 0):
+        raise InvalidParameter("duration", f"must be finite and > 0 s, got {duration!r}")
+    stop = first + int(round(duration / dt))
     if stop > samples:
-        raise InvalidParameter("duration", f"{start_s:g} s + {duration_s:g} s runs past the record's end "
+        raise InvalidParameter("duration", f"{start:g} s + {duration:g} s runs past the record's end "
                                f"({total:g} s)")
     if stop - first < 2:
-        raise InvalidParameter("duration", f"{duration_s:g} s holds fewer than 2 samples")
+        raise InvalidParameter("duration", f"{duration:g} s holds fewer than 2 samples")
     return first, stop
 
 
@@ -277,12 +279,13 @@ class MethodEstimate(Result):
         return table
 
 
-def convergence_time(time_s, history, final, band) -> np.ndarray:
+@renamed_keywords(time_s="time")
+def convergence_time(time, history, final, band) -> np.ndarray:
     """The first time after which ``history`` stays within ``band`` of ``final`` (per record), s.
 
     Parameters
     ----------
-    time_s : ndarray (K,)
+    time : ndarray (K,)
         Times of the history, s.
     history : ndarray (m, K)
         Angles, rad (differences are wrapped).
@@ -298,4 +301,4 @@ def convergence_time(time_s, history, final, band) -> np.ndarray:
     """
     outside = np.abs(wrap_angle(np.asarray(history) - np.asarray(final)[:, None])) > np.asarray(band).reshape(-1, 1)
     last = np.where(outside.any(axis=1), outside.shape[1] - 1 - np.argmax(outside[:, ::-1], axis=1), -1)
-    return np.where(last + 1 < time_s.size, time_s[np.minimum(last + 1, time_s.size - 1)], time_s[-1])
+    return np.where(last + 1 < time.size, time[np.minimum(last + 1, time.size - 1)], time[-1])

@@ -10,7 +10,8 @@ so a north tilt decays with c_Gamma and an east tilt, which a heading error
 makes grow at Omega cos L per radian, turns the frame in azimuth until it
 stops (the loop (1.19)/(1.20) of schuler align, the same equations under the mapping
 of :func:`~schuler.alignment.limits.kpi_equivalent_inputs`). The gains come from
-a time constant T and damping zeta by the manual's design (end of its Sec. 2):
+a time constant T and damping zeta by the manual's design (end of its Sec. 2,
+:func:`schuler.core.gyrocompass_design.loop_gains`; T = 30 s, zeta = 0.8 by default):
 T^2 p^2 + 2 T zeta p + 1 = p^2 + c_Gamma p + U_eta c_a, so
 
     c_a = 1 / (T^2 Omega cos L),    c_Gamma = 2 zeta / T,
@@ -25,15 +26,11 @@ semi-analytic INS", laboratory manual, NTUU "Kyiv Polytechnic Institute"
 
 Examples
 --------
->>> import math
->>> c_gamma, c_a = loop_gains(math.radians(50.0), 30.0, 0.8)
->>> round(c_gamma, 4), round(c_a, 2)
-(0.0533, 23.7)
+>>> settling_time(DESIGN_TIME_CONSTANT, DESIGN_DAMPING)   # 5 T / zeta, s
+187.5
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
@@ -43,48 +40,11 @@ from schuler.alignment.inertial import start_attitude
 from schuler.alignment.limits import horizontal_rate
 from schuler.core.attitude import euler_from_dcm
 from schuler.core.earth import earth_rate_ned
-from schuler.exceptions import InvalidParameter
-
-DEFAULT_TIME_CONSTANT = 30.0
-"""T, s: the manual's "often T = 30 s"."""
-
-DEFAULT_DAMPING = 0.8
-"""zeta: the manual's "often zeta = 0.8"."""
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT, loop_gains
+from schuler.exceptions import renamed_keywords
 
 SETTLING_DECREMENTS = 5.0
 """Settling time = 5 / h (the manual's t = 5 / h)."""
-
-
-def loop_gains(latitude: float, time_constant: float, damping: float) -> tuple[float, float]:
-    """(c_gamma, c_a), 1/s, from T (s) and zeta: c_a = 1 / (T^2 Omega cos L), c_gamma = 2 zeta / T.
-
-    Parameters
-    ----------
-    latitude : float
-        Latitude L, rad.
-    time_constant : float
-        Time constant T of the azimuth loop, s.
-    damping : float
-        Damping zeta of the azimuth loop, plain number.
-
-    Returns
-    -------
-    c_gamma, c_a : float
-        Gains of the levelling and azimuth channels (KPI manual (1.6)), 1/s.
-
-    Raises
-    ------
-    InvalidParameter
-        T or zeta not positive.
-    NotObservable
-        Beyond :data:`~schuler.alignment.limits.MAX_LATITUDE`.
-    """
-    if not (math.isfinite(time_constant) and time_constant > 0):
-        raise InvalidParameter("time_constant", f"must be finite and > 0 s, got {time_constant!r}")
-    if not (math.isfinite(damping) and damping > 0):
-        raise InvalidParameter("damping", f"must be finite and > 0, got {damping!r}")
-    rate = float(horizontal_rate(latitude))
-    return 2.0 * damping / time_constant, 1.0 / (time_constant**2 * rate)
 
 
 def settling_time(time_constant: float, damping: float) -> float:
@@ -105,19 +65,20 @@ def settling_time(time_constant: float, damping: float) -> float:
     return SETTLING_DECREMENTS * time_constant / damping
 
 
-def align_gyrocompass(batch: StaticBatch, *, time_constant_s: float = DEFAULT_TIME_CONSTANT,
-                      damping: float = DEFAULT_DAMPING, initial_window_s: float = 30.0,
-                      history_step_s: float = 1.0) -> MethodEstimate:
+@renamed_keywords(time_constant_s="time_constant", initial_window_s="initial_window", history_step_s="history_step")
+def align_gyrocompass(batch: StaticBatch, *, time_constant: float = DESIGN_TIME_CONSTANT,
+                      damping: float = DESIGN_DAMPING, initial_window: float = 30.0,
+                      history_step: float = 1.0) -> MethodEstimate:
     """The strapdown gyrocompass over every record of ``batch``, started from inertial-frame alignment.
 
     Parameters
     ----------
     batch : StaticBatch
-    time_constant_s, damping : float
+    time_constant, damping : float
         T (s) and zeta of the azimuth loop.
-    initial_window_s : float
+    initial_window : float
         Inertial-frame alignment over the first seconds gives the start.
-    history_step_s : float
+    history_step : float
         Step of the histories, s.
 
     Returns
@@ -126,10 +87,11 @@ def align_gyrocompass(batch: StaticBatch, *, time_constant_s: float = DEFAULT_TI
         No 1-sigma of its own: its accuracy is the limit of its design
         (:func:`~schuler.alignment.limits.accuracy_limit` with the gains).
     """
-    c_gamma, c_a = loop_gains(batch.latitude_rad, time_constant_s, damping)
+    horizontal_rate(batch.latitude_rad)  # refuses beyond MAX_LATITUDE, where heading is not observable
+    c_gamma, c_a = loop_gains(batch.latitude_rad, time_constant, damping)
     dt = batch.sample_interval_s
-    attitude = start_attitude(batch.head(initial_window_s))
-    ends = batch.history_indices(history_step_s)
+    attitude = start_attitude(batch.head(initial_window))
+    ends = batch.history_indices(history_step)
     history = np.empty((batch.members, ends.size, 3, 3))
     _kernels.gyrocompass_loop(batch.gyro_increment, batch.accel_increment, dt, attitude,
                               earth_rate_ned(batch.latitude_rad), batch.gravity, c_gamma, c_a, ends,

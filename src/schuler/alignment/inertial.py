@@ -41,6 +41,7 @@ from schuler.alignment import _kernels
 from schuler.alignment.data import MethodEstimate, StaticBatch
 from schuler.core.attitude import dcm_from_rotation_vector, euler_from_dcm, skew, triad
 from schuler.core.earth import earth_rate_ned
+from schuler.exceptions import renamed_keywords
 
 
 def navigation_velocity(times, latitude, gravity) -> np.ndarray:
@@ -123,13 +124,14 @@ def start_attitude(batch: StaticBatch) -> np.ndarray:
     return _start_and_end(batch)[0]
 
 
-def align_inertial(batch: StaticBatch, history_step_s: float = 1.0) -> MethodEstimate:
+@renamed_keywords(history_step_s="history_step")
+def align_inertial(batch: StaticBatch, history_step: float = 1.0) -> MethodEstimate:
     """Inertial-frame alignment of every record of ``batch``, with the history over the window.
 
     Parameters
     ----------
     batch : StaticBatch
-    history_step_s : float
+    history_step : float
         Step of the histories, s (each point is the method run on [0, t], with t1 = t/2 rounded down).
 
     Returns
@@ -137,7 +139,7 @@ def align_inertial(batch: StaticBatch, history_step_s: float = 1.0) -> MethodEst
     MethodEstimate
         No 1-sigma of its own.
     """
-    history = batch.history_indices(history_step_s)
+    history = batch.history_indices(history_step)
     ends = np.union1d(history, [max(1, batch.samples // 2)])
     attitude = np.empty((batch.members, ends.size, 3, 3))
     velocity = np.empty((batch.members, ends.size, 3))

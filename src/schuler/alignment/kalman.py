@@ -55,7 +55,7 @@ from schuler.alignment.inertial import start_attitude
 from schuler.alignment.limits import accuracy_limit, effective_bias_sigma
 from schuler.core.attitude import dcm_from_euler, dcm_from_rotation_vector, euler_from_dcm, orthonormalise, skew
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY, earth_rate_ned
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 
 STATES = 12
 INFLATION = 10.0
@@ -87,11 +87,12 @@ class KalmanTuning:
     velocity_noise: float
 
     @classmethod
-    def from_model(cls, model, velocity_noise: float = 0.01, window_s: float = 600.0,
+    @renamed_keywords(window_s="window")
+    def from_model(cls, model, velocity_noise: float = 0.01, window: float = 600.0,
                    gravity: float = STANDARD_GRAVITY) -> KalmanTuning:
         """From an :class:`~schuler.imu.error_model.ErrorModel`: N, the constant error at rest
         (:func:`~schuler.alignment.limits.effective_bias_sigma`), and a bias walk that lets the bias
-        instability B build up over ``window_s`` (q = B^2 / window).
+        instability B build up over ``window`` (q = B^2 / window).
 
         Parameters
         ----------
@@ -99,7 +100,7 @@ class KalmanTuning:
             The sensors' per-axis 1-sigma errors, SI, body axes.
         velocity_noise : float
             1-sigma of the zero-velocity measurement, m/s (> 0).
-        window_s : float
+        window : float
             Time over which the bias instability builds up in the bias walk, s (finite, > 0).
         gravity : float
             g at the site, m/s^2 (for the g-dependent constant errors).
@@ -112,17 +113,17 @@ class KalmanTuning:
         Raises
         ------
         InvalidParameter
-            ``velocity_noise`` or ``window_s`` not finite and positive.
+            ``velocity_noise`` or ``window`` not finite and positive.
         """
         if not (math.isfinite(velocity_noise) and velocity_noise > 0):
             raise InvalidParameter("velocity_noise", f"must be finite and > 0 m/s, got {velocity_noise!r}")
-        if not (math.isfinite(window_s) and window_s > 0):
-            raise InvalidParameter("window_s", f"must be finite and > 0 s, got {window_s!r}")
+        if not (math.isfinite(window) and window > 0):
+            raise InvalidParameter("window", f"must be finite and > 0 s, got {window!r}")
         gyro, accel = model.gyro, model.accel
         gyro_bias, accel_bias = effective_bias_sigma(model, gravity)
         return cls(np.asarray(gyro.random_walk, dtype=float), np.asarray(accel.random_walk, dtype=float),
-                   gyro_bias, accel_bias, gyro.bias_instability / math.sqrt(window_s),
-                   accel.bias_instability / math.sqrt(window_s), float(velocity_noise))
+                   gyro_bias, accel_bias, gyro.bias_instability / math.sqrt(window),
+                   accel.bias_instability / math.sqrt(window), float(velocity_noise))
 
 
 def coarse_error_map(latitude: float, gravity: float) -> np.ndarray:
@@ -238,8 +239,9 @@ def attitude_sigma(P: np.ndarray, heading: np.ndarray) -> np.ndarray:
     return np.sqrt(np.maximum(np.diagonal(cov, axis1=-2, axis2=-1), 0.0))
 
 
-def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, update_interval_s: float = 1.0,
-                 initial_window_s: float = 30.0, history_step_s: float = 1.0) -> MethodEstimate:
+@renamed_keywords(update_interval_s="update_interval", initial_window_s="initial_window", history_step_s="history_step")
+def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, update_interval: float = 1.0,
+                 initial_window: float = 30.0, history_step: float = 1.0) -> MethodEstimate:
     """Kalman fine alignment of every record of ``batch`` at once.
 
     Parameters
@@ -249,11 +251,11 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
         The sensors' error model: the filter's noise and bias statistics (:meth:`KalmanTuning.from_model`).
     velocity_noise : float
         1-sigma of the zero-velocity measurement, m/s.
-    update_interval_s : float
+    update_interval : float
         Time between filter updates, s (rounded to whole samples).
-    initial_window_s : float
+    initial_window : float
         Inertial-frame alignment over the first seconds gives the start (shortened to the window if longer).
-    history_step_s : float
+    history_step : float
         Step of the histories, s (rounded to whole updates).
 
     Returns
@@ -261,12 +263,12 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
     MethodEstimate
         With the filter's 1-sigma of roll, pitch and heading (final and over time).
     """
-    if not (math.isfinite(update_interval_s) and update_interval_s > 0):
-        raise InvalidParameter("update_interval", f"must be finite and > 0 s, got {update_interval_s!r}")
+    if not (math.isfinite(update_interval) and update_interval > 0):
+        raise InvalidParameter("update_interval", f"must be finite and > 0 s, got {update_interval!r}")
     dt = batch.sample_interval_s
-    per_update = max(1, int(round(update_interval_s / dt)))
+    per_update = max(1, int(round(update_interval / dt)))
     tuning = KalmanTuning.from_model(model, velocity_noise, gravity=batch.gravity)
-    head = batch.head(initial_window_s)
+    head = batch.head(initial_window)
     C = start_attitude(head)
     heading0 = euler_from_dcm(C)[2]
     m = batch.members
@@ -280,7 +282,7 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
                                         tuning.gyro_bias_walk**2, tuning.accel_bias_walk**2]))
     R = np.eye(3) * tuning.velocity_noise**2
     bounds = np.append(np.arange(0, batch.samples, per_update), batch.samples)
-    record_every = max(1, int(round(history_step_s / (per_update * dt))))
+    record_every = max(1, int(round(history_step / (per_update * dt))))
     times, angles, sigmas = [], [], []
     for step, (start, stop) in enumerate(zip(bounds[:-1], bounds[1:])):
         span = (stop - start) * dt

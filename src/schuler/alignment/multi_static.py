@@ -89,7 +89,7 @@ Examples
 --------
 >>> plan = MultiStaticPlan(positions=12, sample_interval_s=0.02)
 >>> gyro, accel = plan.truth(seed=1)
->>> result = calibrate_multi_static(gyro, accel, plan.sample_interval_s, initial_s=plan.initial_s)
+>>> result = calibrate_multi_static(gyro, accel, plan.sample_interval_s, initial=plan.initial_s)
 >>> result.static_intervals, bool(abs(result.accel_scale - 1).max() < 1e-9)
 (13, True)
 """
@@ -105,7 +105,7 @@ from schuler.alignment import _multi_static_fits as fits
 from schuler.core.attitude import dcm_from_rotation_vector
 from schuler.core.earth import EARTH_RATE, earth_rate_ned, normal_gravity
 from schuler.core.random import RandomStreams
-from schuler.exceptions import IdentificationError, InvalidParameter
+from schuler.exceptions import IdentificationError, InvalidParameter, renamed_keywords
 from schuler.imu.error_model import ErrorModel
 
 THRESHOLD_FACTORS = (2.0, 4.0, 8.0, 16.0, 32.0)
@@ -233,34 +233,36 @@ def _moving_variance(values: np.ndarray, width: int) -> np.ndarray:
     return np.maximum((squares[hi] - squares[lo]) / count - mean**2, 0.0)
 
 
-def detect_static(accel, sample_interval_s: float, *, initial_s: float, factor: float, window_s: float = 1.0,
-                  min_static_s: float = 1.0) -> list[tuple[int, int]]:
+@renamed_keywords(sample_interval_s="sample_interval", initial_s="initial", window_s="window",
+                  min_static_s="min_static")
+def detect_static(accel, sample_interval: float, *, initial: float, factor: float, window: float = 1.0,
+                  min_static: float = 1.0) -> list[tuple[int, int]]:
     """Static intervals [first, stop) of a record (module notes, step 1); the initial period is the first.
 
     Parameters
     ----------
     accel : ndarray (n, 3)
         Specific force samples, m/s^2.
-    sample_interval_s : float
+    sample_interval : float
         dt, s.
-    initial_s : float
+    initial : float
         Length of the initial static period, s.
     factor : float
         Threshold as a multiple of the initial period's mean statistic (a ratio).
-    window_s, min_static_s : float
+    window, min_static : float
         Sliding window and shortest static interval, s.
     """
-    dt = float(sample_interval_s)
-    width = max(3, int(round(window_s / dt)))
+    dt = float(sample_interval)
+    width = max(3, int(round(window / dt)))
     statistic = _moving_variance(np.asarray(accel, dtype=float), width).sum(axis=1)
-    initial = int(round(initial_s / dt))
-    if initial < width or initial > statistic.size:
-        raise InvalidParameter("initial", f"the initial static period of {initial_s:g} s must cover the window "
-                               f"({window_s:g} s) and fit in the record")
-    threshold = factor * statistic[width // 2: initial - width // 2].mean() + VARIANCE_FLOOR
+    initial_samples = int(round(initial / dt))
+    if initial_samples < width or initial_samples > statistic.size:
+        raise InvalidParameter("initial", f"the initial static period of {initial:g} s must cover the window "
+                               f"({window:g} s) and fit in the record")
+    threshold = factor * statistic[width // 2: initial_samples - width // 2].mean() + VARIANCE_FLOOR
     still = statistic <= threshold
     edges = np.flatnonzero(np.diff(np.concatenate([[0], still.astype(np.int8), [0]])))
-    trim, shortest = width // 2, int(round(min_static_s / dt))
+    trim, shortest = width // 2, int(round(min_static / dt))
     intervals = []
     for first, stop in zip(edges[0::2], edges[1::2]):
         first, stop = (first if first == 0 else first + trim), stop - trim
@@ -347,9 +349,11 @@ def _noise(gyro: np.ndarray, intervals, gaps, mean_variances: np.ndarray, dt: fl
             "gap_bias": gap_bias}
 
 
-def calibrate_multi_static(gyro, accel, sample_interval_s: float, *, initial_s: float,
-                           gravity_m_s2: float | None = None, latitude_rad: float = math.radians(45.0),
-                           window_s: float = 1.0, min_static_s: float = 1.0,
+@renamed_keywords(sample_interval_s="sample_interval", initial_s="initial", latitude_rad="latitude", window_s="window",
+                  min_static_s="min_static", gravity_m_s2="gravity")
+def calibrate_multi_static(gyro, accel, sample_interval: float, *, initial: float,
+                           gravity: float | None = None, latitude: float = math.radians(45.0),
+                           window: float = 1.0, min_static: float = 1.0,
                            error_model: ErrorModel | None = None) -> MultiStaticCalibration:
     """Calibrate both triads from a hand-held multi-static record (module notes).
 
@@ -357,15 +361,15 @@ def calibrate_multi_static(gyro, accel, sample_interval_s: float, *, initial_s: 
     ----------
     gyro, accel : ndarray (n, 3)
         Mean rates (rad/s) and specific forces (m/s^2) of every sample, sensor axes.
-    sample_interval_s : float
+    sample_interval : float
         dt, s.
-    initial_s : float
+    initial : float
         Length of the initial static period, s.
-    gravity_m_s2 : float, optional
-        Local g, m/s^2 (default: normal gravity at ``latitude_rad``).
-    latitude_rad : float
+    gravity : float, optional
+        Local g, m/s^2 (default: normal gravity at ``latitude``).
+    latitude : float
         Site latitude L, rad: the default g and the Earth rate's vertical part, Omega sin L (module notes, step 3).
-    window_s, min_static_s : float
+    window, min_static : float
         Static detector settings, s.
     error_model : ErrorModel, optional
         The IMU's error model: its slow bias terms (Gauss-Markov bias, bias instability as the simulator's sum of
@@ -380,12 +384,12 @@ def calibrate_multi_static(gyro, accel, sample_interval_s: float, *, initial_s: 
     gyro, accel = np.asarray(gyro, dtype=float), np.asarray(accel, dtype=float)
     if gyro.shape != accel.shape or gyro.ndim != 2 or gyro.shape[1] != 3:
         raise InvalidParameter("samples", f"gyro {gyro.shape} and accel {accel.shape} must both be (n, 3)")
-    dt = float(sample_interval_s)
-    gravity = float(normal_gravity(latitude_rad)) if gravity_m_s2 is None else float(gravity_m_s2)
+    dt = float(sample_interval)
+    gravity = float(normal_gravity(latitude)) if gravity is None else float(gravity)
     best = None
     for factor in THRESHOLD_FACTORS:
-        intervals = detect_static(accel, dt, initial_s=initial_s, factor=factor, window_s=window_s,
-                                  min_static_s=min_static_s)
+        intervals = detect_static(accel, dt, initial=initial, factor=factor, window=window,
+                                  min_static=min_static)
         if len(intervals) < MIN_INTERVALS:
             continue
         means = _interval_statistics(accel, intervals)[0]
@@ -409,7 +413,7 @@ def calibrate_multi_static(gyro, accel, sample_interval_s: float, *, initial_s: 
     for j, (a, b) in enumerate(gaps):
         motion[j, :b - a] = gyro[a:b] - gyro_bias
     problem = fits.GyroProblem(motion, lengths, dt, fits.directions(accel_params, means), EARTH_RATE,
-                               EARTH_RATE * math.sin(latitude_rad))
+                               EARTH_RATE * math.sin(latitude))
     gyro_params, gyro_jacobian, gyro_rms = fits.least_squares_fit(problem.residuals, np.r_[np.eye(3).ravel(), 0, 0],
                                                                   "gyro fit")
     gyro_covariance = problem.covariance(gyro_params, gyro_jacobian, noise,

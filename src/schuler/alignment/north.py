@@ -44,7 +44,7 @@ Examples
 --------
 >>> import math
 >>> import numpy as np
->>> start, end = schedule("four_position", samples=400, sample_interval_s=0.5)
+>>> start, end = schedule("four_position", samples=400, sample_interval=0.5)
 >>> latitude, psi = math.radians(45.0), math.radians(-40.0)
 >>> gyro = turntable_rates(latitude, psi, start, end, 0.5)
 >>> estimate = find_north(gyro[None, :, :2], start, end, latitude, "four_position", axes="xy")
@@ -62,7 +62,7 @@ import numpy as np
 from schuler.alignment.limits import horizontal_rate
 from schuler.core.attitude import wrap_angle
 from schuler.core.earth import EARTH_RATE
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 
 NORTH_METHODS = ("two_position", "four_position", "carousel")
 """The turntable north finders."""
@@ -74,8 +74,9 @@ DEFAULT_CAROUSEL_PERIOD = 60.0
 """One turn of the carousel, s."""
 
 
-def schedule(method: str, *, samples: int, sample_interval_s: float,
-             carousel_period_s: float = DEFAULT_CAROUSEL_PERIOD) -> tuple[np.ndarray, np.ndarray]:
+@renamed_keywords(sample_interval_s="sample_interval", carousel_period_s="carousel_period")
+def schedule(method: str, *, samples: int, sample_interval: float,
+             carousel_period: float = DEFAULT_CAROUSEL_PERIOD) -> tuple[np.ndarray, np.ndarray]:
     """Turntable angle at the start and the end of each sample interval, rad (each shape (samples,)).
 
     The turns between positions are taken as instantaneous (an ideal table).
@@ -86,9 +87,9 @@ def schedule(method: str, *, samples: int, sample_interval_s: float,
         The north-finding schedule.
     samples : int
         Number of samples (at least 4); the positions get equal shares of them.
-    sample_interval_s : float
+    sample_interval : float
         Sample interval dt, s.
-    carousel_period_s : float
+    carousel_period : float
         One turn of the carousel, s (``carousel`` only).
 
     Returns
@@ -107,10 +108,10 @@ def schedule(method: str, *, samples: int, sample_interval_s: float,
         raise InvalidParameter("duration", f"a north finder needs at least 4 samples, got {samples}")
     k = np.arange(samples)
     if method == "carousel":
-        if not (math.isfinite(carousel_period_s) and carousel_period_s > 0):
-            raise InvalidParameter("carousel_period", f"must be finite and > 0 s, got {carousel_period_s!r}")
-        rate = 2.0 * math.pi / carousel_period_s
-        return rate * sample_interval_s * k, rate * sample_interval_s * (k + 1)
+        if not (math.isfinite(carousel_period) and carousel_period > 0):
+            raise InvalidParameter("carousel_period", f"must be finite and > 0 s, got {carousel_period!r}")
+        rate = 2.0 * math.pi / carousel_period
+        return rate * sample_interval * k, rate * sample_interval * (k + 1)
     positions = 2 if method == "two_position" else 4
     angle = (k * positions // samples) * (2.0 * math.pi / positions)
     return angle.astype(float), angle.astype(float)
@@ -127,7 +128,8 @@ def _interval_means(start, end) -> tuple[np.ndarray, np.ndarray]:
     return cos_mean, sin_mean
 
 
-def turntable_rates(latitude: float, heading: float, start, end, sample_interval_s: float) -> np.ndarray:
+@renamed_keywords(sample_interval_s="sample_interval")
+def turntable_rates(latitude: float, heading: float, start, end, sample_interval: float) -> np.ndarray:
     """True mean angular rates (n, 3) of a level IMU on the table: Earth rate plus the table's rate about z (down).
 
     Parameters
@@ -136,7 +138,7 @@ def turntable_rates(latitude: float, heading: float, start, end, sample_interval
         L and the azimuth psi of the x axis at theta = 0, rad.
     start, end : ndarray (n,)
         Table angle at each interval's start and end, rad (:func:`schedule`).
-    sample_interval_s : float
+    sample_interval : float
         dt, s.
     """
     cos_mean, sin_mean = _interval_means(start, end)
@@ -146,7 +148,7 @@ def turntable_rates(latitude: float, heading: float, start, end, sample_interval
     # cos(psi + theta) = c cos theta - s sin theta; sin(psi + theta) = s cos theta + c sin theta
     rates[:, 0] = horizontal * (c * cos_mean - s * sin_mean)
     rates[:, 1] = -horizontal * (s * cos_mean + c * sin_mean)
-    rates[:, 2] = -vertical + (np.asarray(end) - np.asarray(start)) / sample_interval_s
+    rates[:, 2] = -vertical + (np.asarray(end) - np.asarray(start)) / sample_interval
     return rates
 
 

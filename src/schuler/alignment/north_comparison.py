@@ -29,6 +29,7 @@ from schuler.alignment.north import (
     turntable_rates,
 )
 from schuler.core.attitude import wrap_angle
+from schuler.exceptions import renamed_keywords
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.simulate import ImuSimulator, iter_simulation
 from schuler.imu.spec import GRADES, preset
@@ -42,7 +43,8 @@ READOUT_STEP_S = 1.0
 """Sampling step of the ground gyrocompass's read-out at which a grade's noise is taken, s."""
 
 
-def readout_noise(model: ErrorModel, step_s: float = READOUT_STEP_S) -> float:
+@renamed_keywords(step_s="step")
+def readout_noise(model: ErrorModel, step: float = READOUT_STEP_S) -> float:
     """The angle read-out noise a grade's gyro gives over a step h: sqrt(Q^2 + N^2 h), rad (z gyro).
 
     The mapping of :func:`schuler.imu.system_inputs.north_inputs`: the azimuth angle
@@ -52,7 +54,7 @@ def readout_noise(model: ErrorModel, step_s: float = READOUT_STEP_S) -> float:
     ----------
     model : ErrorModel
         The grade's errors: the z gyro's quantisation Q (rad) and angle random walk N (rad/sqrt(s)).
-    step_s : float
+    step : float
         Read-out step h, s.
 
     Returns
@@ -61,12 +63,14 @@ def readout_noise(model: ErrorModel, step_s: float = READOUT_STEP_S) -> float:
         1-sigma of the angle read-out, rad.
     """
     q, n = model.gyro.quantization[2], model.gyro.random_walk[2]
-    return float(math.sqrt(q**2 + n**2 * step_s))
+    return float(math.sqrt(q**2 + n**2 * step))
 
 
-def simulate_turntable(model: ErrorModel, method: str, *, latitude_rad: float, heading_rad: float, samples: int,
-                       sample_interval_s: float, members, seed: int, axes: str,
-                       carousel_period_s: float = DEFAULT_CAROUSEL_PERIOD):
+@renamed_keywords(latitude_rad="latitude", heading_rad="heading", sample_interval_s="sample_interval",
+                  carousel_period_s="carousel_period")
+def simulate_turntable(model: ErrorModel, method: str, *, latitude: float, heading: float, samples: int,
+                       sample_interval: float, members, seed: int, axes: str,
+                       carousel_period: float = DEFAULT_CAROUSEL_PERIOD):
     """Gyro records of a level IMU on the method's schedule: (rates (m, n, k), start, end).
 
     Parameters
@@ -75,13 +79,13 @@ def simulate_turntable(model: ErrorModel, method: str, *, latitude_rad: float, h
         The simulated sensors' errors.
     method : {"two_position", "four_position", "carousel"}
         The turntable schedule (:func:`~schuler.alignment.north.schedule`).
-    latitude_rad : float
+    latitude : float
         Site latitude L, rad.
-    heading_rad : float
+    heading : float
         True azimuth psi of the x axis at table angle 0, rad, clockwise from north.
     samples : int
         Number of samples n per record.
-    sample_interval_s : float
+    sample_interval : float
         Sample interval dt, s.
     members : int or array_like of int
         Number of members m (numbered 0, 1, ...), or the member numbers themselves.
@@ -89,7 +93,7 @@ def simulate_turntable(model: ErrorModel, method: str, *, latitude_rad: float, h
         Seed of the addressed random streams.
     axes : {"x", "xy"}
         The x gyro alone or both horizontal gyros (k = 1 or 2).
-    carousel_period_s : float
+    carousel_period : float
         One turn of the carousel, s (``carousel`` only).
 
     Returns
@@ -104,15 +108,15 @@ def simulate_turntable(model: ErrorModel, method: str, *, latitude_rad: float, h
     MemoryBudgetExceeded
         The records would exceed the memory budget (:func:`schuler.memory.require`).
     """
-    start, end = schedule(method, samples=samples, sample_interval_s=sample_interval_s,
-                          carousel_period_s=carousel_period_s)
-    truth = turntable_rates(latitude_rad, heading_rad, start, end, sample_interval_s)
+    start, end = schedule(method, samples=samples, sample_interval=sample_interval,
+                          carousel_period=carousel_period)
+    truth = turntable_rates(latitude, heading, start, end, sample_interval)
     ids = np.arange(members) if np.ndim(members) == 0 else np.asarray(members, dtype=np.int64)
     require(ids.size * samples * BYTES_PER_SAMPLE, f"simulating {ids.size:,} turntable records",
-            "--duration, --imu-rate or --monte-carlo")
+            "`duration`, `imu_rate` or `monte_carlo`")
     # the accelerometers read (0, 0, -g) throughout: the table turns about the vertical
-    simulator = ImuSimulator(model, sample_interval_s, true_gyro_rad_s=truth,
-                             true_accel_m_s2=np.array([0.0, 0.0, -9.80665]), seed=seed)
+    simulator = ImuSimulator(model, sample_interval, true_gyro=truth,
+                             true_accel=np.array([0.0, 0.0, -9.80665]), seed=seed)
     rates = np.empty((ids.size, samples, len(axes)))
     row = 0
     for group, first, gyro, _ in iter_simulation(simulator, ids, samples, member_chunk=64):
@@ -183,8 +187,10 @@ class NorthComparison(Result):
         return Group(table, *self.notes)
 
 
-def compare_north(grade: str, *, latitude_rad: float, heading_rad: float, duration_s: float, sample_interval_s: float,
-                  axes: str = "x", carousel_period_s: float = DEFAULT_CAROUSEL_PERIOD, members: int = 200,
+@renamed_keywords(latitude_rad="latitude", heading_rad="heading", duration_s="duration",
+                  sample_interval_s="sample_interval", carousel_period_s="carousel_period")
+def compare_north(grade: str, *, latitude: float, heading: float, duration: float, sample_interval: float,
+                  axes: str = "x", carousel_period: float = DEFAULT_CAROUSEL_PERIOD, members: int = 200,
                   seed: int = 0, ground_gyrocompass: Callable | None = None) -> NorthComparison:
     """Every north finder for one grade (module notes).
 
@@ -192,13 +198,13 @@ def compare_north(grade: str, *, latitude_rad: float, heading_rad: float, durati
     ----------
     grade : str
         An IMU preset (:data:`schuler.imu.spec.GRADES`).
-    latitude_rad, heading_rad : float
+    latitude, heading : float
         Site latitude and the true azimuth of the x axis at table angle 0, rad.
-    duration_s, sample_interval_s : float
+    duration, sample_interval : float
         Total observation time and sample interval, s.
     axes : {"x", "xy"}
         One gyro, or both horizontal gyros.
-    carousel_period_s : float
+    carousel_period : float
         One carousel turn, s.
     members, seed : int
         Monte Carlo members per method and their seed.
@@ -206,48 +212,48 @@ def compare_north(grade: str, *, latitude_rad: float, heading_rad: float, durati
         ``f(durations, readout_noise, latitude) -> 1-sigma`` of schuler north.
     """
     model = preset(grade)
-    samples = int(round(duration_s / sample_interval_s))
+    samples = int(round(duration / sample_interval))
     methods = {}
     for method in NORTH_METHODS:
-        rates, start, end = simulate_turntable(model, method, latitude_rad=latitude_rad, heading_rad=heading_rad,
-                                               samples=samples, sample_interval_s=sample_interval_s,
+        rates, start, end = simulate_turntable(model, method, latitude=latitude, heading=heading,
+                                               samples=samples, sample_interval=sample_interval,
                                                members=max(1, members), seed=seed, axes=axes,
-                                               carousel_period_s=carousel_period_s)
-        estimate = find_north(rates, start, end, latitude_rad, method, axes)
-        truth = abs(wrap_angle(heading_rad)) if estimate.ambiguous else heading_rad
+                                               carousel_period=carousel_period)
+        estimate = find_north(rates, start, end, latitude, method, axes)
+        truth = abs(wrap_angle(heading)) if estimate.ambiguous else heading
         errors = wrap_angle(estimate.heading_rad - truth)
         methods[method] = {
             "heading_rad": float(estimate.heading_rad[0]), "sigma_rad": float(estimate.sigma_rad[0]),
             "error_rad": float(errors[0]), "ambiguous": estimate.ambiguous,
-            "analytic_sigma_rad": float(north_sigma(method, axes, model.gyro.random_walk[0], latitude_rad,
-                                                    samples * sample_interval_s, heading_rad)),
+            "analytic_sigma_rad": float(north_sigma(method, axes, model.gyro.random_walk[0], latitude,
+                                                    samples * sample_interval, heading)),
             "monte_carlo_sigma_rad": float(errors.std(ddof=1)) if errors.size > 1 else None,
             "monte_carlo_mean_rad": float(errors.mean())}
     times = np.asarray(TIMES_S)
     versus_time: dict[str, list] = {"duration_s": times.tolist()}
     for method in NORTH_METHODS:
-        versus_time[method] = np.atleast_1d(north_sigma(method, axes, model.gyro.random_walk[0], latitude_rad, times,
-                                                        heading_rad)).tolist()
-    versus_grade = {name: {method: float(north_sigma(method, axes, preset(name).gyro.random_walk[0], latitude_rad,
-                                                     duration_s, heading_rad)) for method in NORTH_METHODS}
+        versus_time[method] = np.atleast_1d(north_sigma(method, axes, model.gyro.random_walk[0], latitude, times,
+                                                        heading)).tolist()
+    versus_grade = {name: {method: float(north_sigma(method, axes, preset(name).gyro.random_walk[0], latitude,
+                                                     duration, heading)) for method in NORTH_METHODS}
                     for name in GRADES}
     noise = readout_noise(model)
     gyro_entry = {"readout_noise_rad": noise, "sigma_rad": math.nan}
     notes = ["the analytic 1-sigma counts white gyro noise only; bias instability (flicker) moves the bias between "
              "the dwells of the position methods and adds to their Monte Carlo spread"]
     if ground_gyrocompass is not None:
-        curve = np.asarray(ground_gyrocompass(times, noise, latitude_rad), dtype=float)
+        curve = np.asarray(ground_gyrocompass(times, noise, latitude), dtype=float)
         versus_time["ground_gyrocompass"] = curve.tolist()
-        gyro_entry["sigma_rad"] = float(np.asarray(ground_gyrocompass(np.array([duration_s]), noise,
-                                                                       latitude_rad))[0])
+        gyro_entry["sigma_rad"] = float(np.asarray(ground_gyrocompass(np.array([duration]), noise,
+                                                                       latitude))[0])
         notes.append("ground gyrocompass (schuler north): the source's instrument (rotor run-down, 4 unknowns "
                      f"identified) read every {READOUT_STEP_S:g} s with the grade's angle noise sqrt(Q^2 + N^2 h) = "
                      f"{math.degrees(noise) * 3600:.3g} arcsec; its directive torque H Omega cos L acts on a "
                      "sensitive element whose swing is observed directly, so the same read-out noise costs far less "
                      "azimuth than rate noise does a strapdown gyro (its own errors, e.g. suspension torques, "
                      "are not part of this comparison)")
-    return NorthComparison(grade=grade, latitude_rad=latitude_rad, heading_rad=heading_rad,
-                           duration_s=samples * sample_interval_s, sample_interval_s=sample_interval_s, axes=axes,
-                           carousel_period_s=carousel_period_s, members=int(members), seed=seed, methods=methods,
+    return NorthComparison(grade=grade, latitude_rad=latitude, heading_rad=heading,
+                           duration_s=samples * sample_interval, sample_interval_s=sample_interval, axes=axes,
+                           carousel_period_s=carousel_period, members=int(members), seed=seed, methods=methods,
                            versus_time=versus_time, versus_grade=versus_grade, ground_gyrocompass=gyro_entry,
                            notes=notes)

@@ -73,7 +73,7 @@ from schuler.alignment.limits import (
 )
 from schuler.core.attitude import euler_from_dcm
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY, earth_rate_ned
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 
 PROPAGATION_STEP_S = 1.0
 """Longest step of the covariance propagation, s."""
@@ -369,8 +369,9 @@ def staged_limit(errors, design: GyrocompassDesign, *, latitude: float, heading:
                          float(noise[1]), float(noise[2]))
 
 
-def align_staged_gyrocompass(batch: StaticBatch, design: GyrocompassDesign, *, initial_window_s: float = 30.0,
-                             history_step_s: float = 1.0) -> MethodEstimate:
+@renamed_keywords(initial_window_s="initial_window", history_step_s="history_step")
+def align_staged_gyrocompass(batch: StaticBatch, design: GyrocompassDesign, *, initial_window: float = 30.0,
+                             history_step: float = 1.0) -> MethodEstimate:
     """The staged strapdown gyrocompass over every record of ``batch``, started from inertial-frame alignment.
 
     Parameters
@@ -379,9 +380,9 @@ def align_staged_gyrocompass(batch: StaticBatch, design: GyrocompassDesign, *, i
         The static records.
     design : GyrocompassDesign
         Stages and gains (:func:`design_gyrocompass` for this window).
-    initial_window_s : float
+    initial_window : float
         Inertial-frame alignment over the first seconds gives the start, s.
-    history_step_s : float
+    history_step : float
         Step of the histories, s.
 
     Returns
@@ -390,8 +391,8 @@ def align_staged_gyrocompass(batch: StaticBatch, design: GyrocompassDesign, *, i
         No 1-sigma of its own: its accuracy is its stated limit (:func:`staged_limit`).
     """
     dt = batch.sample_interval_s
-    attitude = start_attitude(batch.head(initial_window_s))
-    ends = batch.history_indices(history_step_s)
+    attitude = start_attitude(batch.head(initial_window))
+    ends = batch.history_indices(history_step)
     k1, k2, k3 = design.gains(dt * (np.arange(batch.samples) + 0.5), batch.latitude_rad)
     history = np.empty((batch.members, ends.size, 3, 3))
     _kernels.staged_gyrocompass_loop(batch.gyro_increment, batch.accel_increment, dt, attitude,

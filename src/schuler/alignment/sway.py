@@ -29,7 +29,7 @@ from schuler.alignment.data import StaticBatch
 from schuler.core.attitude import dcm_from_euler
 from schuler.core.earth import earth_rate_ned
 from schuler.core.random import RandomStreams
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 
 _NODES = np.array([-math.sqrt(0.6), 0.0, math.sqrt(0.6)])
 _WEIGHTS = np.array([5.0, 8.0, 5.0]) / 18.0
@@ -100,16 +100,17 @@ def _inputs(t: np.ndarray, heading: float, latitude: float, gravity: float, ampl
     return body_rate, np.einsum("kji,kj->ki", C, specific_force), C
 
 
-def sway_batch(batch: StaticBatch, sway: Sway, *, heading_rad: float, members, seed: int = 0):
-    """``batch`` (simulated at rest, level, at ``heading_rad``) with the base's sway added: (batch, final attitudes).
+@renamed_keywords(heading_rad="heading")
+def sway_batch(batch: StaticBatch, sway: Sway, *, heading: float, members, seed: int = 0):
+    """``batch`` (simulated at rest, level, at ``heading``) with the base's sway added: (batch, final attitudes).
 
     Parameters
     ----------
     batch : StaticBatch
-        Records of a level IMU at rest (true heading ``heading_rad``), with their sensor errors.
+        Records of a level IMU at rest (true heading ``heading``), with their sensor errors.
     sway : Sway
         How the base moves.
-    heading_rad : float
+    heading : float
         The records' rest heading, rad, clockwise from north.
     members : array_like of int
         The member numbers of the batch's records (the addresses of the sway's draws).
@@ -128,17 +129,17 @@ def sway_batch(batch: StaticBatch, sway: Sway, *, heading_rad: float, members, s
         raise InvalidParameter("members", f"{members.size} member numbers for {batch.members} records")
     dt, n = batch.sample_interval_s, batch.samples
     starts = dt * np.arange(n)
-    rest_gyro = np.einsum("ji,j->i", dcm_from_euler(0.0, 0.0, heading_rad), earth_rate_ned(batch.latitude_rad))
+    rest_gyro = np.einsum("ji,j->i", dcm_from_euler(0.0, 0.0, heading), earth_rate_ned(batch.latitude_rad))
     rest_accel = np.array([0.0, 0.0, -batch.gravity])
     gyro, accel = batch.gyro_increment.copy(), batch.accel_increment.copy()
     final = np.empty((members.size, 3))
     amplitude, frequency, phase = _draws(sway, members, seed)
     for row in range(members.size):
         for node, weight in zip(_NODES, _WEIGHTS, strict=True):
-            rate, force, _ = _inputs(starts + dt * (1.0 + node) / 2.0, heading_rad, batch.latitude_rad,
+            rate, force, _ = _inputs(starts + dt * (1.0 + node) / 2.0, heading, batch.latitude_rad,
                                      batch.gravity, amplitude[row], frequency[row], phase[row])
             gyro[row] += weight * dt * (rate - rest_gyro)
             accel[row] += weight * dt * (force - rest_accel)
         angle, _, _ = _motion(np.array([n * dt]), amplitude[row, :3], frequency[row, :3], phase[row, :3])
-        final[row] = angle[0, 0], angle[1, 0], heading_rad + angle[2, 0]
+        final[row] = angle[0, 0], angle[1, 0], heading + angle[2, 0]
     return StaticBatch(gyro, accel, dt, batch.latitude_rad, batch.gravity_m_s2), final

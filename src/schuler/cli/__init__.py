@@ -23,7 +23,7 @@ import warnings
 import click
 
 from schuler import __version__
-from schuler.exceptions import SchulerError
+from schuler.exceptions import SchulerError, as_options
 from schuler.registry import SUMMARIES, SYSTEM_MODULES, get_system
 
 # The models' matrices are small: BLAS threads cost more than they give on them, and the cores are shared with
@@ -79,7 +79,7 @@ def cli():
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    print(f"schuler: warning: {message}", file=sys.stderr)
+    print(f"schuler: warning: {as_options(str(message))}", file=sys.stderr)
 
 
 _SIGNALLED: list[int] = []
@@ -117,7 +117,7 @@ def main(argv=None) -> None:
         print(f"schuler: error: {error.format_message()}", file=sys.stderr)
         code = 2
     except SchulerError as error:
-        print(f"schuler: error: {error}", file=sys.stderr)
+        print(f"schuler: error: {as_options(str(error))}", file=sys.stderr)
         code = 2
     except OSError as error:  # an output folder that cannot be written, a full disk
         where = f": {error.filename}" if error.filename else ""

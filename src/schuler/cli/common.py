@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Iterable
 from contextlib import contextmanager
 from pathlib import Path
 
 import click
 
 from schuler import __version__
-from schuler.exceptions import InvalidParameter, SchulerError
+from schuler.exceptions import InvalidParameter, SchulerError, as_options
 from schuler.results import json_safe
 
 
@@ -48,13 +49,13 @@ def parameter_options(parameters):
 
 
 @contextmanager
-def options_named(parameters):
+def options_named(parameters, names: Iterable[str] = ()):
     """Re-raise library errors under the CLI option's name (``speed`` -> ``--speed``).
 
     Library code names a parameter as the API knows it; at the command line the
     user typed an option. An :class:`InvalidParameter` whose ``name`` is one of
-    ``parameters`` is raised again with the option; any other :class:`SchulerError`
-    whose message starts with ``"name: "`` gets the option in front instead.
+    ``parameters`` (or of ``names``, the command's other options) is raised again with the option; any other
+    :class:`SchulerError` whose message starts with ``"name: "`` gets the option in front instead.
     Errors naming nothing in ``parameters`` pass unchanged.
 
     Examples
@@ -68,7 +69,7 @@ def options_named(parameters):
     ...     print(error)
     --speed: must be finite
     """
-    options = {spec.name: spec.option for spec in parameters}
+    options = {spec.name: spec.option for spec in parameters} | {name: as_options(f"`{name}`") for name in names}
     try:
         yield
     except InvalidParameter as error:

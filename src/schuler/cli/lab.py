@@ -13,6 +13,7 @@ import webbrowser
 
 import click
 
+from schuler.cli.common import options_named
 from schuler.lab.server import (
     LabServer,
     check_host,
@@ -39,8 +40,9 @@ def lab(port: int, host: str, allow_remote: bool, no_browser: bool) -> None:
     pages. Everything runs on this machine: the pages need no internet.
     Stop with Ctrl-C.
     """
-    address = check_host(host, allow_remote)
-    sock = listen(address, check_port(port))
+    with options_named((), names=("host", "port")):
+        address = check_host(host, allow_remote)
+        sock = listen(address, check_port(port))
     from schuler.lab.app import create_app
 
     bench = create_app(address, sock.getsockname()[1])

@@ -120,7 +120,7 @@ def _with_instrument(system: System, case: Case, options: Case) -> tuple[Case, C
         raise InvalidParameter("--" + extra.replace("_", "-"), "applies with --imu only")
     with options_named(system.parameters + instrument_options(system.name)):
         case, _ = apply_instrument(system.name, system.parameters, case, options["imu"],
-                                   window_s=options.get("imu_window"), latitude_rad=options.get("imu_latitude"))
+                                   window=options.get("imu_window"), latitude=options.get("imu_latitude"))
     return case, options
 
 
@@ -206,7 +206,7 @@ def _action_command(system: System, action: Action) -> click.Command:
     def act(out_dir: Path | None, as_json: bool, **raw):
         files_in = {name: raw.pop(name) for name in paths}
         case = action.parameters.parse(raw, labels="option")
-        with options_named(action.parameters):
+        with options_named(action.parameters, names=("output",) if action.output_file else ()):
             result = action.function(**files_in, **case)
         files = _write_files(partial(system.write, action=action.name), result, out_dir,
                              f"{system.name} {action.name}")

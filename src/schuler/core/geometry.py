@@ -11,8 +11,9 @@ floats and arrays (no units library).
   azimuth (:func:`level_frame_earth_rate`), and the horizontal rate
   Omega cos L where north is to be found from it (:func:`horizontal_earth_rate`,
   which refuses the poles).
-* One time-grid rule (:func:`time_grid`, :func:`time_grids`) and one test of
-  uniform spacing (:func:`uniform_step`).
+* One time-grid rule (:func:`time_grid`, :func:`time_grids`), its point count
+  sized before anything is allocated (:func:`grid_points`), and one test of
+  uniform spacing (:func:`uniform_step`). Every system's output times follow it.
 
 Frames: the level frame is NED-like: x horizontal at an azimuth measured from
 north clockwise seen from above (towards east), y horizontal 90 deg to the
@@ -213,10 +214,44 @@ def horizontal_earth_rate(latitude, earth_rate: float = EARTH_RATE):
     return float(north) if north.ndim == 0 else north
 
 
-def _grid_counts(durations, steps, names: tuple[str, str], max_points: float) -> np.ndarray:
-    """Number of points of each case's :func:`time_grid`, checked before anything is allocated."""
+def grid_points(duration, step, *, names: tuple[str, str] = ("duration", "step"), max_points: float = math.inf):
+    """Number of points :func:`time_grid` gives for each (duration, step), without building the grids.
+
+    The count is checked before anything is allocated; it is a float (exact
+    below 2^53), so that an absurd grid can be sized, and refused by a memory
+    check such as :func:`schuler.memory.require`, rather than overflow an integer.
+
+    Parameters
+    ----------
+    duration : float or array_like
+        Length of each grid, s (> 0).
+    step : float or array_like
+        Time step of each grid, s (> 0, at most its ``duration``); broadcast against ``duration``.
+    names : (str, str)
+        The caller's names of the duration and the step, used in error messages.
+    max_points : float
+        Largest count accepted, in number of points (default: no limit).
+
+    Returns
+    -------
+    float or ndarray
+        The number of points: a float for scalar inputs, else an array of the broadcast shape.
+
+    Raises
+    ------
+    InvalidParameter
+        For a non-finite or non-positive duration or step, a step longer than
+        the duration, or a count above ``max_points``.
+
+    Examples
+    --------
+    >>> grid_points(2.0, 0.5), grid_points(1.0, 0.3), grid_points(1e9, 1e-3)
+    (5.0, 5.0, 1000000000001.0)
+    >>> grid_points([10.0, 10.5], 1.0)
+    array([11., 12.])
+    """
     duration_name, step_name = names
-    durations, steps = np.broadcast_arrays(np.asarray(durations, dtype=float), np.asarray(steps, dtype=float))
+    durations, steps = np.broadcast_arrays(np.asarray(duration, dtype=float), np.asarray(step, dtype=float))
     bad = ~(np.isfinite(durations) & (durations > 0.0))
     if np.any(bad):
         raise InvalidParameter(duration_name, f"{float(durations[bad].flat[0]):g} s: must be finite and > 0")
@@ -235,8 +270,6 @@ def _grid_counts(durations, steps, names: tuple[str, str], max_points: float) ->
     with np.errstate(invalid="ignore"):
         on_step = np.abs(ratio - whole) <= GRID_TOLERANCE + 4.0 * np.finfo(float).eps * ratio
     counts = np.where(on_step, whole + 1.0, np.floor(ratio) + 2.0)
-    if np.isinf(max_points):
-        return counts
     if not np.all(counts <= max_points):
         worst = int(np.argmax(counts))
         raise InvalidParameter(
@@ -244,27 +277,7 @@ def _grid_counts(durations, steps, names: tuple[str, str], max_points: float) ->
             f"{steps.flat[worst]:g} s over {durations.flat[worst]:g} s gives {counts.flat[worst]:,.0f} points; "
             f"at most {max_points:,} (use a longer step)",
         )
-    return counts.astype(np.int64)
-
-
-def grid_points(duration: float, step: float, *, names: tuple[str, str] = ("duration", "step")) -> float:
-    """Number of points :func:`time_grid` would return (a float: huge requests can be sized, then refused).
-
-    Parameters
-    ----------
-    duration : float
-        Length of the grid, s.
-    step : float
-        Output step, s.
-    names : tuple of str
-        The parameter names an error message uses for ``duration`` and ``step``.
-
-    Examples
-    --------
-    >>> grid_points(2.0, 0.5), grid_points(1.0, 0.3), grid_points(1e9, 1e-3)
-    (5.0, 5.0, 1000000000001.0)
-    """
-    return float(_grid_counts(duration, step, names, np.inf).astype(float))
+    return float(counts) if counts.ndim == 0 else counts
 
 
 def time_grid(duration: float, step: float, *, names: tuple[str, str] = ("duration", "step"),
@@ -308,7 +321,7 @@ def time_grid(duration: float, step: float, *, names: tuple[str, str] = ("durati
     >>> float(time_grid(0.3, 0.1)[-1])   # 0.3 / 0.1 = 2.9999999999999996: on a step
     0.3
     """
-    count = int(_grid_counts(duration, step, names, max_points))
+    count = int(grid_points(duration, step, names=names, max_points=max_points))
     grid = float(step) * np.arange(count, dtype=float)
     grid[-1] = duration
     return grid
@@ -342,7 +355,7 @@ def time_grids(durations, steps, *, names: tuple[str, str] = ("duration", "step"
     """
     durations, steps = np.broadcast_arrays(np.atleast_1d(np.asarray(durations, dtype=float)),
                                            np.atleast_1d(np.asarray(steps, dtype=float)))
-    counts = _grid_counts(durations, steps, names, max_points)
+    counts = grid_points(durations, steps, names=names, max_points=max_points).astype(np.int64)
     n_max = int(counts.max())
     if n_max * counts.size > max_points:
         raise InvalidParameter(names[1], f"{counts.size} grids of up to {n_max:,} points exceed {max_points:,} points")

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 
 
 def _system(A, C, Q, R) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -315,8 +315,9 @@ def _times(t_s) -> np.ndarray:
     return t
 
 
-def loop_monte_carlo(A, K, C, Q, R, P0, duration_s: float, step_s: float, members: int, seed: int) -> np.ndarray:
-    """Errors x_hat - x of the fixed-gain loop at ``duration_s`` over seeded Monte Carlo members.
+@renamed_keywords(duration_s="duration", step_s="step")
+def loop_monte_carlo(A, K, C, Q, R, P0, duration: float, step: float, members: int, seed: int) -> np.ndarray:
+    """Errors x_hat - x of the fixed-gain loop at ``duration`` over seeded Monte Carlo members.
 
     Truth and estimate are simulated together, d/dt [x; x_hat] = [[A, 0], [K C, A - K C]] [x; x_hat] +
     [w; K v] (w of PSD Q, v of PSD R: the estimate sees z = C x + v), discretised exactly (Van Loan,
@@ -338,9 +339,9 @@ def loop_monte_carlo(A, K, C, Q, R, P0, duration_s: float, step_s: float, member
         PSD of the measurement noise, (measurement units)^2 s.
     P0 : array_like, shape (n, n)
         Covariance of the truth at t = 0, (state units)^2.
-    duration_s : float
+    duration : float
         Simulated time, s (> 0).
-    step_s : float
+    step : float
         Step of the exact discretisation, s (> 0; the result does not depend on it).
     members : int
         Number of members (>= 2).
@@ -361,15 +362,15 @@ def loop_monte_carlo(A, K, C, Q, R, P0, duration_s: float, step_s: float, member
     A, C, Q, R = _system(A, C, Q, R)
     n = A.shape[0]
     K = np.atleast_2d(np.asarray(K, dtype=float)).reshape(n, C.shape[0])
-    if not (np.isfinite(duration_s) and np.isfinite(step_s) and duration_s > 0 and step_s > 0):
+    if not (np.isfinite(duration) and np.isfinite(step) and duration > 0 and step > 0):
         raise InvalidParameter("duration_s", "duration and step must be finite and > 0 s")
     if int(members) < 2:
         raise InvalidParameter("members", f"needs at least 2 members, got {members!r}")
     from schuler.core.propagation import discretise_noise
 
-    steps = max(1, int(np.ceil(duration_s / step_s - 1e-9)))
+    steps = max(1, int(np.ceil(duration / step - 1e-9)))
     F, W = _joint_loop(A, K, C, Q, R)
-    Phi, Qd = discretise_noise(F, W, duration_s / steps)
+    Phi, Qd = discretise_noise(F, W, duration / steps)
     # a factor of the (possibly singular) step covariance: eigenvectors scaled by the roots of their eigenvalues
     values, vectors = np.linalg.eigh(Qd)
     root = vectors * np.sqrt(np.clip(values, 0.0, None))
@@ -383,7 +384,8 @@ def loop_monte_carlo(A, K, C, Q, R, P0, duration_s: float, step_s: float, member
     return z[:, n:] - z[:, :n]
 
 
-def bias_state(sigma: float, correlation_time_s: float, rate_random_walk: float = 0.0) -> tuple[float, float]:
+@renamed_keywords(correlation_time_s="correlation_time")
+def bias_state(sigma: float, correlation_time: float, rate_random_walk: float = 0.0) -> tuple[float, float]:
     """Decay rate and PSD of a bias state b' = -b / T + w: a first-order Gauss-Markov process plus a random walk.
 
     Spec 07: a Gauss-Markov bias of steady standard deviation sigma and correlation time T has PSD
@@ -394,7 +396,7 @@ def bias_state(sigma: float, correlation_time_s: float, rate_random_walk: float 
     ----------
     sigma : float
         Steady standard deviation of the Gauss-Markov part, bias units (rad/s or m/s^2); >= 0.
-    correlation_time_s : float
+    correlation_time : float
         T, s (> 0).
     rate_random_walk : float
         K, bias units per sqrt(s); >= 0.
@@ -409,10 +411,10 @@ def bias_state(sigma: float, correlation_time_s: float, rate_random_walk: float 
     >>> bias_state(2.0, 100.0), bias_state(0.0, 100.0, 0.1)
     ((0.01, 0.08), (0.0, 0.010000000000000002))
     """
-    values = (sigma, correlation_time_s, rate_random_walk)
-    if not all(np.isfinite(v) and v >= 0 for v in values) or correlation_time_s <= 0:
+    values = (sigma, correlation_time, rate_random_walk)
+    if not all(np.isfinite(v) and v >= 0 for v in values) or correlation_time <= 0:
         raise InvalidParameter("bias", f"sigma, K must be finite and >= 0 and T > 0 s, got {values}")
-    decay = 1.0 / correlation_time_s if sigma > 0 else 0.0
+    decay = 1.0 / correlation_time if sigma > 0 else 0.0
     return decay, 2.0 * sigma**2 * decay + rate_random_walk**2
 
 

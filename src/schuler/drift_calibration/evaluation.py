@@ -221,7 +221,7 @@ def check_observable(latitude: np.ndarray, max_latitude: np.ndarray) -> None:
         worst = int(np.argmax(np.where(beyond, phi, -1.0)))
         raise NotObservable(
             f"latitude: {math.degrees(phi[worst]):g} deg is beyond the azimuth limit "
-            f"{math.degrees(max_latitude[worst]):g} deg (--max-latitude): the horizontal Earth rate "
+            f"{math.degrees(max_latitude[worst]):g} deg (`max_latitude`): the horizontal Earth rate "
             f"Omega cos(latitude) = {EARTH_RATE * math.cos(phi[worst]):.3g} rad/s magnifies every rate error "
             f"{1 / math.cos(phi[worst]):.0f} times in the azimuth")
     highest = float(np.max(phi))
@@ -259,7 +259,7 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
     for index, group in _instrument_groups(cases):
         first = group.case(0)
         need = member_bytes(first)
-        require(need, "one calibration procedure", "--positions or --cycles")
+        require(need, "one calibration procedure", "`positions` or `cycles`")
         stabilizer = stabilizer_of(first)
         step = chunk_members(need)
         for start in range(0, len(group), step):

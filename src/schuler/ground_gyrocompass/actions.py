@@ -87,7 +87,7 @@ def identify_record(record: Path, **values) -> NorthIdentification:
                 "the record's length")
     time, observed = read_record(record)
     require(fit_bytes(time.size, case["method"], case["unknowns"]), f"identifying {record}",
-            "the record's length or --method")
+            "the record's length or `method`")
     estimate = identify_north(time, observed, case["unknowns"], decay_rate=case["decay_rate"], hm=case["hm"],
                               inertia=case["inertia"], omega_h=float(omega_h_of(Cases.from_case(case))[0]),
                               reading=case["reading"], method=case["method"])

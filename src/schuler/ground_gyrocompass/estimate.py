@@ -42,16 +42,17 @@ def dms_text(angle_deg: float) -> str:
 class NorthEstimate(Result):
     """Identified north and run-down parameters, with standard errors (SI unless named).
 
-    ``north_deg`` is the azimuth of north measured from the rotor axis at release,
-    = -alpha0. JSON keys ``lambda``/``lambda_std`` hold ``decay_rate``.
+    ``north_rad`` is the azimuth of north measured from the rotor axis at release,
+    = -alpha0 (its degrees, minutes and seconds: ``north_dms``). JSON keys
+    ``lambda``/``lambda_std`` hold ``decay_rate``.
     """
 
     unknowns: int
     method: str
     reading: str
     identified: list
-    north_deg: float
-    north_std_arcsec: float | None
+    north_rad: float
+    north_std_rad: float | None
     north_dms: str
     alpha0_rad: float
     alpha0_rad_std: float | None
@@ -68,7 +69,7 @@ class NorthEstimate(Result):
     offset_rad: float | None
     offset_rad_std: float | None
     misfit: float
-    residual_rms_arcsec: float
+    residual_rms_rad: float
     n_samples: int
     nfev: int
     converged: bool
@@ -81,6 +82,9 @@ class NorthEstimate(Result):
     residuals: np.ndarray = field(repr=False)
 
     units: ClassVar[dict] = {
+        "north_rad": "rad",
+        "north_std_rad": "rad",
+        "residual_rms_rad": "rad",
         "alpha0_dot": "rad/s",
         "alpha0_dot_std": "rad/s",
         "lambda": "1/s",
@@ -105,14 +109,15 @@ class NorthEstimate(Result):
         from rich.console import Group
         from rich.table import Table
 
-        std = self.north_std_arcsec
+        std = None if self.north_std_rad is None else math.degrees(self.north_std_rad) * 3600.0  # shown, arcsec
+        north_deg = math.degrees(self.north_rad)
         north = Table(title=f"North from the ground gyrocompass ({self.unknowns} unknowns, {self.method})")
         north.add_column("quantity")
         north.add_column("value", justify="right")
         north.add_column("standard error", justify="right")
-        north.add_row("north from the rotor axis", f"{self.north_deg:.6f} deg", _std(std, 1 / 3600, "deg", ".2g"))
-        north.add_row("", f"{self.north_deg * 60:.4f} arcmin", _std(std, 1 / 60, "arcmin", ".2g"))
-        north.add_row("", f"{self.north_deg * 3600:.2f} arcsec", _std(std, 1.0, "arcsec", ".2g"))
+        north.add_row("north from the rotor axis", f"{north_deg:.6f} deg", _std(std, 1 / 3600, "deg", ".2g"))
+        north.add_row("", f"{north_deg * 60:.4f} arcmin", _std(std, 1 / 60, "arcmin", ".2g"))
+        north.add_row("", f"{north_deg * 3600:.2f} arcsec", _std(std, 1.0, "arcsec", ".2g"))
         north.add_row("", self.north_dms, "")
         rows = [
             ("alpha0", self.alpha0_rad, self.alpha0_rad_std, "rad"),
@@ -132,7 +137,8 @@ class NorthEstimate(Result):
             params.add_row(name, f"{value:.10g} {unit}", "" if error is None else f"{error:.3g} {unit}")
         summary = (
             f"misfit {self.misfit:.4g} rad^2 over {self.n_samples} samples "
-            f"(rms {self.residual_rms_arcsec:.3g} arcsec), {self.nfev} model evaluations; {self.message}"
+            f"(rms {math.degrees(self.residual_rms_rad) * 3600.0:.3g} arcsec), {self.nfev} model evaluations; "
+            f"{self.message}"
         )
         return Group(north, params, summary)
 
@@ -182,8 +188,8 @@ def make_estimate(fit: Fit, time, observed, unknowns, reading, method, inertia, 
         method=method,
         reading=reading,
         identified=list(fit.names),
-        north_deg=math.degrees(-values["alpha0"]),
-        north_std_arcsec=None if alpha0_std is None else math.degrees(alpha0_std) * 3600.0,
+        north_rad=-values["alpha0"],
+        north_std_rad=alpha0_std,
         north_dms=dms_text(math.degrees(-values["alpha0"])),
         alpha0_rad=values["alpha0"],
         alpha0_rad_std=alpha0_std,
@@ -200,7 +206,7 @@ def make_estimate(fit: Fit, time, observed, unknowns, reading, method, inertia, 
         offset_rad=values["offset"] if reading == "absolute" else None,
         offset_rad_std=err("offset"),
         misfit=fit.misfit,
-        residual_rms_arcsec=math.degrees(math.sqrt(fit.misfit / len(time))) * 3600.0,
+        residual_rms_rad=math.sqrt(fit.misfit / len(time)),
         n_samples=len(time),
         nfev=fit.nfev,
         converged=fit.converged,
@@ -251,7 +257,7 @@ def identify(
     >>> b = 0.432 * 3.65e-5 / 1.1607e-3  # B = Hm Omega_h / J
     >>> y = closed_form(t, 0.0215, 4.08e-4, 2.15e-3, b) - 0.0215
     >>> est = identify(t, y, 2, decay_rate=2.15e-3, hm=0.432, inertia=1.1607e-3, omega_h=3.65e-5)
-    >>> round(est.north_deg, 6), round(math.degrees(-0.0215), 6)
+    >>> round(math.degrees(est.north_rad), 6), round(math.degrees(-0.0215), 6)
     (-1.231859, -1.231859)
     """
     coefficient = float(directive_coefficient(hm, omega_h, inertia))

@@ -306,7 +306,7 @@ def record_window(cases: Cases, bytes_per_sample: int) -> np.ndarray:
     duration, step = float(cases.float("duration")[0]), float(cases.float("output_step")[0])
     if step > duration:
         raise InvalidParameter("output_step", f"{step:g} s is longer than the duration {duration:g} s")
-    require(sample_count(duration, step) * bytes_per_sample, "this run", "--duration or --output-step")
+    require(sample_count(duration, step) * bytes_per_sample, "this run", "`duration` or `output_step`")
     return time_grid(duration, step, names=("duration", "output_step"), max_points=sys.maxsize)
 
 

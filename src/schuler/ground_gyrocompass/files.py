@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from schuler.exceptions import renamed_keywords
 from schuler.ground_gyrocompass import plots
 from schuler.ground_gyrocompass.estimate import NorthEstimate, dms_text
 from schuler.ground_gyrocompass.grid import STEP_ALPHA0, run_stage
@@ -138,14 +139,15 @@ def record_figures(result: Result) -> dict[str, Any]:
                                               f"Simulated run-down record ({result.reading} reading)")}
 
 
-def fit_figures(fit: RecordFit, noise_rad: float | None = None) -> dict[str, Any]:
+@renamed_keywords(noise_rad="noise")
+def fit_figures(fit: RecordFit, noise: float | None = None) -> dict[str, Any]:
     """The fit and residuals, the misfit map around the estimate, the predicted error against the window.
 
     Parameters
     ----------
     fit : RecordFit
         A record and its fit.
-    noise_rad : float, optional
+    noise : float, optional
         Read-out noise standard deviation, rad (default: the residuals' rms, or 1 arcsec for a noise-free record).
     """
     a0, rate = fit.motion["alpha0"], fit.motion["alpha0_dot"]
@@ -157,17 +159,18 @@ def fit_figures(fit: RecordFit, noise_rad: float | None = None) -> dict[str, Any
             "north_misfit_map": plots.plot_misfit_map(
                 stage, title=f"Misfit around the estimate ({stage.cells} cells, the source's first-stage steps), "
                              "at the estimated lambda and B"),
-            "north_error_vs_time": error_vs_time(fit, noise_rad)}
+            "north_error_vs_time": error_vs_time(fit, noise)}
 
 
-def error_vs_time(fit: RecordFit, noise_rad: float | None = None):
+@renamed_keywords(noise_rad="noise")
+def error_vs_time(fit: RecordFit, noise: float | None = None):
     """The standard error of north predicted for windows around the record's, 2 and the fit's unknowns.
 
     Parameters
     ----------
     fit : RecordFit
         A record and its fit: its parameters are taken as the truth, its sampling step is kept.
-    noise_rad : float, optional
+    noise : float, optional
         Read-out noise standard deviation, rad (default: the residuals' rms, or 1 arcsec for a noise-free record).
 
     Returns
@@ -177,7 +180,7 @@ def error_vs_time(fit: RecordFit, noise_rad: float | None = None):
     """
     step = float(np.median(np.diff(fit.time))) if fit.time.size > 1 else 1.0
     arcsec = from_unit(1.0, "arcsec")
-    noise = noise_rad or math.sqrt(fit.misfit / fit.time.size)
+    noise = noise or math.sqrt(fit.misfit / fit.time.size)
     if noise < 0.01 * arcsec:  # a noise-free record: the error per arcsec of read-out noise
         noise = arcsec
     duration = float(fit.time[-1])

@@ -133,7 +133,7 @@ def predicted_errors(values, duration, step, noise, quantisation=0.0, unknowns=4
 class NorthErrorStudy(Result):
     """North error against observation time and noise (Monte Carlo and predicted).
 
-    Arrays are indexed [duration, noise]; errors in arcsec, over the records whose
+    Arrays are indexed [duration, noise]; errors in rad, over the records whose
     fit converged. ``converged_fraction`` is the share of records the estimator
     fitted (it raised on, or did not converge for, the rest);
     ``gross_error_fraction`` the share of converged fits off by more than
@@ -143,13 +143,13 @@ class NorthErrorStudy(Result):
     unknowns: int
     members: int
     step_s: float
-    quantisation_arcsec: float
+    quantisation_rad: float
     durations_s: np.ndarray
-    noises_arcsec: np.ndarray
-    rms_error_arcsec: np.ndarray
-    std_error_arcsec: np.ndarray
-    mean_error_arcsec: np.ndarray
-    predicted_std_arcsec: np.ndarray
+    noises_rad: np.ndarray
+    rms_error_rad: np.ndarray
+    std_error_rad: np.ndarray
+    mean_error_rad: np.ndarray
+    predicted_std_rad: np.ndarray
     converged_fraction: np.ndarray
     gross_error_fraction: np.ndarray
     seed: int
@@ -161,12 +161,12 @@ class NorthErrorStudy(Result):
 
         table = Table(title=f"North error vs observation time ({self.unknowns} unknowns, {self.members} runs)")
         table.add_column("window, s")
-        for noise in self.noises_arcsec:
+        for noise in self.noises_rad / ARCSEC:
             table.add_column(f"noise {noise:g}\": MC std / predicted, arcsec", justify="right")
         for i, duration in enumerate(self.durations_s):
             cells = [
-                f"{self.std_error_arcsec[i, j]:.3g} / {self.predicted_std_arcsec[i, j]:.3g}"
-                for j in range(len(self.noises_arcsec))
+                f"{self.std_error_rad[i, j] / ARCSEC:.3g} / {self.predicted_std_rad[i, j] / ARCSEC:.3g}"
+                for j in range(len(self.noises_rad))
             ]
             table.add_row(f"{duration:g}", *cells)
         return table
@@ -263,13 +263,13 @@ def monte_carlo(
         unknowns=unknowns,
         members=members,
         step_s=step,
-        quantisation_arcsec=quantisation / ARCSEC,
+        quantisation_rad=quantisation,
         durations_s=durations,
-        noises_arcsec=noises / ARCSEC,
-        rms_error_arcsec=rms,
-        std_error_arcsec=std,
-        mean_error_arcsec=mean,
-        predicted_std_arcsec=predicted,
+        noises_rad=noises,
+        rms_error_rad=rms * ARCSEC,
+        std_error_rad=std * ARCSEC,
+        mean_error_rad=mean * ARCSEC,
+        predicted_std_rad=predicted * ARCSEC,
         converged_fraction=converged,
         gross_error_fraction=gross,
         seed=seed,

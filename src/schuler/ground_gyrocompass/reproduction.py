@@ -15,6 +15,7 @@ Printed values are quoted as printed, decimal commas included.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -405,7 +406,7 @@ def _identification_rows(estimate: NorthEstimate, correlation: float) -> list[Re
     if unknowns == 5:
         rows.append(compare("harmful torque identified (5 unknowns)", estimate.torque, "N m",
                             note="the source's simulator has none: 0 expected"))
-    rows.append(compare("north from the rotor axis at release", estimate.north_deg, "deg",
+    rows.append(compare("north from the rotor axis at release", math.degrees(estimate.north_rad), "deg",
                         note="-alpha0 of the identification above"))
     return rows
 

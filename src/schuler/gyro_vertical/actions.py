@@ -12,12 +12,15 @@ bare durations (``duration``, ``ramp_duration``) were hours and are seconds now.
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
 from schuler.contract import Action
 from schuler.core.earth import PRESETS
+from schuler.core.geometry import grid_points, time_grid
 from schuler.gyro_vertical import friction as friction_model
-from schuler.gyro_vertical.evaluation import output_points, time_grid
+from schuler.gyro_vertical.evaluation import GRID_NAMES
 from schuler.gyro_vertical.results import FrictionResult
 from schuler.memory import require
 from schuler.params import Parameter, ParameterSet
@@ -89,8 +92,9 @@ def friction(dead_zone: float = 0.01, inner_ratio: float = 1.0, initial_beta: fl
     """
     constants = PRESETS[earth]
     R, g = constants.radius, constants.gravity
-    require(POINT_BYTES * output_points(duration, output_step), "this friction run", "--duration or --output-step")
-    time = time_grid(duration, output_step)
+    require(POINT_BYTES * grid_points(duration, output_step, names=GRID_NAMES), "this friction run",
+            "`duration` or `output_step`")
+    time = time_grid(duration, output_step, names=GRID_NAMES, max_points=sys.maxsize)  # sized by require above
     q = (dead_zone / R, inner_ratio * dead_zone / R)
     acceleration = friction_model.AccelerationInput.ramp(ramp_acceleration, 0.0, ramp_duration) \
         if ramp_acceleration else None

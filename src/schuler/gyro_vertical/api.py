@@ -19,15 +19,18 @@ Examples
 
 from __future__ import annotations
 
+from functools import partial
+
 from schuler.contract import System
+from schuler.core.geometry import grid_points
 from schuler.gyro_vertical.actions import FRICTION
 from schuler.gyro_vertical.evaluation import (
     FIDELITIES,
+    GRID_NAMES,
     OUTPUTS,
     PARAMETERS,
     evaluate,
     member_bytes,
-    output_points,
 )
 from schuler.gyro_vertical.optimal import (
     OPTIMAL,
@@ -40,6 +43,7 @@ from schuler.gyro_vertical.optimal import (
 )
 from schuler.gyro_vertical.reproduction import report, reproduce
 from schuler.gyro_vertical.results import VerticalResult, data_files, figures
+from schuler.imu.instrument import apply_options, instrument_options
 from schuler.params import Case, ParameterSet
 from schuler.references import DROZDOVICH_1959
 
@@ -56,7 +60,7 @@ def member_seconds(case: Case) -> float:
     case : Case
         A validated case (SI values: ``duration`` and ``output_step`` s).
     """
-    return SECONDS_PER_POINT * output_points(case["duration"], case["output_step"])
+    return SECONDS_PER_POINT * grid_points(case["duration"], case["output_step"], names=GRID_NAMES)
 
 
 SYSTEM = System(
@@ -77,6 +81,8 @@ SYSTEM = System(
     member_bytes=member_bytes,
     member_seconds=member_seconds,
     guide="vertical",
+    instrument=partial(apply_options, "vertical"),
+    instrument_parameters=instrument_options("vertical"),
 )
 
 __all__ = ["SYSTEM", "level_gains", "level_gains_from_period", "level_noise_ratios", "level_period_damping", "optimal",

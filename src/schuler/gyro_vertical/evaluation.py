@@ -46,7 +46,7 @@ their beat, the initial-tilt amplitude of (23).
 
 from __future__ import annotations
 
-import math
+import sys
 from types import SimpleNamespace
 from typing import Any
 
@@ -54,6 +54,7 @@ import numpy as np
 
 from schuler.contract import Cases, Evaluation, Output
 from schuler.core.earth import PRESETS
+from schuler.core.geometry import grid_points, time_grid
 from schuler.core.response import Histories
 from schuler.exceptions import InvalidParameter
 from schuler.gyro_vertical.model import GyroVertical, forcing
@@ -86,6 +87,9 @@ CLOSED_POINT_BYTES = 320
 CASE_BYTES = 4 * 2**20
 """Memory of a simulated case that does not grow with its output points (solver steps,
 the decimated mode fit), bytes."""
+
+GRID_NAMES = ("duration", "output_step")
+"""The output grid's parameters, as the core's time grid (:func:`schuler.core.geometry.time_grid`) names them."""
 
 PARAMETERS = ParameterSet((
     Parameter("latitude", "deg", 60.0, "Latitude phi of the start.", minimum=-90, maximum=90),
@@ -224,34 +228,6 @@ def build_model(case) -> GyroVertical:
     )
 
 
-def output_points(duration: float, output_step: float) -> int:
-    """Samples of the output grid 0, step, 2 step, ... up to ``duration`` (the last within half a step).
-
-    Parameters
-    ----------
-    duration : float
-        Simulated time, s.
-    output_step : float
-        Spacing of the output grid, s.
-    """
-    return math.floor(duration / output_step + 0.5) + 1
-
-
-def time_grid(duration: float, output_step: float) -> np.ndarray:
-    """The output times of a case, s (refuses a step longer than the duration).
-
-    Parameters
-    ----------
-    duration : float
-        Simulated time, s.
-    output_step : float
-        Spacing of the output grid, s.
-    """
-    if output_step > duration:
-        raise InvalidParameter("output_step", f"{output_step:g} s is longer than the duration {duration:g} s")
-    return np.arange(output_points(duration, output_step)) * output_step
-
-
 def member_bytes(case: Case) -> int:
     """Memory one case holds while simulated, bytes (see :data:`POINT_BYTES`).
 
@@ -260,7 +236,7 @@ def member_bytes(case: Case) -> int:
     case : Case
         A validated case (SI values).
     """
-    return int(POINT_BYTES * output_points(case["duration"], case["output_step"]) + CASE_BYTES)
+    return int(POINT_BYTES * grid_points(case["duration"], case["output_step"], names=GRID_NAMES) + CASE_BYTES)
 
 
 def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | Evaluation:
@@ -308,15 +284,13 @@ def _evaluate(cases: Cases, keep_histories: bool) -> tuple[dict[str, np.ndarray]
         return out, []
     each = [cases.case(i) for i in range(n)]
     out.update(_start_closed_forms(cases, each))
-    durations, steps = cases.float("duration"), cases.float("output_step")
-    largest = int(np.argmax(durations / steps))
-    points = output_points(durations[largest], steps[largest])
+    points = float(np.max(grid_points(cases.float("duration"), cases.float("output_step"), names=GRID_NAMES)))
     per_point = POINT_BYTES if fidelity == "simulated" else CLOSED_POINT_BYTES
-    require(per_point * points + CASE_BYTES, "this run", "--duration or --output-step")
+    require(per_point * points + CASE_BYTES, "this run", "`duration` or `output_step`")
     details: list[Any] = []
     for i, case in enumerate(each):
         model = build_model(case)
-        time = time_grid(case["duration"], case["output_step"])
+        time = time_grid(case["duration"], case["output_step"], names=GRID_NAMES, max_points=sys.maxsize)  # sized above
         out["end_time_s"][i] = time[-1]
         out["final_latitude_rad"][i] = float(model.trajectory.kinematics(time[-1]).latitude)
         if fidelity == "simulated":

@@ -6,7 +6,8 @@ axis that is off the horizontal Earth rate U_eta and drive the platform in the
 level and azimuth channels.
 
 - :mod:`~schuler.gyrocompassing.models`: the linear models (1.17) corrected, (1.18), (1.19) on the exact engine;
-- :mod:`~schuler.gyrocompassing.analytic`: steady state (1.21)/(1.25), transient (1.22)/(1.24), settling time, design;
+- :mod:`~schuler.gyrocompassing.analytic`: steady state (1.21)/(1.25), transient (1.22)/(1.24), settling time;
+  the design T, zeta <-> c_Gamma, c_a (end of Sec. 2) is the core's :mod:`schuler.core.gyrocompass_design`;
 - :mod:`~schuler.gyrocompassing.case`: cases, validation, gains, closed forms of many cases at once;
 - :mod:`~schuler.gyrocompassing.simulation`: runs with the task-1 constraint checks, batched simulation;
 - :mod:`~schuler.gyrocompassing.evaluation`: the system's parameters, outputs and ``evaluate`` (a run in full)

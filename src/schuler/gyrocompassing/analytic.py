@@ -1,4 +1,4 @@
-"""Closed forms of gyrocompassing (the KPI manual): steady state, transient, settling time, design.
+"""Closed forms of gyrocompassing (the KPI manual): steady state, transient, settling time.
 
 All functions take SI floats or arrays (broadcast together) and return arrays:
 angles in rad, rates in rad/s, gains c_gamma and c_a in 1/s, times in s.
@@ -14,77 +14,9 @@ import numpy as np
 
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
 from schuler.core.geometry import earth_rate_north_up, horizontal_earth_rate
-from schuler.exceptions import InvalidParameter
 
 SETTLING_DECREMENTS = 5.0
 """Settling time = 5 time constants of the slowest mode (the KPI manual: t = 5 / h)."""
-
-
-def gains_from_design(time_constant, damping, latitude, earth_rate=EARTH_RATE):
-    """Correction gains from the time constant T and damping zeta (the KPI manual, end of Sec. 2).
-
-    From T^2 p^2 + 2 T zeta p + 1 = 0 matched to p^2 + c_gamma p + U_eta c_a = 0:
-    c_a = 1 / (T^2 U_eta), c_gamma = 2 T zeta U_eta c_a = 2 zeta / T.
-
-    Parameters
-    ----------
-    time_constant : float or ndarray
-        T, s (> 0).
-    damping : float or ndarray
-        zeta, dimensionless (> 0).
-    latitude : float or ndarray
-        phi, rad.
-    earth_rate : float
-        U, rad/s.
-
-    Returns
-    -------
-    c_gamma, c_a : ndarray
-        1/s.
-
-    Examples
-    --------
-    >>> c_gamma, c_a = gains_from_design(30.0, 0.8, np.radians(50))
-    >>> round(float(c_gamma), 4), round(float(c_a), 2)
-    (0.0533, 23.7)
-    """
-    T = np.asarray(time_constant, dtype=float)
-    zeta = np.asarray(damping, dtype=float)
-    if np.any(~(T > 0)):
-        raise InvalidParameter("time_constant", "must be positive")
-    if np.any(~(zeta > 0)):
-        raise InvalidParameter("damping", "must be positive (zeta <= 0 is not a stable loop)")
-    U_eta = horizontal_earth_rate(latitude, earth_rate)
-    return 2.0 * zeta / T, 1.0 / (T**2 * U_eta)
-
-
-def design_from_gains(c_gamma, c_a, latitude, earth_rate=EARTH_RATE):
-    """Time constant T = 1 / sqrt(U_eta c_a) and damping zeta = c_gamma / (2 sqrt(U_eta c_a)).
-
-    Parameters
-    ----------
-    c_gamma, c_a : float or ndarray
-        Gains, 1/s.
-    latitude : float or ndarray
-        phi, rad.
-    earth_rate : float
-        U, rad/s.
-
-    Returns
-    -------
-    time_constant : ndarray
-        T, s.
-    damping : ndarray
-        zeta.
-
-    Examples
-    --------
-    >>> T, zeta = design_from_gains(0.08, 22.0, np.radians(46.16))
-    >>> round(float(T), 1), round(float(zeta), 2)
-    (30.0, 1.2)
-    """
-    omega0 = np.sqrt(np.asarray(c_a, dtype=float) * horizontal_earth_rate(latitude, earth_rate))
-    return 1.0 / omega0, np.asarray(c_gamma, dtype=float) / (2.0 * omega0)
 
 
 def accelerometer_tilts(azimuth, accel_error_x, accel_error_y, gravity=STANDARD_GRAVITY):

@@ -2,11 +2,12 @@
 
 A :class:`AlignmentCase` holds one case or N cases (every field a float or an
 array of length N, SI); it checks that azimuth is observable at its latitude,
-derives the gains c_gamma, c_a from the time constant T and damping zeta, and
-builds the state-space models of :mod:`schuler.gyrocompassing.models`.
+derives the gains c_gamma, c_a from the time constant T and damping zeta by the
+manual's design (:mod:`schuler.core.gyrocompass_design`, T = 30 s and zeta = 0.8 by
+default), and builds the state-space models of :mod:`schuler.gyrocompassing.models`.
 :func:`analytic_results` evaluates the closed forms of :mod:`~schuler.gyrocompassing.analytic`
-for many cases at once (pure numpy); :func:`time_grid` and
-:func:`automatic_duration` fix how long and how finely a case is simulated.
+for many cases at once (pure numpy); :func:`automatic_duration` fixes how long a
+case is simulated (its output times: :func:`schuler.core.geometry.time_grid`).
 """
 
 from __future__ import annotations
@@ -19,14 +20,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT, loop_design, loop_gains
 from schuler.core.lti import StateSpace
 from schuler.exceptions import InvalidParameter, NotObservable
 from schuler.gyrocompassing import analytic, models
 
 DEFAULT_LATITUDE = math.radians(50.0)
-DEFAULT_TIME_CONSTANT = 30.0
-"""T, s (the KPI manual: "often T = 30 s, zeta = 0.8")."""
-DEFAULT_DAMPING = 0.8
 DEFAULT_INITIAL_AZIMUTH_ERROR = math.radians(1.0)
 DEFAULT_MAX_LATITUDE = math.radians(85.0)
 """Above this latitude gyrocompassing is refused as not observable (user-overridable)."""
@@ -36,7 +35,6 @@ DEFAULT_DURATION = 7200.0
 """Simulated time, s, unless 3 settling times are longer."""
 MAX_DURATION = 48 * 3600.0
 """Longest automatic run, s: a case that settles slower is reported as not settled."""
-MAX_TIME_POINTS = 2_000_000
 
 
 class GyrocompassingAccuracyWarning(UserWarning):
@@ -90,8 +88,8 @@ class AlignmentCase:
     latitude_error: float | np.ndarray = 0.0
     accel_error_x: float | np.ndarray = 0.0
     accel_error_y: float | np.ndarray = 0.0
-    time_constant: float | np.ndarray = DEFAULT_TIME_CONSTANT
-    damping: float | np.ndarray = DEFAULT_DAMPING
+    time_constant: float | np.ndarray = DESIGN_TIME_CONSTANT
+    damping: float | np.ndarray = DESIGN_DAMPING
     c_gamma: float | np.ndarray | None = None
     c_a: float | np.ndarray | None = None
     initial_azimuth_error: float | np.ndarray = DEFAULT_INITIAL_AZIMUTH_ERROR
@@ -137,7 +135,7 @@ class AlignmentCase:
         if worst > self.max_latitude:
             raise NotObservable(
                 f"latitude: {math.degrees(worst):g} deg is beyond the gyrocompassing limit "
-                f"{math.degrees(self.max_latitude):g} deg (--max-latitude): the horizontal Earth rate "
+                f"{math.degrees(self.max_latitude):g} deg (`max_latitude`): the horizontal Earth rate "
                 f"U cos(latitude) = {self.earth_rate * math.cos(worst):.3g} rad/s is too small to find north"
             )
         if worst > DEGRADED_LATITUDE:
@@ -149,7 +147,7 @@ class AlignmentCase:
 
     def gains(self) -> tuple[np.ndarray, np.ndarray]:
         """(c_gamma, c_a), 1/s: the given ones, else from T and zeta (c_a = 1/(T^2 U_eta), c_gamma = 2 zeta/T)."""
-        from_design = analytic.gains_from_design(self.time_constant, self.damping, self.latitude, self.earth_rate)
+        from_design = loop_gains(self.latitude, self.time_constant, self.damping, self.earth_rate)
         gains = []
         for given, designed in zip((self.c_gamma, self.c_a), from_design):
             if given is None:
@@ -245,7 +243,7 @@ def analytic_results(case: AlignmentCase, model: str = "full") -> dict[str, np.n
     else:
         delta, beta, _ = analytic.full_steady_state(case.latitude, c_gamma, c_a, drift_east, drift_north, case.drift_z,
                                                     case.latitude_error, eps_beta, eps_alpha, case.earth_rate)
-    time_constant, damping = analytic.design_from_gains(c_gamma, c_a, case.latitude, case.earth_rate)
+    time_constant, damping = loop_design(case.latitude, c_gamma, c_a, case.earth_rate)
     shape = np.broadcast_shapes(*(np.shape(x) for x in (delta, c_gamma, c_a)))
     result = {
         "azimuth_error_rad": delta,
@@ -259,32 +257,6 @@ def analytic_results(case: AlignmentCase, model: str = "full") -> dict[str, np.n
         "damping": damping,
     }
     return {key: np.broadcast_to(value, shape).astype(float) for key, value in result.items()}
-
-
-def time_grid(duration: float, time_step: float) -> np.ndarray:
-    """Output times 0, dt, ..., duration (the last step shortened to end exactly at duration), s.
-
-    Parameters
-    ----------
-    duration : float
-        Simulated time, s.
-    time_step : float
-        Output step dt, s.
-
-    Examples
-    --------
-    >>> time_grid(2.5, 1.0)
-    array([0. , 1. , 2. , 2.5])
-    """
-    if not duration > 0:
-        raise InvalidParameter("duration", "must be positive")
-    if not time_step > 0:
-        raise InvalidParameter("time_step", "must be positive")
-    n = int(math.floor(duration / time_step + 1e-9))
-    if n + 1 > MAX_TIME_POINTS:
-        raise InvalidParameter("time_step", f"{n + 1} output points exceed {MAX_TIME_POINTS}: use a longer step")
-    t = time_step * np.arange(n + 1)
-    return t if math.isclose(t[-1], duration, rel_tol=1e-12) else np.append(t, duration)
 
 
 def automatic_duration(settling_time) -> float:

@@ -22,19 +22,19 @@ import numpy as np
 
 from schuler.contract import Cases, Evaluation, Output
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.geometry import grid_points
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT
 from schuler.core.response import Histories
 from schuler.gyrocompassing import analytic, models
 from schuler.gyrocompassing.case import (
-    DEFAULT_DAMPING,
     DEFAULT_INITIAL_AZIMUTH_ERROR,
     DEFAULT_MAX_LATITUDE,
-    DEFAULT_TIME_CONSTANT,
     MAX_DURATION,
     AlignmentCase,
     analytic_results,
     automatic_duration,
 )
-from schuler.gyrocompassing.simulation import evaluate_cases
+from schuler.gyrocompassing.simulation import MAX_TIME_POINTS, evaluate_cases
 from schuler.gyrocompassing.simulation import run_case as simulate_case
 from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
@@ -68,10 +68,10 @@ PARAMETERS = ParameterSet((
               minimum=-0.1, maximum=0.1),
     Parameter("accel_bias_y", "g", 0.0, "Bias Delta a_y of the y accelerometer (measured - true).",
               minimum=-0.1, maximum=0.1),
-    Parameter("time_constant", "s", DEFAULT_TIME_CONSTANT,
+    Parameter("time_constant", "s", DESIGN_TIME_CONSTANT,
               "Time constant T of the azimuth loop (gains not given follow from T and zeta).",
               minimum=0.1, maximum=1e5),
-    Parameter("damping", "", DEFAULT_DAMPING, "Damping ratio zeta of the azimuth loop.",
+    Parameter("damping", "", DESIGN_DAMPING, "Damping ratio zeta of the azimuth loop.",
               minimum=0.01, maximum=100),
     Parameter("c_gamma", "1/s", None, "Level correction gain c_Gamma (not set: 2 zeta / T).",
               minimum=1e-6, maximum=100),
@@ -207,14 +207,14 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
 def _evaluate_group(cases: Cases, fidelity: str) -> dict[str, np.ndarray]:
     model = str(cases["model"][0])
     case = alignment_case(cases)
-    duration = float(cases.float("duration")[0])
+    duration, step = float(cases.float("duration")[0]), float(cases.float("output_step")[0])
     simulate = fidelity == "simulated"
     if simulate:
-        points = duration / float(cases.float("output_step")[0]) + 2
+        # the grid checked under this system's names before the simulation builds it
+        points = grid_points(duration, step, names=("duration", "output_step"), max_points=MAX_TIME_POINTS)
         require(points * 8 * 6 * min(len(cases), _CHUNK_MEMBERS), "this simulation",
-                "--duration or --output-step (or --fidelity closed)")
-    result = evaluate_cases(case, model, simulate_runs=simulate, duration=duration,
-                                  time_step=float(cases.float("output_step")[0]))
+                "`duration` or `output_step` (or `fidelity` closed)")
+    result = evaluate_cases(case, model, simulate_runs=simulate, duration=duration, time_step=step)
     full = analytic_results(case, "full-ab")["azimuth_error_rad"]
     c_gamma, c_a = result["c_gamma"], result["c_a"]
     system = case.model(model)
@@ -258,7 +258,7 @@ def _histories(cases: Cases, outputs: dict[str, np.ndarray], fidelity: str) -> E
                     "constraint_violations": []}
     if fidelity != "simulated":
         return Evaluation(outputs, extras=extras)
-    require(member_bytes(case) * 3, "this run's histories", "--duration or --output-step")
+    require(member_bytes(case) * 3, "this run's histories", "`duration` or `output_step`")
     with warnings.catch_warnings():
         # evaluate has warned about the latitude already; the histories are the same case
         warnings.filterwarnings("ignore", message=r"latitude .* accuracy degrades")

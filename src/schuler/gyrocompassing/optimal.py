@@ -20,7 +20,7 @@ white noise (velocity random walk N_a) is the measurement noise, PSD r = (N_a / 
 * the seed's loop: K = (c_Gamma, c_a, 0, 0), its error covariance from the Lyapunov equation
   (:func:`schuler.core.steady_state.loop_error_covariance`);
 * the optimal loop: the steady-state Kalman-Bucy gain (:func:`schuler.core.steady_state.steady_state_gain`);
-* the map gains <-> (T, zeta) (:func:`schuler.gyrocompassing.analytic.design_from_gains`), and back, for the
+* the map gains <-> (T, zeta) (:func:`schuler.core.gyrocompass_design.loop_design`), and back, for the
   white-noise loop (bias states left out): the algebraic Riccati equation gives in closed form
   c_a = sqrt(q_delta / r), c_Gamma^2 = q_beta / r + 2 c_a U_eta, so zeta^2 = 1/2 + q_beta / (4 r omega0^2):
   a pair of gains is optimal for some noise only when zeta >= 1/sqrt(2) (spec 07's return-difference
@@ -43,9 +43,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.geometry import horizontal_earth_rate
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT, loop_design, loop_gains
 from schuler.core.steady_state import loop_error_covariance, riccati_solution, steady_state_gain
-from schuler.exceptions import InvalidParameter
-from schuler.gyrocompassing.analytic import design_from_gains, gains_from_design, horizontal_earth_rate
+from schuler.exceptions import InvalidParameter, renamed_keywords
 
 GAUSS_MARKOV_PEAK_RATIO = 1.893
 """tau / T at the Allan-deviation peak of a first-order Gauss-Markov process (:mod:`schuler.imu.error_model`)."""
@@ -100,7 +101,8 @@ class LoopNoise:
             raise InvalidParameter("correlation_time", "must be > 0 s")
 
 
-def noise_from_imu(model, window_s: float = 600.0, correlation_time: float | None = None) -> LoopNoise:
+@renamed_keywords(window_s="window")
+def noise_from_imu(model, window: float = 600.0, correlation_time: float | None = None) -> LoopNoise:
     """The loop's noise from an IMU error model (a grade, a spec sheet or a recording's identified terms).
 
     White noise: the rms N of the two horizontal gyros and accelerometers, the z gyro's N. Drift: the
@@ -112,7 +114,7 @@ def noise_from_imu(model, window_s: float = 600.0, correlation_time: float | Non
     ----------
     model : schuler.imu.error_model.ErrorModel
         The IMU, SI.
-    window_s : float
+    window : float
         Time between the gyro calibration and the alignment, s.
     correlation_time : float, optional
         tau of the Gauss-Markov drift, s (not set: from the model).
@@ -125,7 +127,7 @@ def noise_from_imu(model, window_s: float = 600.0, correlation_time: float | Non
     if correlation_time is None:
         correlation_time = float(np.max(gyro.gm_correlation_time_s)) if np.any(gyro.gm_sigma > 0) \
             else gyro.flicker_tau_range_s[1] / GAUSS_MARKOV_PEAK_RATIO
-    drift = align_inputs(model, window_s=window_s).values
+    drift = align_inputs(model, window=window).values
     return LoopNoise(gyro_noise=float(np.hypot(*gyro.random_walk[:2]) / math.sqrt(2)),
                      gyro_noise_z=float(gyro.random_walk[2]),
                      accel_noise=float(np.hypot(*accel.random_walk[:2]) / math.sqrt(2)),
@@ -215,13 +217,14 @@ def loop_accuracy(gain, noise: LoopNoise, latitude: float, earth_rate: float = E
     bias = np.hypot(*(-np.linalg.solve(closed, G * np.array([noise.drift_east, noise.drift_z]))).T)
     # without drift gains the drift states are the process's own, not the loop's: their poles are left out
     poles = np.linalg.eigvals(closed if np.any(K[2:]) else closed[:2, :2])
-    T, zeta = design_from_gains(K[0], K[1], latitude, earth_rate)
+    T, zeta = loop_design(latitude, K[0], K[1], earth_rate)
     return LoopAccuracy(float(T), float(zeta), float(K[0]), float(K[1]), float(math.sqrt(P[1, 1])),
                         float(bias[1]), SETTLING_FACTOR / float(np.min(-poles.real)), (float(K[2]), float(K[3])))
 
 
-def seed_accuracy(noise: LoopNoise, latitude: float, time_constant: float = 30.0, damping: float = 0.8,
-                  earth_rate: float = EARTH_RATE, gravity: float = STANDARD_GRAVITY) -> LoopAccuracy:
+def seed_accuracy(noise: LoopNoise, latitude: float, time_constant: float = DESIGN_TIME_CONSTANT,
+                  damping: float = DESIGN_DAMPING, earth_rate: float = EARTH_RATE,
+                  gravity: float = STANDARD_GRAVITY) -> LoopAccuracy:
     """The KPI design c_Gamma = 2 zeta / T, c_a = 1 / (T^2 U_eta) on these sensors (:func:`loop_accuracy`).
 
     Parameters
@@ -239,7 +242,7 @@ def seed_accuracy(noise: LoopNoise, latitude: float, time_constant: float = 30.0
     gravity : float
         g, m/s^2.
     """
-    c_gamma, c_a = gains_from_design(time_constant, damping, latitude, earth_rate)
+    c_gamma, c_a = loop_gains(latitude, time_constant, damping, earth_rate)
     return loop_accuracy((float(c_gamma), float(c_a)), noise, latitude, earth_rate, gravity)
 
 
@@ -324,7 +327,7 @@ def noise_for_gains(c_gamma: float, c_a: float, latitude: float, earth_rate: flo
     return q_beta, c_a**2
 
 
-def accuracy_versus_time_constant(noise: LoopNoise, latitude: float, time_constants, damping: float = 0.8,
+def accuracy_versus_time_constant(noise: LoopNoise, latitude: float, time_constants, damping: float = DESIGN_DAMPING,
                                   earth_rate: float = EARTH_RATE, gravity: float = STANDARD_GRAVITY) -> np.ndarray:
     """The KPI loop's azimuth error at each T (zeta fixed): noise sigma and constant-drift error, rad.
 
@@ -352,7 +355,7 @@ def accuracy_versus_time_constant(noise: LoopNoise, latitude: float, time_consta
     return np.array([(row.azimuth_error_sigma_rad, row.azimuth_error_bias_rad) for row in rows])
 
 
-def best_time_constant(noise: LoopNoise, latitude: float, damping: float = 0.8, bounds=(1.0, 3600.0),
+def best_time_constant(noise: LoopNoise, latitude: float, damping: float = DESIGN_DAMPING, bounds=(1.0, 3600.0),
                        earth_rate: float = EARTH_RATE, gravity: float = STANDARD_GRAVITY) -> float:
     """The T of the KPI loop (zeta fixed) with the least total azimuth error sqrt(sigma^2 + bias^2), s.
 

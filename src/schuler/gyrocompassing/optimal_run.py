@@ -18,9 +18,10 @@ import numpy as np
 
 from schuler.contract import Action
 from schuler.core.earth import STANDARD_GRAVITY
+from schuler.core.geometry import horizontal_earth_rate
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT
 from schuler.exceptions import InvalidParameter
 from schuler.gyrocompassing import optimal as model
-from schuler.gyrocompassing.analytic import horizontal_earth_rate
 from schuler.params import Parameter, ParameterSet
 from schuler.results import Result, json_safe, write_result
 from schuler.units import to_unit
@@ -29,8 +30,8 @@ OPTIMAL_PARAMETERS = ParameterSet((
     Parameter("imu", "", "tactical", "IMU: a grade (navigation, tactical, industrial, consumer), a TOML spec file "
               "or a recording whose identified noise terms are used.", kind="text"),
     Parameter("latitude", "deg", 50.0, "Latitude of the site.", minimum=-85, maximum=85),
-    Parameter("time_constant", "s", 30.0, "T of the seed's design.", minimum=1, maximum=1e5),
-    Parameter("damping", "", 0.8, "zeta of the seed's design.", minimum=0.05, maximum=10),
+    Parameter("time_constant", "s", DESIGN_TIME_CONSTANT, "T of the seed's design.", minimum=1, maximum=1e5),
+    Parameter("damping", "", DESIGN_DAMPING, "zeta of the seed's design.", minimum=0.05, maximum=10),
     Parameter("imu_window", "s", 600.0, "Time between the gyro calibration and the alignment (the constant "
               "residual drift).", minimum=1e-3, maximum=1e7),
     Parameter("gyro_noise", "deg/sqrt(h)", None, "Gyro angle random walk N (not set: the IMU's).", minimum=0,
@@ -118,8 +119,8 @@ def _noise(imu: str, window: float, gyro_noise, accel_noise, correlation_time) -
     return dataclasses.replace(noise, **{k: v for k, v in given.items() if v is not None})
 
 
-def optimal(imu: str = "tactical", latitude: float = math.radians(50.0), time_constant: float = 30.0,
-            damping: float = 0.8, imu_window: float = 600.0, gyro_noise: float | None = None,
+def optimal(imu: str = "tactical", latitude: float = math.radians(50.0), time_constant: float = DESIGN_TIME_CONSTANT,
+            damping: float = DESIGN_DAMPING, imu_window: float = 600.0, gyro_noise: float | None = None,
             accel_noise: float | None = None, correlation_time: float | None = None, duration: float = 7200.0,
             initial_azimuth_sigma: float = math.radians(5.0),
             initial_tilt_sigma: float = math.radians(3.0 / 60.0)) -> OptimalAlignment:

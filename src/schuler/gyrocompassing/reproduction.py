@@ -17,6 +17,7 @@ import numpy as np
 
 from schuler.contract import Cases, FigureRef, ReportSection, monte_carlo
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT, loop_design, loop_gains
 from schuler.core.lti import simulate
 from schuler.core.random import RandomStreams
 from schuler.gyrocompassing import analytic, evaluation, models, plots
@@ -32,8 +33,6 @@ PRINTED_C_GAMMA = 0.08
 """c_Gamma printed for T = 30 s, 1/s."""
 PRINTED_C_A = 22.0
 """c_a printed for T = 30 s, 1/s."""
-DESIGN_TIME_CONSTANT = 30.0
-DESIGN_DAMPING = 0.8
 EXAMPLE_DRIFT = from_unit(0.01, "deg/h")
 """0.01 deg/h, rad/s: the residual drift of the worked cases."""
 EXAMPLE_ACCEL_ERROR = 1e-4 * STANDARD_GRAVITY
@@ -63,8 +62,7 @@ def reproduce() -> Reproduction:
     """
     where = "Sec. 2, after (1.25)"
     rows = []
-    gains = analytic.gains_from_design(DESIGN_TIME_CONSTANT, DESIGN_DAMPING, KYIV_LATITUDE)
-    c_gamma, c_a_kyiv = (float(x) for x in gains)
+    c_gamma, c_a_kyiv = loop_gains(KYIV_LATITUDE, DESIGN_TIME_CONSTANT, DESIGN_DAMPING)
     rows.append(compare(
         "c_Gamma for T = 30 s, zeta = 0.8", c_gamma, "1/s", printed="0.08", where=where,
         erratum="c_Gamma = 2 zeta / T; the printed 0.08 needs zeta = "
@@ -74,7 +72,7 @@ def reproduce() -> Reproduction:
         "c_a for T = 30 s at Kyiv (50.45 deg)", c_a_kyiv, "1/s", printed="22", where=where,
         erratum=f"c_a = 1 / (T^2 U cos(latitude)); the printed 22 holds at {math.degrees(latitude_for_22):.2f} deg "
                 f"(U = {EARTH_RATE} rad/s)"))
-    _, zeta_printed = analytic.design_from_gains(PRINTED_C_GAMMA, PRINTED_C_A, latitude_for_22)
+    _, zeta_printed = loop_design(latitude_for_22, PRINTED_C_GAMMA, PRINTED_C_A)
     rows.append(compare(
         "damping of the printed pair (0.08, 22)", float(zeta_printed), "1", printed="0.8", where=where,
         erratum="the printed gains give an aperiodic loop (zeta > 1), not the zeta = 0.8 they are meant for"))
@@ -103,7 +101,7 @@ def reproduce() -> Reproduction:
         note="dominant term of (1.21), Delta omega_dxi / (U cos(latitude)); a worked value of this toolkit"))
     rate = {}
     for label, builder in (("printed", models.printed_mu_nu_model), ("corrected", models.full_mu_nu_model)):
-        rate[label] = float(np.max(builder(KYIV_LATITUDE, 0.0, *gains).eigenvalues().real))
+        rate[label] = float(np.max(builder(KYIV_LATITUDE, 0.0, c_gamma, c_a_kyiv).eigenvalues().real))
     rows.append(compare(
         "largest real part of the (1.17) eigenvalues at A = 0, as printed", rate["printed"], "1/s",
         note=f"as printed the azimuth loop diverges (e-folding {1 / rate['printed'] / 3600:.1f} h); "

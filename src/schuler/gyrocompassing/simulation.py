@@ -4,7 +4,8 @@
 constraints over the whole run; :func:`evaluate_cases` evaluates many cases at
 once, in closed form and optionally by simulating them, streamed in chunks of
 members through :func:`schuler.core.lti.simulate_reduce` so that no history is
-kept (:func:`simulate_cases`).
+kept (:func:`simulate_cases`). Output times follow the core's rule
+(:func:`schuler.core.geometry.time_grid`), at most :data:`MAX_TIME_POINTS` of them.
 
 Constraints (task 1): |delta| < 0.4 rad, |beta| < 0.01 rad and an azimuth
 slew rate |delta'| < 0.2 rad/s. The source writes the last "0.2 1/s" in the
@@ -20,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from schuler.core.geometry import time_grid
 from schuler.core.lti import Response, StateSpace, simulate, simulate_reduce
 from schuler.exceptions import InvalidParameter
 from schuler.gyrocompassing import analytic
@@ -29,9 +31,12 @@ from schuler.gyrocompassing.case import (
     analytic_results,
     automatic_duration,
     check_model,
-    time_grid,
 )
 
+MAX_TIME_POINTS = 2_000_000
+"""Most output times of a run (a longer grid is refused before it is allocated)."""
+GRID_NAMES = ("duration", "time_step")
+"""The grid's parameters, as the core's time grid names them in its messages."""
 MAX_DELTA = 0.4
 """Constraint |delta| < 0.4 rad (task 1)."""
 MAX_BETA = 0.01
@@ -168,7 +173,7 @@ def evaluate_cases(case: AlignmentCase, model: str = "full", *, simulate_runs: b
     if not simulate_runs:
         return result
     duration = automatic_duration(result["settling_time_s"]) if duration is None else duration
-    time = time_grid(duration, time_step)
+    time = time_grid(duration, time_step, names=GRID_NAMES, max_points=MAX_TIME_POINTS)
     system = case.model(model)
     simulated = simulate_cases(system, time, case.initial_state(model), case.inputs(), members)
     result.update({
@@ -260,7 +265,7 @@ def run_case(case: AlignmentCase, model: str = "full", *, duration: float | None
             "the simulated azimuth error is not yet the steady state",
             GyrocompassingAccuracyWarning, stacklevel=2,
         )
-    time = time_grid(duration, time_step)
+    time = time_grid(duration, time_step, names=GRID_NAMES, max_points=MAX_TIME_POINTS)
     system = case.model(model)
     response = simulate(system, time, case.initial_state(model), case.inputs())
     delta, beta, rate = response["delta"], response["beta"], response["delta_rate"]

@@ -31,7 +31,7 @@ through :mod:`schuler.units`.
 - :mod:`~schuler.imu.allan`: streaming overlapping Allan deviation with confidence intervals;
 - :mod:`~schuler.imu.noise_terms`: IEEE 952 terms by weighted least squares, uncertainties, resolvability;
 - :mod:`~schuler.imu.characterise`: six-channel analysis, grade, round trip, the PSINS reproduction;
-- :mod:`~schuler.imu.system_inputs`: error model -> parameters of align, calibrate, north, errors;
+- :mod:`~schuler.imu.system_inputs`: error model -> parameters of align, calibrate, north, errors, vertical;
 - :mod:`~schuler.imu.analysis`: the everyday functions above;
 - :mod:`~schuler.imu.results`, :mod:`~schuler.imu.plots`: typed results, figures and the system's files;
 - :mod:`~schuler.imu.static`: latitude and attitude of a record at rest from its mean rates;
@@ -44,7 +44,7 @@ The system on the contract (``schuler imu``):
 - :mod:`~schuler.imu.actions`: ``info``, ``allan`` and ``simulate``;
 - :mod:`~schuler.imu.run_results`: how a run renders, what ``simulate`` returns;
 - :mod:`~schuler.imu.reproduction`: the grade figures round-tripped and the PSINS recording, the report section;
-- :mod:`~schuler.imu.instrument`: ``--imu`` on align, calibrate, north and errors (and ``[instrument]``).
+- :mod:`~schuler.imu.instrument`: ``--imu`` on align, calibrate, north, errors and vertical (and ``[instrument]``).
 """
 
 from schuler.imu.analysis import allan_deviation, identify, read_record

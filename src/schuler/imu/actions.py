@@ -27,13 +27,13 @@ from pathlib import Path
 from schuler.contract import Action, Argument
 from schuler.exceptions import InvalidParameter
 from schuler.imu.analysis import PER_OCTAVE, allan_deviation
-from schuler.imu.evaluation import PARAMETERS, sample_interval
+from schuler.imu.evaluation import PARAMETERS, imu_of, sample_interval
 from schuler.imu.files import file_info, write_record
+from schuler.imu.instrument import resolve_model
 from schuler.imu.record import KINDS, ImuInfo
 from schuler.imu.results import AllanResult
 from schuler.imu.run_results import SimulationResult
 from schuler.imu.simulate import simulate_record, write_simulation
-from schuler.imu.spec import case_model
 from schuler.memory import require
 from schuler.params import Parameter, ParameterSet
 from schuler.units import quoted
@@ -108,7 +108,7 @@ def csv_options(file: Path, kind=None, axes=None, columns=None, units=None, lati
     -------
     dict
         ``open_csv`` keywords: ``kind``, ``axes``, ``columns`` and ``units`` (dicts by channel) and
-        ``latitude_rad``, only those the user set.
+        ``latitude``, only those the user set.
     """
     given = [name for name, value in (("kind", kind), ("axes", axes), ("columns", columns), ("units", units),
                                       ("latitude", latitude)) if value not in (None, "")]
@@ -126,7 +126,7 @@ def csv_options(file: Path, kind=None, axes=None, columns=None, units=None, lati
     if units:
         options["units"] = _pairs(units, "units")
     if latitude is not None:
-        options["latitude_rad"] = latitude
+        options["latitude"] = latitude
     return options
 
 
@@ -169,7 +169,7 @@ def allan(file: Path, per_octave: int = 2, **options) -> AllanResult:
     return allan_deviation(file, per_octave=per_octave, **csv_options(file, **options))
 
 
-def simulate(output: Path, grade=None, spec=None, duration=3600.0, imu_rate=100.0, output_step=None,
+def simulate(output: Path, imu=None, duration=3600.0, imu_rate=100.0, output_step=None,
              latitude=math.radians(45.0), azimuth=0.0, seed: int = 0) -> SimulationResult:
     """Simulate a record of a grade or spec file at rest into ``output`` (.parquet streamed, .csv in memory).
 
@@ -177,10 +177,9 @@ def simulate(output: Path, grade=None, spec=None, duration=3600.0, imu_rate=100.
     ----------
     output : Path
         File to write: ``.parquet`` (native, written window by window) or ``.csv`` (the project's format).
-    grade : str, optional
-        Grade preset of the simulated IMU (:data:`~schuler.imu.spec.GRADES`; not set: tactical).
-    spec : str, optional
-        TOML spec file of the simulated IMU, instead of ``grade``.
+    imu : str, optional
+        The simulated IMU: a grade (:data:`~schuler.imu.spec.GRADES`), a TOML spec file or a recording whose
+        identified noise terms are simulated (not set: tactical).
     duration : float
         Length of the record, s (rounded to whole samples).
     imu_rate : float
@@ -203,8 +202,8 @@ def simulate(output: Path, grade=None, spec=None, duration=3600.0, imu_rate=100.
     output = Path(output)
     suffix = output.suffix.lower()
     if suffix not in (".parquet", ".csv"):
-        raise InvalidParameter("--output", f"{output.name}: write .parquet (native, streamed) or .csv")
-    model = case_model(grade, spec)
+        raise InvalidParameter("output", f"{output.name}: write .parquet (native, streamed) or .csv")
+    model = resolve_model(imu_of(imu))
     dt = sample_interval(imu_rate, output_step)
     samples = int(round(duration / dt))
     if samples < 2:
@@ -216,13 +215,13 @@ def simulate(output: Path, grade=None, spec=None, duration=3600.0, imu_rate=100.
     if needed_disk > free:
         raise InvalidParameter("duration", f"the file would take about {needed_disk / 1e9:.3g} GB, more than the "
                                f"{free / 1e9:.3g} GB free in {folder}")
-    site = {"latitude_rad": latitude, "heading_rad": azimuth}
+    site = {"latitude": latitude, "heading": azimuth}
     if suffix == ".parquet":
-        write_simulation(output, model, duration_s=samples * dt, sample_interval_s=dt, seed=seed, **site)
+        write_simulation(output, model, duration=samples * dt, sample_interval=dt, seed=seed, **site)
     else:
-        require(samples * CSV_BYTES_PER_SAMPLE, "this CSV file", "--duration or --imu-rate (or write .parquet, which "
+        require(samples * CSV_BYTES_PER_SAMPLE, "this CSV file", "`duration` or `imu_rate` (or write .parquet, which "
                                                                  "streams)")
-        record = simulate_record(model, duration_s=samples * dt, sample_interval_s=dt, seed=seed,
+        record = simulate_record(model, duration=samples * dt, sample_interval=dt, seed=seed,
                                  max_memory_bytes=samples * CSV_BYTES_PER_SAMPLE, **site)
         write_record(record, output)
     return SimulationResult(path=str(output), model=model.name, model_source=model.source, samples=samples,

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu import _kernels
 
 DEFAULT_MAX_FRACTION = 0.125
@@ -186,10 +186,11 @@ class AllanAccumulator:
     True
     """
 
-    def __init__(self, sample_interval_s: float, lags, channels: int = 6, offsets=None):
-        self.dt = float(sample_interval_s)
+    @renamed_keywords(sample_interval_s="sample_interval")
+    def __init__(self, sample_interval: float, lags, channels: int = 6, offsets=None):
+        self.dt = float(sample_interval)
         if not (math.isfinite(self.dt) and self.dt > 0):
-            raise InvalidParameter("sample_interval_s", f"must be finite and > 0, got {sample_interval_s!r}")
+            raise InvalidParameter("sample_interval_s", f"must be finite and > 0, got {sample_interval!r}")
         self.lags = np.asarray(lags, dtype=np.int64)
         if self.lags.ndim != 1 or self.lags.size == 0 or self.lags.min() < 1:
             raise InvalidParameter("lags", "give one or more lags >= 1")
@@ -263,14 +264,15 @@ class AllanAccumulator:
         return out
 
 
-def allan_deviation(rates, sample_interval_s: float, lags=None, chunk: int = 1 << 20) -> AllanCurve:
+@renamed_keywords(sample_interval_s="sample_interval")
+def allan_deviation(rates, sample_interval: float, lags=None, chunk: int = 1 << 20) -> AllanCurve:
     """Overlapping Allan deviation of one channel of rate samples (an array), with confidence intervals.
 
     Parameters
     ----------
     rates : array_like, shape (n,)
         Rate samples (rad/s or m/s^2), mean over each interval.
-    sample_interval_s : float
+    sample_interval : float
         tau0, s.
     lags : array_like of int, optional
         Lags m, number of samples (default :func:`allan_lags`: two per octave, up to n / 8).
@@ -279,7 +281,7 @@ def allan_deviation(rates, sample_interval_s: float, lags=None, chunk: int = 1 <
     """
     rates = np.asarray(rates, dtype=float).reshape(-1)
     lags = allan_lags(rates.size) if lags is None else lags
-    accumulator = AllanAccumulator(sample_interval_s, lags, channels=1, offsets=[np.mean(rates)])
+    accumulator = AllanAccumulator(sample_interval, lags, channels=1, offsets=[np.mean(rates)])
     for start in range(0, rates.size, chunk):
         accumulator.update(rates[start:start + chunk])
     return accumulator.curves()[0]

@@ -4,12 +4,12 @@ Options are Python values, not command-line text: a CSV file's ``columns``
 and ``units`` are dicts (``units={"gyro": "deg/s", "accel": "g"}``: a unit as
 text or a pint unit, ``gyro`` and ``accel`` standing for their three axes),
 ``kind`` and ``axes`` names (``"increment"``, ``"RFU"``), a site in SI
-(``latitude_rad``). ``schuler imu allan`` parses its options and calls
+(``latitude``). ``schuler imu allan`` parses its options and calls
 :func:`allan_deviation`, so the command and the function give the same numbers.
 
 >>> from schuler.imu.simulate import simulate_record
 >>> from schuler.imu.spec import preset
->>> record = simulate_record(preset("consumer"), duration_s=60.0, sample_interval_s=0.01, seed=2)
+>>> record = simulate_record(preset("consumer"), duration=60.0, sample_interval=0.01, seed=2)
 >>> terms = identify(record, channels=["gyro_x"])
 >>> round(terms.terms["gyro_x"]["N"] / float(preset("consumer").gyro.random_walk[0]), 1)
 1.0
@@ -77,7 +77,7 @@ def allan_deviation(record: ImuRecord | str | Path, *, channels: Iterable[str] |
     **options
         CSV files only, the reader's keywords (:func:`~schuler.imu.readers.open_csv`): ``columns`` (channel ->
         the file's column), ``units`` (channel, ``gyro`` or ``accel`` -> unit text or pint unit), ``kind``
-        ("rate" or "increment"), ``axes`` (where the file's x, y, z point, e.g. "RFU"), ``latitude_rad`` (rad).
+        ("rate" or "increment"), ``axes`` (where the file's x, y, z point, e.g. "RFU"), ``latitude`` (rad).
 
     Returns
     -------

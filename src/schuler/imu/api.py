@@ -11,7 +11,7 @@ Sources: the grade presets' data sheets (:mod:`~schuler.imu.spec`), IEEE Std
 
 Examples
 --------
->>> r = SYSTEM.run(grade="consumer", duration=600.0)
+>>> r = SYSTEM.run(imu="consumer", duration=600.0)
 >>> r.to_dict()["noise"]["gyro_x"]["N"] > 0, r.all_within
 (True, True)
 """

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu.allan import DEFAULT_MAX_FRACTION, AllanAccumulator, AllanCurve, allan_lags
 from schuler.imu.error_model import ErrorModel, SensorErrors
 from schuler.imu.files import open_record, read_record
@@ -100,7 +100,8 @@ def classify_grade(noise: dict) -> tuple[str | None, dict[str, float]]:
     return (max(consistent, key=margins.__getitem__) if consistent else None), margins
 
 
-def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, kind: str = "rate",
+@renamed_keywords(sample_interval_s="sample_interval")
+def analyse_chunks(chunks, *, sample_interval: float, expected_samples: int, kind: str = "rate",
                    source: str = "", per_octave: int = 2, max_fraction: float = DEFAULT_MAX_FRACTION,
                    channels: tuple[str, ...] = CHANNELS) -> AllanResult:
     """Allan analysis of streamed ``(time_s, gyro, accel)`` chunks (rates or increments, see ``kind``).
@@ -114,7 +115,7 @@ def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, k
         ``(time_s, gyro, accel)`` per chunk: times, s, shape (n,); gyro and accelerometer samples, arrays of
         shape (n, 3), body axes x forward, y right, z down: rad/s and m/s^2 (``kind="rate"``) or rad and m/s
         over each interval (``kind="increment"``). Only the sensor columns are used.
-    sample_interval_s : float
+    sample_interval : float
         Sample interval dt, s.
     expected_samples : int
         Samples the record is expected to hold, number of (sets the lags; at least 4 used).
@@ -135,7 +136,7 @@ def analyse_chunks(chunks, *, sample_interval_s: float, expected_samples: int, k
     AllanResult
         Curves with confidence intervals, identified terms of the channels and the grade they match.
     """
-    dt = float(sample_interval_s)
+    dt = float(sample_interval)
     lags = allan_lags(max(4, int(expected_samples)), per_octave=per_octave, max_fraction=max_fraction)
     # all six columns as they come (a copy's layout would move the offsets' rounding)
     columns = slice(None) if channels == CHANNELS else [CHANNELS.index(name) for name in channels]
@@ -176,13 +177,13 @@ def analyse_record(record: ImuRecord, per_octave: int = 2, max_fraction: float =
     Examples
     --------
     >>> from schuler.imu.spec import preset
-    >>> record = simulate_record(preset("consumer"), duration_s=60.0, sample_interval_s=0.01, seed=2)
+    >>> record = simulate_record(preset("consumer"), duration=60.0, sample_interval=0.01, seed=2)
     >>> result = analyse_record(record)
     >>> round(float(result.noise["gyro_x"].terms.values["N"] / preset("consumer").gyro.random_walk[0]), 1)
     1.0
     """
     chunks = [(record.time_s, record.gyro_rate_rad_s, record.accel_m_s2)]
-    return analyse_chunks(chunks, sample_interval_s=record.sample_interval_s, expected_samples=record.samples,
+    return analyse_chunks(chunks, sample_interval=record.sample_interval_s, expected_samples=record.samples,
                           source=record.source, per_octave=per_octave, max_fraction=max_fraction, channels=channels)
 
 
@@ -215,7 +216,7 @@ def analyse_source(source: RecordSource, per_octave: int = 2, max_fraction: floa
         yield first
         yield from chunks
 
-    return analyse_chunks(all_chunks(), sample_interval_s=source.interval_s(),
+    return analyse_chunks(all_chunks(), sample_interval=source.interval_s(),
                           expected_samples=source.estimated_samples, kind=source.kind, source=source.path.name,
                           per_octave=per_octave, max_fraction=max_fraction, channels=channels)
 
@@ -291,19 +292,21 @@ def expected_terms(errors: SensorErrors, axis: int, curve: AllanCurve) -> dict[s
     return identify_terms(model_curve).values
 
 
-def round_trip(model: ErrorModel | str, *, duration_s: float, sample_interval_s: float, seed: int = 0,
-               member: int = 0, latitude_rad: float = math.radians(45.0), heading_rad: float = 0.0) -> RoundTripResult:
+@renamed_keywords(duration_s="duration", sample_interval_s="sample_interval", latitude_rad="latitude",
+                  heading_rad="heading")
+def round_trip(model: ErrorModel | str, *, duration: float, sample_interval: float, seed: int = 0,
+               member: int = 0, latitude: float = math.radians(45.0), heading: float = 0.0) -> RoundTripResult:
     """Simulate a record from known terms, identify them, and check each within its tolerance.
 
     Parameters
     ----------
     model : ErrorModel or str
         A model or a grade name.
-    duration_s, sample_interval_s : float
+    duration, sample_interval : float
         Record length and dt, s.
     seed, member : int
         Address of the record's random numbers: seed and member number.
-    latitude_rad, heading_rad : float
+    latitude, heading : float
         Site latitude and heading of the body x axis, rad.
 
     Returns
@@ -313,8 +316,8 @@ def round_trip(model: ErrorModel | str, *, duration_s: float, sample_interval_s:
         resolved; B is compared only where there is no Gauss-Markov term.
     """
     model = preset(model) if isinstance(model, str) else model
-    record = simulate_record(model, duration_s=duration_s, sample_interval_s=sample_interval_s, seed=seed,
-                             member=member, latitude_rad=latitude_rad, heading_rad=heading_rad)
+    record = simulate_record(model, duration=duration, sample_interval=sample_interval, seed=seed,
+                             member=member, latitude=latitude, heading=heading)
     analysis = analyse_record(record)
     checks = []
     for name in CHANNELS:

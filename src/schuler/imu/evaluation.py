@@ -45,6 +45,7 @@ from schuler.contract import Cases, Evaluation, Output
 from schuler.exceptions import InvalidParameter
 from schuler.imu.characterise import round_trip, true_terms
 from schuler.imu.error_model import ErrorModel
+from schuler.imu.instrument import resolve_model
 from schuler.imu.results import (
     CHANNELS,
     CHECK_UNITS,
@@ -56,7 +57,7 @@ from schuler.imu.results import (
     curves_histories,
     sensor_of,
 )
-from schuler.imu.spec import GRADES, case_model
+from schuler.imu.spec import GRADES
 from schuler.memory import require
 from schuler.params import Case, Parameter, ParameterSet
 from schuler.results import json_safe
@@ -80,10 +81,9 @@ TERM_NAMES = {"N": "random walk N", "B": "bias instability B", "K": "rate random
               "R": "rate ramp R"}
 
 PARAMETERS = ParameterSet((
-    Parameter("grade", "", "tactical", "Grade preset of the simulated IMU (data-sheet figures and their sources: "
-              "schuler imu reproduce).", choices=GRADES, kind="choice"),
-    Parameter("spec", "", None, "TOML spec file of the simulated IMU, figures in spec-sheet units (instead of "
-              "--grade).", kind="text"),
+    Parameter("imu", "", None, "The simulated IMU: a grade (" + ", ".join(GRADES) + "; data-sheet figures and "
+              "their sources: schuler imu reproduce), a TOML spec file (figures in spec-sheet units) or a "
+              "recording whose identified noise terms are simulated (not set: tactical).", kind="text"),
     Parameter("duration", "s", "1 h", "Length of the simulated record.", minimum=0, exclusive_minimum=True,
               maximum=MAX_DURATION),
     Parameter("imu_rate", "Hz", 100.0, "Sample rate of the record.", minimum=0, exclusive_minimum=True,
@@ -93,8 +93,23 @@ PARAMETERS = ParameterSet((
     Parameter("latitude", "deg", 45.0, "Latitude of the site (the Earth rate and gravity the record shows).",
               minimum=-90, maximum=90),
     Parameter("azimuth", "deg", 0.0, "Heading of the body x axis, clockwise from north.", minimum=-360, maximum=360),
-), owner="imu", exclusive=(("grade", "spec"), ("imu_rate", "output_step")))
+), owner="imu", exclusive=(("imu_rate", "output_step"),), renamed={"grade": "imu", "spec": "imu"})
 """Every option of ``schuler imu run`` (and key of an ``imu`` scenario)."""
+
+
+DEFAULT_IMU = "tactical"
+"""The grade simulated when ``imu`` is not set."""
+
+
+def imu_of(value: str | None) -> str:
+    """The IMU a case names (:func:`~schuler.imu.instrument.resolve_model` reads it), not set the default grade.
+
+    Parameters
+    ----------
+    value : str or None
+        The case's ``imu``.
+    """
+    return DEFAULT_IMU if value is None else str(value).strip()
 
 
 def output_name(channel: str, term: str) -> str:
@@ -161,19 +176,19 @@ def record_samples(duration: float, dt: float) -> int:
     if samples < MIN_SAMPLES:
         raise InvalidParameter("duration", f"{duration:g} s at {dt:g} s per sample gives {samples:,} samples; an "
                                f"Allan analysis of five terms needs at least {MIN_SAMPLES}")
-    require(samples * BYTES_PER_SAMPLE, "this record", "--duration or --imu-rate")
+    require(samples * BYTES_PER_SAMPLE, "this record", "`duration` or `imu_rate`")
     return samples
 
 
 def _round_trip(case: Case, seed: int, member: int, models: dict) -> tuple[ErrorModel, RoundTripResult]:
-    key = (case["grade"], case["spec"])  # one model per grade or spec file in a batch
+    key = imu_of(case["imu"])  # one model per IMU in a batch
     if key not in models:
-        models[key] = case_model(*key)
+        models[key] = resolve_model(key)
     model = models[key]
     dt = sample_interval(case["imu_rate"], case["output_step"])
     samples = record_samples(case["duration"], dt)
-    trip = round_trip(model, duration_s=samples * dt, sample_interval_s=dt, seed=seed, member=member,
-                      latitude_rad=case["latitude"], heading_rad=case["azimuth"])
+    trip = round_trip(model, duration=samples * dt, sample_interval=dt, seed=seed, member=member,
+                      latitude=case["latitude"], heading=case["azimuth"])
     return model, trip
 
 
@@ -224,7 +239,7 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
 
     Examples
     --------
-    >>> run = evaluate(Cases.from_case(PARAMETERS.case(grade="consumer", duration=600.0)), histories=True)
+    >>> run = evaluate(Cases.from_case(PARAMETERS.case(imu="consumer", duration=600.0)), histories=True)
     >>> round(float(run["noise_gyro_x_N"][0] / run.extras["true_terms"]["gyro_x"]["N"]), 2)
     1.0
     """

@@ -1,4 +1,5 @@
-"""An IMU for the other systems: ``--imu GRADE|SPEC.toml|RECORD`` on align, calibrate, north and errors runs.
+"""An IMU for the other systems: ``--imu GRADE|SPEC.toml|RECORD`` on align, calibrate, north, errors and vertical
+runs.
 
 The seed systems take their instrument errors as numbers; this module turns an
 IMU (a grade preset, a TOML spec file, or a recording whose identified noise
@@ -26,6 +27,9 @@ north      ``readout_noise`` = sqrt(Q^2 + N^2 h), z gyro, h = the case's ``outpu
 errors     ``magnitude`` of the case's ``source`` (drift and accelerometer
            residuals, tilt = bias / g, azimuth from the static gyrocompassing
            limit at ``imu_latitude``, velocity 0)
+vertical   ``drift_x``, ``drift_y``: residual gyro drift after calibration over
+           ``imu_window`` (housing x, y = body y, x); ``accel_bias_x``,
+           ``accel_bias_y``: turn-on bias plus its change
 ========== =====================================================================
 """
 
@@ -34,7 +38,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu.error_model import ErrorModel
 from schuler.imu.spec import GRADES, load_spec_file, preset
 from schuler.imu.system_inputs import (
@@ -44,10 +48,11 @@ from schuler.imu.system_inputs import (
     calibrate_inputs,
     errors_inputs,
     north_inputs,
+    vertical_inputs,
 )
 from schuler.params import Case, Parameter, ParameterSet
 
-IMU_SYSTEMS = ("align", "calibrate", "north", "errors")
+IMU_SYSTEMS = ("align", "calibrate", "north", "errors", "vertical")
 """The systems whose runs take ``--imu``."""
 
 IMU_OPTION = Parameter("imu", "", None, "IMU whose errors set this run's instrument parameters: a grade ("
@@ -73,12 +78,12 @@ def instrument_options(system: str) -> ParameterSet:
     Returns
     -------
     ParameterSet
-        ``imu``, plus ``imu_window`` (align, errors) and ``imu_latitude`` (errors).
+        ``imu``, plus ``imu_window`` (align, errors, vertical) and ``imu_latitude`` (errors).
     """
     if system not in IMU_SYSTEMS:
         return ParameterSet((), owner=system)
     options = [IMU_OPTION]
-    if system in ("align", "errors"):
+    if system in ("align", "errors", "vertical"):
         options.append(WINDOW_OPTION)
     if system == "errors":
         options.append(LATITUDE_OPTION)
@@ -112,22 +117,23 @@ def resolve_model(text: str, base: Path | None = None) -> ErrorModel:
     return model_from_analysis(analyse_file(path), name=f"identified from {path.name}")
 
 
-def system_inputs(system: str, model: ErrorModel, case: Case, *, window_s: float | None = None,
-                  latitude_rad: float | None = None) -> SystemInputs:
+@renamed_keywords(latitude_rad="latitude", window_s="window")
+def system_inputs(system: str, model: ErrorModel, case: Case, *, window: float | None = None,
+                  latitude: float | None = None) -> SystemInputs:
     """The mapping for one system: :mod:`~schuler.imu.system_inputs` with what it needs from the case.
 
     Parameters
     ----------
-    system : {"align", "calibrate", "north", "errors"}
+    system : {"align", "calibrate", "north", "errors", "vertical"}
         The system whose parameters the IMU sets.
     model : ErrorModel
         The IMU, SI.
     case : Case
         The system's case, SI: align uses its ``azimuth`` (rad), north its ``output_step`` (s), errors its
         ``source``.
-    window_s : float, optional
-        Time between the gyro calibration and use, s (align, errors; not set: 600 s).
-    latitude_rad : float, optional
+    window : float, optional
+        Time between the gyro calibration and use, s (align, errors, vertical; not set: 600 s).
+    latitude : float, optional
         Latitude of the errors system's static gyrocompassing limit, rad (not set: 45 deg).
 
     Returns
@@ -135,30 +141,33 @@ def system_inputs(system: str, model: ErrorModel, case: Case, *, window_s: float
     SystemInputs
         The system's parameter values and Monte Carlo sigmas, SI, with their units and notes.
     """
-    window = DEFAULT_WINDOW_S if window_s is None else window_s
+    window = DEFAULT_WINDOW_S if window is None else window
     if system == "align":
-        return align_inputs(model, heading_rad=case["azimuth"], window_s=window)
+        return align_inputs(model, heading=case["azimuth"], window=window)
     if system == "calibrate":
         return calibrate_inputs(model)
     if system == "north":
-        return north_inputs(model, step_s=case["output_step"])
+        return north_inputs(model, step=case["output_step"])
     if system == "errors":
-        inputs = errors_inputs(model, latitude_rad=DEFAULT_LATITUDE if latitude_rad is None else latitude_rad,
-                               window_s=window)
+        inputs = errors_inputs(model, latitude=DEFAULT_LATITUDE if latitude is None else latitude,
+                               window=window)
         source = case["source"]
         return SystemInputs("errors", inputs.model, {"magnitude": inputs.values[source]},
                             {"magnitude": inputs.sigmas.get(source, 0.0)},
                             {"magnitude": inputs.parameter_units[source]}, [f"source {source}", *inputs.notes])
+    if system == "vertical":
+        return vertical_inputs(model, window=window)
     raise InvalidParameter("imu", f"applies to {', '.join(IMU_SYSTEMS)} runs, not {system}")
 
 
-def apply_instrument(system: str, parameters: ParameterSet, case: Case, imu: str, *, window_s: float | None = None,
-                     latitude_rad: float | None = None, base: Path | None = None) -> tuple[Case, SystemInputs]:
+@renamed_keywords(window_s="window", latitude_rad="latitude")
+def apply_instrument(system: str, parameters: ParameterSet, case: Case, imu: str, *, window: float | None = None,
+                     latitude: float | None = None, base: Path | None = None) -> tuple[Case, SystemInputs]:
     """The case with the IMU's values for every parameter the user did not give, and the mapping used.
 
     Parameters
     ----------
-    system : {"align", "calibrate", "north", "errors"}
+    system : {"align", "calibrate", "north", "errors", "vertical"}
         The system being run.
     parameters : ParameterSet
         The system's parameters (the merged case is validated against them).
@@ -166,9 +175,9 @@ def apply_instrument(system: str, parameters: ParameterSet, case: Case, imu: str
         The case as the user gave it, SI; its ``given`` names win over the IMU's values.
     imu : str
         A grade name, a ``.toml`` spec file or a recording (``.csv``, ``.imu``, ``.parquet``).
-    window_s : float, optional
+    window : float, optional
         Time between the gyro calibration and use, s (not set: 600 s).
-    latitude_rad : float, optional
+    latitude : float, optional
         Latitude of the errors system's static gyrocompassing limit, rad (not set: 45 deg).
     base : Path, optional
         Folder relative paths in ``imu`` start from (a scenario's folder); default: the current one.
@@ -186,7 +195,7 @@ def apply_instrument(system: str, parameters: ParameterSet, case: Case, imu: str
         beyond calibrate's 3600 deg/h).
     """
     model = resolve_model(imu, base)
-    inputs = system_inputs(system, model, case, window_s=window_s, latitude_rad=latitude_rad)
+    inputs = system_inputs(system, model, case, window=window, latitude=latitude)
     given = {name: case[name] for name in case.given}
     merged = {**{k: v for k, v in inputs.values.items() if k not in case.given}, **given}
     try:
@@ -206,7 +215,7 @@ def apply_options(system: str, parameters: ParameterSet, case: Case, options: Ca
 
     Parameters
     ----------
-    system : {"align", "calibrate", "north", "errors"}
+    system : {"align", "calibrate", "north", "errors", "vertical"}
         The system being run.
     parameters : ParameterSet
         The system's parameters.
@@ -216,6 +225,6 @@ def apply_options(system: str, parameters: ParameterSet, case: Case, options: Ca
         ``imu`` (a grade, spec file or recording) and, where the system has them, ``imu_window`` (s) and
         ``imu_latitude`` (rad).
     """
-    merged, _ = apply_instrument(system, parameters, case, options["imu"], window_s=options.get("imu_window"),
-                                 latitude_rad=options.get("imu_latitude"))
+    merged, _ = apply_instrument(system, parameters, case, options["imu"], window=options.get("imu_window"),
+                                 latitude=options.get("imu_latitude"))
     return merged

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu.readers import ImuFileError, RecordSource
 from schuler.imu.record import KINDS, ImuRecord
 
@@ -55,7 +55,8 @@ class ParquetRecordWriter:
         ``gravity_m_s2``, ``source``.
     """
 
-    def __init__(self, path, kind: str, sample_interval_s: float, **metadata):
+    @renamed_keywords(sample_interval_s="sample_interval")
+    def __init__(self, path, kind: str, sample_interval: float, **metadata):
         import pyarrow.parquet as pq
 
         from schuler.io import atomic_path
@@ -67,7 +68,7 @@ class ParquetRecordWriter:
             raise InvalidParameter(sorted(set(metadata) - allowed)[0], "unknown record metadata")
         self._atomic = atomic_path(path)
         self._tmp = self._atomic.__enter__()
-        header = {"version": FORMAT_VERSION, "kind": kind, "sample_interval_s": float(sample_interval_s), **metadata}
+        header = {"version": FORMAT_VERSION, "kind": kind, "sample_interval_s": float(sample_interval), **metadata}
         self._schema = _schema(header)
         self._writer = pq.ParquetWriter(self._tmp, self._schema)
         self.path = Path(path)

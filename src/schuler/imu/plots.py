@@ -18,9 +18,10 @@ from typing import Any
 import numpy as np
 
 from schuler.imu.error_model import ErrorModel
+from schuler.imu.evaluation import imu_of
+from schuler.imu.instrument import resolve_model
 from schuler.imu.noise_terms import SLOPES, model_allan_deviation, term_allan_deviations
 from schuler.imu.results import DISPLAY_UNITS, AllanResult, IdentifiedTerms, sensor_of, shown_unit
-from schuler.imu.spec import case_model
 from schuler.io import save_figure_formats, write_dataframe_csv
 from schuler.reproduction import Reproduction
 from schuler.results import Result, SystemResult
@@ -257,7 +258,7 @@ def figures(result: Result) -> dict[str, Any]:
     if not isinstance(result, SystemResult):
         return {}
     extras, parameters = result.extras, result.parameters
-    model = case_model(parameters["grade"], parameters["spec"])
+    model = resolve_model(imu_of(parameters["imu"]))
     grade = f" (grade: {extras['grade']})" if extras["grade"] else ""
     drawn = {f"imu_allan_{sensor}": allan_figure(
         extras["noise"], sensor, model, f"simulated {extras['model']}, seed {extras['seed']}, member "

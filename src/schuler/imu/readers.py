@@ -48,7 +48,7 @@ from pathlib import Path
 
 import numpy as np
 
-from schuler.exceptions import InvalidParameter, SchulerError
+from schuler.exceptions import InvalidParameter, SchulerError, renamed_keywords
 from schuler.imu.record import KINDS, ImuRecord, axes_matrix
 from schuler.units import quoted
 
@@ -284,8 +284,7 @@ def _estimate_rows(path: Path, header_bytes: int, sample_lines: list[str]) -> in
     return int(math.ceil(max(0, size - header_bytes) / per_line))
 
 
-def _read_numeric_chunks(path: Path, encoding: str, skip_lines: int, names, sep: str, rows: int,
-                         first_line: int):
+def _read_numeric_chunks(path: Path, encoding: str, skip_lines: int, names, sep: str, rows: int, first_line: int):
     """pandas' C reader over the data lines, float64, with file/line/column in every error."""
     import pandas as pd
 
@@ -332,10 +331,11 @@ def _unit_scale(unit: str, expected: str, channel: str) -> float:
     return parse_quantity(f"1 {unit}", expected, name=f"units.{channel}")
 
 
+@renamed_keywords(latitude_rad="latitude", longitude_rad="longitude", height_m="height")
 def open_csv(path, *, columns: dict[str, str] | None = None, units: dict[str, str] | None = None,
              kind: str = "rate", axes: str = "FRD", delimiter: str = ",", check_units: bool = True,
-             latitude_rad: float | None = None, longitude_rad: float | None = None,
-             height_m: float | None = None) -> RecordSource:
+             latitude: float | None = None, longitude: float | None = None,
+             height: float | None = None) -> RecordSource:
     """Open a CSV file of IMU samples.
 
     Parameters
@@ -355,7 +355,7 @@ def open_csv(path, *, columns: dict[str, str] | None = None, units: dict[str, st
     check_units : bool
         Refuse accelerometer rates whose mean magnitude is 0.5..1.5 while declared
         in m/s^2 (the file is almost surely in g).
-    latitude_rad, longitude_rad, height_m : float, optional
+    latitude, longitude, height : float, optional
         The site, which a CSV file does not carry: latitude and longitude in rad, height in m.
 
     Returns
@@ -388,7 +388,7 @@ def open_csv(path, *, columns: dict[str, str] | None = None, units: dict[str, st
             yield time_s, gyro @ rotation.T, accel @ rotation.T
 
     return RecordSource(path=path, kind=kind, sample_interval_s=None, estimated_samples=estimated,
-                        metadata={"latitude_rad": latitude_rad, "longitude_rad": longitude_rad, "height_m": height_m,
+                        metadata={"latitude_rad": latitude, "longitude_rad": longitude, "height_m": height,
                                   "first_data_line": first_line},
                         _chunks=lambda rows: _decode_guard(path, chunks(rows)))
 

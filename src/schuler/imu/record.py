@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.results import Result
 
 KINDS = ("rate", "increment")
@@ -285,8 +285,9 @@ def record_info(record: ImuRecord) -> ImuInfo:
                            initial_attitude_rad=record.initial_attitude_rad)
 
 
-def info_from_means(source: str, samples: int, kind: str, sample_interval_s: float, mean_gyro_rad_s,
-                    mean_accel_m_s2, **site) -> ImuInfo:
+@renamed_keywords(sample_interval_s="sample_interval", mean_gyro_rad_s="mean_gyro", mean_accel_m_s2="mean_accel")
+def info_from_means(source: str, samples: int, kind: str, sample_interval: float, mean_gyro,
+                    mean_accel, **site) -> ImuInfo:
     """An :class:`ImuInfo` from a record's size and mean rates (what a streamed file gives).
 
     ``site``: ``latitude_rad``, ``longitude_rad``, ``height_m``, ``gravity_m_s2``,
@@ -300,11 +301,11 @@ def info_from_means(source: str, samples: int, kind: str, sample_interval_s: flo
         Samples in the record, number of.
     kind : {"rate", "increment"}
         What the file's sensor columns hold.
-    sample_interval_s : float
+    sample_interval : float
         Sample interval dt, s.
-    mean_gyro_rad_s : array_like
+    mean_gyro : array_like
         Mean angular rate, rad/s, shape (3,), body axes x forward, y right, z down.
-    mean_accel_m_s2 : array_like
+    mean_accel : array_like
         Mean specific force, m/s^2, shape (3,), body axes.
     **site
         ``latitude_rad``, ``longitude_rad`` (rad), ``height_m`` (m), ``gravity_m_s2`` (m/s^2),
@@ -315,16 +316,16 @@ def info_from_means(source: str, samples: int, kind: str, sample_interval_s: flo
     ImuInfo
         SI fields; the expected Earth-rate components when the latitude is known.
     """
-    gyro = np.asarray(mean_gyro_rad_s, dtype=float)
-    accel = np.asarray(mean_accel_m_s2, dtype=float)
+    gyro = np.asarray(mean_gyro, dtype=float)
+    accel = np.asarray(mean_accel, dtype=float)
     latitude = site.get("latitude_rad")
     return ImuInfo(
         source=source,
         samples=int(samples),
         kind=kind,
-        sample_interval_s=float(sample_interval_s),
-        sample_rate_hz=1.0 / sample_interval_s,
-        duration_s=round(samples * sample_interval_s, 12),
+        sample_interval_s=float(sample_interval),
+        sample_rate_hz=1.0 / sample_interval,
+        duration_s=round(samples * sample_interval, 12),
         mean_gyro_rad_s=(float(gyro[0]), float(gyro[1]), float(gyro[2])),
         mean_accel_m_s2=(float(accel[0]), float(accel[1]), float(accel[2])),
         horizontal_gyro_rad_s=float(math.hypot(gyro[0], gyro[1])),

@@ -84,7 +84,7 @@ REPRODUCE_PARAMETERS = ParameterSet((
 @cache
 def grade_round_trip(grade: str) -> RoundTripResult:
     """The round trip of a grade's record (seed 0, member 0, 100 Hz, :data:`GRADE_DURATIONS`); cached: it is pure."""
-    return round_trip(preset(grade), duration_s=GRADE_DURATIONS[grade], sample_interval_s=SAMPLE_INTERVAL, seed=0)
+    return round_trip(preset(grade), duration=GRADE_DURATIONS[grade], sample_interval=SAMPLE_INTERVAL, seed=0)
 
 
 def _round_up(value: float, digits: int = 2) -> float:

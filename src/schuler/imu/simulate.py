@@ -32,8 +32,8 @@ by (seed, stream, member, b, position), whatever the windows.
 Examples
 --------
 >>> from schuler.imu.spec import preset
->>> record = simulate_record(preset("tactical"), duration_s=10.0, sample_interval_s=0.01, seed=1,
-...                          latitude_rad=0.6)
+>>> record = simulate_record(preset("tactical"), duration=10.0, sample_interval=0.01, seed=1,
+...                          latitude=0.6)
 >>> record.samples, record.kind
 (1000, 'rate')
 >>> bool(abs(record.accel_m_s2[:, 2].mean() + 9.80) < 0.05)   # specific force z ~ -g (z down)
@@ -50,7 +50,7 @@ import numpy as np
 
 from schuler.core.earth import EARTH_RATE, normal_gravity
 from schuler.core.random import BLOCK, RandomStreams
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu import _kernels
 from schuler.imu.error_model import ErrorModel, SensorErrors, flicker_terms
 from schuler.imu.record import ImuRecord
@@ -68,16 +68,17 @@ _AXES = "xyz"
 _NO_OFFSET = np.zeros(1)
 
 
-def static_truth(latitude_rad: float, heading_rad: float = 0.0, gravity_m_s2: float | None = None):
+@renamed_keywords(latitude_rad="latitude", heading_rad="heading", gravity_m_s2="gravity")
+def static_truth(latitude: float, heading: float = 0.0, gravity: float | None = None):
     """True gyro and accelerometer inputs of a level IMU at rest, body x forward, y right, z down.
 
     Parameters
     ----------
-    latitude_rad : float
+    latitude : float
         Geodetic latitude L, rad.
-    heading_rad : float
+    heading : float
         Heading psi of the x axis, clockwise from north, rad.
-    gravity_m_s2 : float, optional
+    gravity : float, optional
         g (default: WGS-84 normal gravity at L).
 
     Returns
@@ -85,11 +86,11 @@ def static_truth(latitude_rad: float, heading_rad: float = 0.0, gravity_m_s2: fl
     gyro, accel : ndarray (3,)
         omega_b = Omega [cos L cos psi, -cos L sin psi, -sin L] (rad/s) and f_b = [0, 0, -g] (m/s^2).
     """
-    if not abs(latitude_rad) <= math.pi / 2:
-        raise InvalidParameter("latitude", f"{latitude_rad!r} rad must be within [-pi/2, pi/2]")
-    g = float(normal_gravity(latitude_rad)) if gravity_m_s2 is None else float(gravity_m_s2)
-    c, s = math.cos(latitude_rad), math.sin(latitude_rad)
-    gyro = EARTH_RATE * np.array([c * math.cos(heading_rad), -c * math.sin(heading_rad), -s])
+    if not abs(latitude) <= math.pi / 2:
+        raise InvalidParameter("latitude", f"{latitude!r} rad must be within [-pi/2, pi/2]")
+    g = float(normal_gravity(latitude)) if gravity is None else float(gravity)
+    c, s = math.cos(latitude), math.sin(latitude)
+    gyro = EARTH_RATE * np.array([c * math.cos(heading), -c * math.sin(heading), -s])
     return gyro, np.array([0.0, 0.0, -g])
 
 
@@ -183,15 +184,16 @@ class ImuSimulator:
     so any cut gives the same numbers.
     """
 
-    def __init__(self, model: ErrorModel, sample_interval_s: float, *, true_gyro_rad_s=(0.0, 0.0, 0.0),
-                 true_accel_m_s2=(0.0, 0.0, 0.0), seed: int = 0, workers: int = 1):
-        dt = float(sample_interval_s)
+    @renamed_keywords(sample_interval_s="sample_interval", true_gyro_rad_s="true_gyro", true_accel_m_s2="true_accel")
+    def __init__(self, model: ErrorModel, sample_interval: float, *, true_gyro=(0.0, 0.0, 0.0),
+                 true_accel=(0.0, 0.0, 0.0), seed: int = 0, workers: int = 1):
+        dt = float(sample_interval)
         if not (math.isfinite(dt) and dt > 0):
-            raise InvalidParameter("sample_interval", f"must be finite and > 0 s, got {sample_interval_s!r}")
+            raise InvalidParameter("sample_interval", f"must be finite and > 0 s, got {sample_interval!r}")
         self.model, self.dt, self.workers = model, dt, max(1, int(workers))
         self.streams = RandomStreams(seed)
-        self.true_gyro = self._truth(true_gyro_rad_s, "true_gyro_rad_s")
-        self.true_accel = self._truth(true_accel_m_s2, "true_accel_m_s2")
+        self.true_gyro = self._truth(true_gyro, "true_gyro_rad_s")
+        self.true_accel = self._truth(true_accel, "true_accel_m_s2")
         self._sensors = {"gyro": model.gyro, "accel": model.accel}
         self._slow_terms = {f"{s}_{a}": _slow_terms(e, i, dt) for s, e in self._sensors.items()
                             for i, a in enumerate(_AXES)}
@@ -412,8 +414,9 @@ def iter_simulation(simulator: ImuSimulator, members, samples: int, window: int 
         simulator.forget(group)
 
 
-def simulate_members(model: ErrorModel, *, samples: int, sample_interval_s: float, members=1, seed: int = 0,
-                     true_gyro_rad_s=(0.0, 0.0, 0.0), true_accel_m_s2=(0.0, 0.0, 0.0), workers: int = 1,
+@renamed_keywords(sample_interval_s="sample_interval", true_gyro_rad_s="true_gyro", true_accel_m_s2="true_accel")
+def simulate_members(model: ErrorModel, *, samples: int, sample_interval: float, members=1, seed: int = 0,
+                     true_gyro=(0.0, 0.0, 0.0), true_accel=(0.0, 0.0, 0.0), workers: int = 1,
                      max_memory_bytes: int = DEFAULT_MAX_MEMORY_BYTES) -> tuple[np.ndarray, np.ndarray]:
     """All samples of several members in memory: gyro and accel rates, each (members, samples, 3).
 
@@ -425,15 +428,15 @@ def simulate_members(model: ErrorModel, *, samples: int, sample_interval_s: floa
         Sensor errors (SI).
     samples : int
         Number of samples per member.
-    sample_interval_s : float
+    sample_interval : float
         dt, s.
     members : int or sequence of int
         A count (members 0 .. n-1) or the member numbers.
     seed : int
         Seed of the random streams.
-    true_gyro_rad_s : tuple of float
+    true_gyro : tuple of float
         True angular rate in body axes, rad/s.
-    true_accel_m_s2 : tuple of float
+    true_accel : tuple of float
         True specific force in body axes, m/s^2.
     workers : int
         Number of threads.
@@ -443,8 +446,8 @@ def simulate_members(model: ErrorModel, *, samples: int, sample_interval_s: floa
     """
     ids = np.arange(members) if np.ndim(members) == 0 else np.asarray(members, dtype=np.int64)
     _check_size(ids.size, int(samples), max_memory_bytes)
-    simulator = ImuSimulator(model, sample_interval_s, true_gyro_rad_s=true_gyro_rad_s,
-                             true_accel_m_s2=true_accel_m_s2, seed=seed, workers=workers)
+    simulator = ImuSimulator(model, sample_interval, true_gyro=true_gyro,
+                             true_accel=true_accel, seed=seed, workers=workers)
     gyro = np.empty((ids.size, int(samples), 3))
     accel = np.empty_like(gyro)
     for _, start, g, a in iter_simulation(simulator, ids, int(samples), member_chunk=max(1, ids.size)):
@@ -453,8 +456,10 @@ def simulate_members(model: ErrorModel, *, samples: int, sample_interval_s: floa
     return gyro, accel
 
 
-def simulate_record(model: ErrorModel, *, duration_s: float, sample_interval_s: float, seed: int = 0, member: int = 0,
-                    latitude_rad: float = math.radians(45.0), heading_rad: float = 0.0, kind: str = "rate",
+@renamed_keywords(duration_s="duration", sample_interval_s="sample_interval", latitude_rad="latitude",
+                  heading_rad="heading")
+def simulate_record(model: ErrorModel, *, duration: float, sample_interval: float, seed: int = 0, member: int = 0,
+                    latitude: float = math.radians(45.0), heading: float = 0.0, kind: str = "rate",
                     max_memory_bytes: int = DEFAULT_MAX_MEMORY_BYTES) -> ImuRecord:
     """One member's record of a level IMU at rest (:func:`static_truth`), as an :class:`ImuRecord`.
 
@@ -462,17 +467,17 @@ def simulate_record(model: ErrorModel, *, duration_s: float, sample_interval_s: 
     ----------
     model : ErrorModel
         Sensor errors (SI): the member's constant errors are drawn from it, its random processes simulated.
-    duration_s : float
+    duration : float
         Length of the record, s.
-    sample_interval_s : float
+    sample_interval : float
         Sample interval dt, s.
     seed : int
         Study seed of the addressed random numbers, plain number >= 0.
     member : int
         Member number, index >= 0: with the seed, the address of the random numbers.
-    latitude_rad : float
+    latitude : float
         Geodetic latitude L of the site, rad.
-    heading_rad : float
+    heading : float
         Heading of the body x axis, clockwise from north, rad.
     kind : {"rate", "increment"}
         What a sample holds: the mean rate over dt (rad/s, m/s^2) or its increment (rad, m/s).
@@ -484,20 +489,22 @@ def simulate_record(model: ErrorModel, *, duration_s: float, sample_interval_s: 
     ImuRecord
         Samples at t = dt, 2 dt, ..., body axes x forward, y right, z down.
     """
-    dt = float(sample_interval_s)
-    samples = _sample_count(duration_s, dt)
-    gyro_true, accel_true = static_truth(latitude_rad, heading_rad)
-    gyro, accel = simulate_members(model, samples=samples, sample_interval_s=dt, members=[member], seed=seed,
-                                   true_gyro_rad_s=gyro_true, true_accel_m_s2=accel_true,
+    dt = float(sample_interval)
+    samples = _sample_count(duration, dt)
+    gyro_true, accel_true = static_truth(latitude, heading)
+    gyro, accel = simulate_members(model, samples=samples, sample_interval=dt, members=[member], seed=seed,
+                                   true_gyro=gyro_true, true_accel=accel_true,
                                    max_memory_bytes=max_memory_bytes)
     scale = dt if kind == "increment" else 1.0
     return ImuRecord(time_s=dt * np.arange(1, samples + 1), gyro=gyro[0] * scale, accel=accel[0] * scale, kind=kind,
-                     sample_interval_s=dt, latitude_rad=latitude_rad, initial_attitude_rad=(0.0, 0.0, heading_rad),
+                     sample_interval_s=dt, latitude_rad=latitude, initial_attitude_rad=(0.0, 0.0, heading),
                      source=f"simulated {model.name}, seed {seed}, member {member}")
 
 
-def write_simulation(path, model: ErrorModel, *, duration_s: float, sample_interval_s: float, seed: int = 0,
-                     member: int = 0, latitude_rad: float = math.radians(45.0), heading_rad: float = 0.0,
+@renamed_keywords(duration_s="duration", sample_interval_s="sample_interval", latitude_rad="latitude",
+                  heading_rad="heading")
+def write_simulation(path, model: ErrorModel, *, duration: float, sample_interval: float, seed: int = 0,
+                     member: int = 0, latitude: float = math.radians(45.0), heading: float = 0.0,
                      workers: int = 1):
     """Simulate one member at rest straight into a native (Parquet) file, window by window; returns the path.
 
@@ -507,17 +514,17 @@ def write_simulation(path, model: ErrorModel, *, duration_s: float, sample_inter
         The Parquet file.
     model : ErrorModel
         Sensor errors (SI).
-    duration_s : float
+    duration : float
         Length of the record, s.
-    sample_interval_s : float
+    sample_interval : float
         Sample interval dt, s.
     seed : int
         Study seed of the addressed random numbers, plain number >= 0.
     member : int
         Member number, index >= 0: with the seed, the address of the random numbers.
-    latitude_rad : float
+    latitude : float
         Geodetic latitude L of the site, rad.
-    heading_rad : float
+    heading : float
         Heading of the body x axis, clockwise from north, rad.
     workers : int
         Threads over members, number of.
@@ -530,12 +537,12 @@ def write_simulation(path, model: ErrorModel, *, duration_s: float, sample_inter
     """
     from schuler.imu.native import ParquetRecordWriter
 
-    dt = float(sample_interval_s)
-    samples = _sample_count(duration_s, dt)
-    gyro_true, accel_true = static_truth(latitude_rad, heading_rad)
-    simulator = ImuSimulator(model, dt, true_gyro_rad_s=gyro_true, true_accel_m_s2=accel_true, seed=seed,
+    dt = float(sample_interval)
+    samples = _sample_count(duration, dt)
+    gyro_true, accel_true = static_truth(latitude, heading)
+    simulator = ImuSimulator(model, dt, true_gyro=gyro_true, true_accel=accel_true, seed=seed,
                              workers=workers)
-    with ParquetRecordWriter(path, "rate", dt, latitude_rad=latitude_rad, initial_attitude_rad=(0.0, 0.0, heading_rad),
+    with ParquetRecordWriter(path, "rate", dt, latitude_rad=latitude, initial_attitude_rad=(0.0, 0.0, heading),
                              source=f"simulated {model.name}, seed {seed}, member {member}") as writer:
         for _, start, gyro, accel in iter_simulation(simulator, [member], samples):
             writer.write(dt * np.arange(start + 1, start + gyro.shape[1] + 1), gyro[0], accel[0])

@@ -250,21 +250,3 @@ def preset(grade: str) -> ErrorModel:
         hint = f"; did you mean {close[0]!r}?" if close else ""
         raise InvalidParameter("grade", f"{grade!r} is not one of {', '.join(GRADES)}{hint}")
     return error_model_from_spec(PRESET_SPECS[grade], name=grade)
-
-
-def case_model(grade: str | None, spec: str | None) -> ErrorModel:
-    """The error model of a case: the spec file when given, else the grade preset.
-
-    Parameters
-    ----------
-    grade : str or None
-        Grade preset, one of :data:`GRADES` (None: tactical, the default of ``schuler imu run``).
-    spec : str or None
-        Path of a TOML spec file (figures in spec-sheet units); when set it wins over ``grade``.
-
-    Returns
-    -------
-    ErrorModel
-        The IMU's error terms, SI.
-    """
-    return load_spec_file(spec) if spec else preset(grade or "tactical")

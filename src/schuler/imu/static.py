@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 
 
 @dataclass(frozen=True)
@@ -53,14 +53,15 @@ class StaticAttitude:
     heading_rad: float
 
 
-def static_attitude(mean_gyro_rad_s, mean_accel_m_s2) -> StaticAttitude:
+@renamed_keywords(mean_gyro_rad_s="mean_gyro", mean_accel_m_s2="mean_accel")
+def static_attitude(mean_gyro, mean_accel) -> StaticAttitude:
     """Latitude, roll, pitch and heading of a resting IMU from its mean gyro and accelerometer rates.
 
     Parameters
     ----------
-    mean_gyro_rad_s : array_like (3,)
+    mean_gyro : array_like (3,)
         Mean angular rate, body x forward, y right, z down, rad/s.
-    mean_accel_m_s2 : array_like (3,)
+    mean_accel : array_like (3,)
         Mean specific force, same axes, m/s^2.
 
     Returns
@@ -72,8 +73,8 @@ def static_attitude(mean_gyro_rad_s, mean_accel_m_s2) -> StaticAttitude:
     InvalidParameter
         A zero vector, or parallel rates (at a pole, or a record in motion).
     """
-    omega = np.asarray(mean_gyro_rad_s, dtype=float).reshape(3)
-    force = np.asarray(mean_accel_m_s2, dtype=float).reshape(3)
+    omega = np.asarray(mean_gyro, dtype=float).reshape(3)
+    force = np.asarray(mean_accel, dtype=float).reshape(3)
     if not (np.all(np.isfinite(omega)) and np.all(np.isfinite(force))):
         raise InvalidParameter("mean rates", "must be finite")
     size_omega, size_force = float(np.linalg.norm(omega)), float(np.linalg.norm(force))

@@ -45,7 +45,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
-from schuler.exceptions import InvalidParameter
+from schuler.exceptions import InvalidParameter, renamed_keywords
 from schuler.imu.error_model import ErrorModel, SensorErrors
 from schuler.results import Result
 
@@ -109,7 +109,8 @@ def _check_latitude(latitude_rad: float, limit: float = math.radians(89.0)) -> f
     return float(latitude_rad)
 
 
-def residual_bias(errors: SensorErrors, window_s: float, include_turn_on: bool) -> np.ndarray:
+@renamed_keywords(window_s="window")
+def residual_bias(errors: SensorErrors, window: float, include_turn_on: bool) -> np.ndarray:
     """1-sigma residual bias per body axis: sqrt(b^2 [if kept] + 2 sigma_A,slow^2(window)).
 
     ``sigma_A,slow`` is the Allan deviation of the slow terms only (flicker,
@@ -119,7 +120,7 @@ def residual_bias(errors: SensorErrors, window_s: float, include_turn_on: bool) 
     ----------
     errors : SensorErrors
         The triad's error model, SI.
-    window_s : float
+    window : float
         Time between the bias estimate and use, which is also the averaging window, s (> 0).
     include_turn_on : bool
         True: the turn-on bias b stays in the residual (nothing removed it); False: only its change counts.
@@ -130,9 +131,9 @@ def residual_bias(errors: SensorErrors, window_s: float, include_turn_on: bool) 
         Residual bias, shape (3,), body axes x forward, y right, z down: rad/s (gyro triad) or m/s^2
         (accelerometer triad).
     """
-    window_s = _check_window(window_s)
+    window = _check_window(window)
     slow = replace(errors, random_walk=np.zeros(3), quantization=np.zeros(3))
-    drift = np.array([2.0 * float(slow.allan_variance(np.array([window_s]), axis)[0]) for axis in range(3)])
+    drift = np.array([2.0 * float(slow.allan_variance(np.array([window]), axis)[0]) for axis in range(3)])
     if include_turn_on:
         drift = drift + errors.bias**2
     return np.sqrt(drift)
@@ -148,16 +149,17 @@ def _horizontal_rms(values: np.ndarray) -> float:
     return float(math.sqrt((values[0] ** 2 + values[1] ** 2) / 2.0))
 
 
-def align_inputs(model: ErrorModel, *, heading_rad: float = 0.0, window_s: float = DEFAULT_WINDOW_S,
+@renamed_keywords(heading_rad="heading", window_s="window")
+def align_inputs(model: ErrorModel, *, heading: float = 0.0, window: float = DEFAULT_WINDOW_S,
                  calibrated_gyros: bool = True) -> SystemInputs:
     """``align`` (gyrocompassing) inputs: residual platform drifts, accelerometer biases and their sigmas.
 
     Parameters
     ----------
     model : ErrorModel
-    heading_rad : float
+    heading : float
         Heading of the body x axis, rad: align's azimuth A of the platform y axis.
-    window_s : float
+    window : float
         Time between the gyro calibration and the alignment, s.
     calibrated_gyros : bool
         True: the gyro turn-on bias is removed (residual = its change over the window).
@@ -173,9 +175,9 @@ def align_inputs(model: ErrorModel, *, heading_rad: float = 0.0, window_s: float
         drifts), ``sigma_drift_z`` and ``sigma_accel`` (rms of the two horizontal
         accelerometers) for align's Monte Carlo.
     """
-    gyro = residual_bias(model.gyro, window_s, include_turn_on=not calibrated_gyros)
-    accel = residual_bias(model.accel, window_s, include_turn_on=True)
-    rotation = _level_rotation(heading_rad)
+    gyro = residual_bias(model.gyro, window, include_turn_on=not calibrated_gyros)
+    accel = residual_bias(model.accel, window, include_turn_on=True)
+    rotation = _level_rotation(heading)
     drift_ned = -rotation @ gyro
     spread_ned = np.sqrt((rotation**2) @ gyro**2)
     values = {"drift_east": float(drift_ned[1]) + 0.0, "drift_north": float(drift_ned[0]) + 0.0,
@@ -187,11 +189,45 @@ def align_inputs(model: ErrorModel, *, heading_rad: float = 0.0, window_s: float
               "accel_bias_x": float(accel[1]), "accel_bias_y": float(accel[0])}
     units = {name: "rad/s" for name in ("drift_east", "drift_north", "drift_z", "sigma_drift", "sigma_drift_z")}
     units.update(accel_bias_x="m/s^2", accel_bias_y="m/s^2", sigma_accel="m/s^2")
-    notes = [f"drift = -C_b^n b_g with b_g at +1 sigma, heading (align's azimuth) {math.degrees(heading_rad):g} deg",
+    notes = [f"drift = -C_b^n b_g with b_g at +1 sigma, heading (align's azimuth) {math.degrees(heading):g} deg",
              f"gyro turn-on bias {'removed by calibration' if calibrated_gyros else 'kept'}; change over "
-             f"{window_s:g} s = sqrt(2) x slow-term Allan deviation",
+             f"{window:g} s = sqrt(2) x slow-term Allan deviation",
              "accelerometer turn-on bias kept (indistinguishable from tilt at rest); platform x, y = body y, x"]
     return SystemInputs("align", model.name, values, sigmas, units, notes)
+
+
+@renamed_keywords(window_s="window")
+def vertical_inputs(model: ErrorModel, *, window: float = DEFAULT_WINDOW_S) -> SystemInputs:
+    """``vertical`` (gyro vertical) inputs: the residual drifts of its two level axes and its accelerometer biases.
+
+    The vertical's housing axes x, y take the IMU's body y, x (as align's platform: x, y, z = body y, x, -z).
+    ``drift_x``, ``drift_y`` (rad/s): -b_g of those axes for the residual gyro bias at +1 sigma after a
+    calibration ``window`` before use (its change over the window, sqrt(2) x the slow terms' Allan deviation);
+    ``accel_bias_x``, ``accel_bias_y`` (m/s^2): the accelerometers' turn-on bias and its change, which nothing
+    at rest removes (it is indistinguishable from tilt).
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The IMU, SI.
+    window : float
+        Time between the gyro calibration and the run, s.
+
+    Returns
+    -------
+    SystemInputs
+        The four values, SI, and the same magnitudes as their 1-sigma spreads.
+    """
+    gyro = residual_bias(model.gyro, window, include_turn_on=False)
+    accel = residual_bias(model.accel, window, include_turn_on=True)
+    values = {"drift_x": -float(gyro[1]), "drift_y": -float(gyro[0]), "accel_bias_x": float(accel[1]),
+              "accel_bias_y": float(accel[0])}
+    sigmas = {name: abs(value) for name, value in values.items()}
+    units = {"drift_x": "rad/s", "drift_y": "rad/s", "accel_bias_x": "m/s^2", "accel_bias_y": "m/s^2"}
+    notes = [f"drift = -b_g at +1 sigma; gyro turn-on bias removed by calibration; change over {window:g} s = "
+             "sqrt(2) x slow-term Allan deviation",
+             "accelerometer turn-on bias kept (indistinguishable from tilt at rest); housing x, y = body y, x"]
+    return SystemInputs("vertical", model.name, values, sigmas, units, notes)
 
 
 def calibrate_inputs(model: ErrorModel) -> SystemInputs:
@@ -220,7 +256,8 @@ def calibrate_inputs(model: ErrorModel) -> SystemInputs:
                          "platform X, Y = body y, x"])
 
 
-def north_inputs(model: ErrorModel, *, step_s: float) -> SystemInputs:
+@renamed_keywords(step_s="step")
+def north_inputs(model: ErrorModel, *, step: float) -> SystemInputs:
     """``north`` (ground gyrocompass) input: ``readout_noise``, the noise of one azimuth observation, rad.
 
     An angle obtained by integrating the rate over a sample step h carries the
@@ -232,7 +269,7 @@ def north_inputs(model: ErrorModel, *, step_s: float) -> SystemInputs:
     ----------
     model : ErrorModel
         The IMU, SI; only the z gyro's quantisation Q (rad) and random walk N (rad/sqrt(s)) are used.
-    step_s : float
+    step : float
         Sample step h of an azimuth observation, s (> 0; the ``north`` case's ``output_step``).
 
     Returns
@@ -240,14 +277,15 @@ def north_inputs(model: ErrorModel, *, step_s: float) -> SystemInputs:
     SystemInputs
         ``readout_noise``, rad, and the same value as its 1-sigma spread.
     """
-    step_s = _check_window(step_s, "output_step")
+    step = _check_window(step, "output_step")
     q, n = model.gyro.quantization[2], model.gyro.random_walk[2]
-    noise = float(math.sqrt(q**2 + n**2 * step_s))
+    noise = float(math.sqrt(q**2 + n**2 * step))
     return SystemInputs("north", model.name, {"readout_noise": noise}, {"readout_noise": noise},
-                        {"readout_noise": "rad"}, [f"sqrt(Q^2 + N^2 h) of the z gyro at h = {step_s:g} s"])
+                        {"readout_noise": "rad"}, [f"sqrt(Q^2 + N^2 h) of the z gyro at h = {step:g} s"])
 
 
-def errors_inputs(model: ErrorModel, *, latitude_rad: float, window_s: float = DEFAULT_WINDOW_S) -> SystemInputs:
+@renamed_keywords(latitude_rad="latitude", window_s="window")
+def errors_inputs(model: ErrorModel, *, latitude: float, window: float = DEFAULT_WINDOW_S) -> SystemInputs:
     """``errors`` (Schuler-loop navigation errors) inputs: each source's 1-sigma magnitude, SI, keyed by source.
 
     ``errors`` takes one source and its ``magnitude``; the caller picks the
@@ -264,9 +302,9 @@ def errors_inputs(model: ErrorModel, *, latitude_rad: float, window_s: float = D
     ----------
     model : ErrorModel
         The IMU, SI.
-    latitude_rad : float
+    latitude : float
         Latitude L of the static gyrocompassing limit, rad (within +/-89 deg).
-    window_s : float
+    window : float
         Time between the gyro calibration and use (also the averaging window), s.
 
     Returns
@@ -274,15 +312,15 @@ def errors_inputs(model: ErrorModel, *, latitude_rad: float, window_s: float = D
     SystemInputs
         Source name -> 1-sigma magnitude in the units above, and the same as sigmas (velocity has none).
     """
-    latitude_rad = _check_latitude(latitude_rad)
-    gyro = residual_bias(model.gyro, window_s, include_turn_on=False)
-    accel = residual_bias(model.accel, window_s, include_turn_on=True)
+    latitude = _check_latitude(latitude)
+    gyro = residual_bias(model.gyro, window, include_turn_on=False)
+    accel = residual_bias(model.accel, window, include_turn_on=True)
     drift, bias = _horizontal_rms(gyro), _horizontal_rms(accel)
-    azimuth = math.hypot(drift / (EARTH_RATE * math.cos(latitude_rad)),
-                         bias * math.tan(latitude_rad) / STANDARD_GRAVITY)
+    azimuth = math.hypot(drift / (EARTH_RATE * math.cos(latitude)),
+                         bias * math.tan(latitude) / STANDARD_GRAVITY)
     values = {"tilt": bias / STANDARD_GRAVITY, "velocity": 0.0, "accelerometer": bias, "drift": drift,
               "azimuth": float(azimuth)}
     units = {"tilt": "rad", "velocity": "m/s", "accelerometer": "m/s^2", "drift": "rad/s", "azimuth": "rad"}
     return SystemInputs("errors", model.name, values, {k: v for k, v in values.items() if k != "velocity"}, units,
-                        [f"latitude {math.degrees(latitude_rad):g} deg, window {window_s:g} s",
+                        [f"latitude {math.degrees(latitude):g} deg, window {window:g} s",
                          "velocity 0: the run starts at rest"])

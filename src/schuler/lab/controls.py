@@ -19,7 +19,7 @@ from typing import Any
 
 from dash import dcc, html
 
-from schuler.exceptions import InvalidParameter, SchulerError
+from schuler.exceptions import InvalidParameter, SchulerError, as_options
 from schuler.lab.views import data_attributes
 from schuler.params import Case, Parameter, ParameterSet
 from schuler.units import to_unit
@@ -299,7 +299,7 @@ def parse_typed(parameters: ParameterSet, typed: Mapping[str, str]) -> tuple[Cas
         try:
             parameter.parse(text, parameter.option)
         except SchulerError as error:
-            errors[name] = str(error)
+            errors[name] = as_options(str(error))
         except Exception:  # the units library fails on some texts ("()") with errors of its own
             unit = (parameter.unit if parameter.kind == "quantity" else "") or "plain numbers"
             errors[name] = f"{parameter.option}: cannot read {text.strip()!r} as a quantity in {unit}"
@@ -308,7 +308,7 @@ def parse_typed(parameters: ParameterSet, typed: Mapping[str, str]) -> tuple[Cas
     try:
         return parameters.parse(dict(typed), labels="option"), {}
     except InvalidParameter as error:
-        return None, {_owner(parameters, error.name) or parameters.names[0]: str(error)}
+        return None, {_owner(parameters, error.name) or parameters.names[0]: as_options(str(error))}
 
 
 def _owner(parameters: ParameterSet, label: str) -> str | None:
@@ -346,5 +346,5 @@ def error_owner(parameters: ParameterSet, error: SchulerError) -> tuple[str | No
         name, _, reason = str(error).partition(": ")
     owner = _owner(parameters, name)
     if owner is not None and reason:
-        return owner, f"{parameters[owner].option}: {reason}"
-    return None, str(error)
+        return owner, as_options(f"{parameters[owner].option}: {reason}")
+    return None, as_options(str(error))

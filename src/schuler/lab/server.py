@@ -78,15 +78,15 @@ def check_host(host: str, allow_remote: bool = False) -> str:
     >>> check_host("0.0.0.0")
     Traceback (most recent call last):
     ...
-    schuler.exceptions.InvalidParameter: --host: '0.0.0.0' is not a loopback address; the lab has no login, so \
-it listens only on this machine (127.0.0.1, ::1, localhost) unless --allow-remote is given
+    schuler.exceptions.InvalidParameter: host: '0.0.0.0' is not a loopback address; the lab has no login, so \
+it listens only on this machine (127.0.0.1, ::1, localhost) unless `allow_remote` is given
     """
     text = str(host).strip()
     if not text:
-        raise InvalidParameter("--host", "empty host")
+        raise InvalidParameter("host", "empty host")
     if not allow_remote and not is_loopback(text):
-        raise InvalidParameter("--host", f"{text!r} is not a loopback address; the lab has no login, so it listens "
-                                         "only on this machine (127.0.0.1, ::1, localhost) unless --allow-remote "
+        raise InvalidParameter("host", f"{text!r} is not a loopback address; the lab has no login, so it listens "
+                                         "only on this machine (127.0.0.1, ::1, localhost) unless `allow_remote` "
                                          "is given")
     return text
 
@@ -169,7 +169,7 @@ def check_port(port: int) -> int:
     8050
     """
     if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
-        raise InvalidParameter("--port", f"{port!r} is outside [0, 65535]")
+        raise InvalidParameter("port", f"{port!r} is outside [0, 65535]")
     return port
 
 
@@ -252,7 +252,7 @@ def listen(host: str, port: int) -> socket.socket:
         sock.listen(64)
     except OSError as error:
         sock.close()
-        raise InvalidParameter("--port", f"cannot listen on {host}:{port}: {error.strerror or error}") from None
+        raise InvalidParameter("port", f"cannot listen on {host}:{port}: {error.strerror or error}") from None
     return sock
 
 

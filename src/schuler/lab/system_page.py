@@ -24,7 +24,7 @@ from dash import ALL, Dash, Input, Output, State, dcc, html, no_update
 from dash.exceptions import PreventUpdate
 
 from schuler.contract import RUN_OPTIONS, System
-from schuler.exceptions import SchulerError
+from schuler.exceptions import SchulerError, as_options
 from schuler.lab import views
 from schuler.lab.controls import ERROR, PARAM, Names, controls, error_owner, parse_typed, typed_values
 from schuler.lab.figures import GRAPH, block, empty, file_figures, interactive_figures, interactive_stems
@@ -42,7 +42,8 @@ ACTION_PAGES = {"align": {"compare": "Every self-alignment method on the same da
 """System name -> its actions that have a page of their own (``/NAME/ACTION``) and the link's text."""
 
 
-OFFERED_NAMES = {"aided": {"imu": ("schuler.imu.spec", "GRADES", False),
+OFFERED_NAMES = {"aided": {"trajectory": ("schuler.navigate.evaluation", "TRAJECTORIES", False),
+                           "imu": ("schuler.imu.spec", "GRADES", False),
                            "aiding": ("schuler.aided.evaluation", "AIDING", True)}}
 """System name -> its text parameters whose controls offer names: (module, attribute holding the names the
 parameter takes, whether it takes several). The names are read from where the parameter checks them, so that a
@@ -327,7 +328,7 @@ def register(app: Dash) -> None:
         try:
             archive = files_archive(system, run_typed(system, typed_values(page_parameters(system), ids, values)))
         except SchulerError as error:
-            return no_update, str(error)
+            return no_update, as_options(str(error))
         return dcc.send_bytes(archive, f"{name}_lab.zip"), ""
 
     @app.callback(

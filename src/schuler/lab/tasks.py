@@ -26,7 +26,7 @@ from dash import ALL, MATCH, ClientsideFunction, Dash, Input, Output, State, dcc
 from dash.exceptions import PreventUpdate
 
 from schuler.contract import System
-from schuler.exceptions import SchulerError
+from schuler.exceptions import SchulerError, as_options
 from schuler.gyrocompassing.results import case_runs
 from schuler.gyrocompassing.simulation import MAX_BETA, MAX_DELTA, MAX_DELTA_RATE
 from schuler.lab import figures, manual, views
@@ -456,7 +456,7 @@ def register(app: Dash) -> None:
             view = compute(get_system("align"), page, wanted["case"], wanted["sweep"],
                            progress=lambda done, total: set_progress((done, total)))
         except SchulerError as error:
-            return no_update, no_update, str(error), no_update
+            return no_update, no_update, as_options(str(error)), no_update
         except Exception as error:  # a bug must not leave the page waiting: say it in one line
             return no_update, no_update, internal_error(error), no_update
         notes = [html.P(n, className="violated" if " is violated " in n else "warning") for n in view.notes]

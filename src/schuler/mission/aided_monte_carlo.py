@@ -16,7 +16,11 @@ member, epoch), the outages removed). It starts where its alignment left it
 (position and attitude errors of its draws, velocity error zero) and runs
 :func:`schuler.aided.ekf.run_filter` with the filter model of the covariance
 analysis (:func:`schuler.mission.aiding.filter_model`) and its initial
-1-sigma, batched over the members; the errors and each outage's drift are
+1-sigma, batched over the members, on the drive with the zero-velocity updates
+at its stops and its odometer and constraint as ``schuler aided``'s sources
+(:func:`schuler.mission.aiding_measurements.filter_sources`: the epochs of the
+covariance analysis, each member's odometer noise at the address (seed,
+``odometer``, member, epoch)); the errors and each outage's drift are
 ``schuler aided``'s (:func:`schuler.aided.analysis.errors`,
 :func:`schuler.aided.analysis.outage_drift`).
 """
@@ -27,13 +31,13 @@ import numpy as np
 
 from schuler.aided import analysis
 from schuler.aided.ekf import Start, run_filter
-from schuler.aided.evaluation import _member
 from schuler.aided.gnss import gnss_measurements, gnss_truth
 from schuler.core.attitude import dcm_from_quaternion, quaternion_from_rotation_vector, quaternion_multiply
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.core.random import RandomStreams
 from schuler.exceptions import InvalidParameter
 from schuler.mission.aiding import attitude_from_psi, filter_model
+from schuler.mission.aiding_measurements import filter_sources
 from schuler.mission.monte_carlo import member_draws, sensor_errors, white_noise
 from schuler.mission.setup import MissionSetup
 from schuler.navigate.truth import ideal_imu
@@ -112,9 +116,11 @@ def aided_members(setup: MissionSetup, members, streams: RandomStreams, imu_rate
     gnss = [gnss_measurements(antenna, position_sigma=aiding.position_sigma,
                               velocity_sigma=aiding.velocity_sigma if aiding.use_velocity else None, streams=streams,
                               member=int(m), outages=aiding.outages) for m in members]
-    run = run_filter(increments, truth.interval_s, start, filter_model(setup), gnss, lever_arm=aiding.lever_arm,
+    model = filter_model(setup)
+    run = run_filter(increments, truth.interval_s, start, model, gnss, lever_arm=aiding.lever_arm,
                      covariance_interval=aiding.covariance_interval, use_velocity=aiding.use_velocity,
-                     output_every=int(round(every)), initial_sensor_sigma=start_sigma[9:], earth_rate=EARTH_RATE)
+                     output_every=int(round(every)), initial_sensor_sigma=start_sigma[9:], earth_rate=EARTH_RATE,
+                     sources=filter_sources(setup, model, members, streams, imu_rate))
     rows = np.searchsorted(truth.t_s, run.t_s - 1e-9)
     true = analysis.Truth(truth.latitude_rad[rows], truth.longitude_rad[rows], truth.height_m[rows],
                           truth.velocity_ned_m_s[rows], truth.quaternion[rows])
@@ -145,7 +151,7 @@ def member_outputs(run, errors, outages) -> dict[str, np.ndarray]:
         for kind in ("end", "max"):
             out[f"member_outage_{k}_horizontal_error_{kind}_m"] = np.zeros(count)
     for m in range(count):
-        drifts = analysis.outage_drift(_member(run, m), _member(errors, m), outages[:OUTAGE_SLOTS])
+        drifts = analysis.outage_drift(analysis.member(run, m), analysis.member(errors, m), outages[:OUTAGE_SLOTS])
         for k, drift in enumerate(drifts, start=1):
             out[f"member_outage_{k}_horizontal_error_end_m"][m] = drift.horizontal_error_end_m
             out[f"member_outage_{k}_horizontal_error_max_m"][m] = drift.horizontal_error_max_m

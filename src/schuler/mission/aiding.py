@@ -1,4 +1,4 @@
-"""Covariance analysis of an aided mission: every error source carried through the GNSS-aided filter's closed loop.
+"""Covariance analysis of an aided mission: every error source carried through the aided filter's closed loop.
 
 The filter is ``schuler aided``'s error-state filter (spec 07;
 :mod:`schuler.aided.error_state`, 21 states: position, velocity and attitude
@@ -15,20 +15,25 @@ velocity random walks white. The analysis has two passes.
    and the exact transition and process noise of Van Loan 1978
    (:func:`schuler.aided.error_state.transition`'s discretisation):
    Phi_k = e^(F Delta), Q_k = int_0^Delta e^(F s) G Q_c G^T e^(F^T s) ds.
-   At a fix (epochs j / ``gnss_rate`` outside the outages, on the step grid)
-   with H of :mod:`schuler.aided.measurements` (lever arm included) and
-   R = diag(sigma^2), K = P_f H^T (H P_f H^T + R)^-1 (spec 07; Groves 2013,
-   Sec. 3.2). The filter starts from the diagonal of the true initial
-   covariance (what ``schuler aided``'s ``Start`` accepts).
+   At the end of a step where measurements fall (GNSS fixes at j / ``gnss_rate``
+   outside the outages; on the drive zero-velocity updates inside its stops,
+   odometer and non-holonomic constraint: every epoch on the step grid,
+   :mod:`schuler.mission.aiding_measurements`) they are one stacked update,
+   H the blocks' rows of :mod:`schuler.aided.measurements` (lever arms
+   included) and R = blockdiag(R_b), K = P_f H^T (H P_f H^T + R)^-1 (spec 07;
+   Groves 2013, Sec. 3.2). The filter starts from the diagonal of the true
+   initial covariance (what ``schuler aided``'s ``Start`` accepts).
 
 2. **Sources through the closed loop.** Each independent source i (every
    constant source of :mod:`schuler.mission.setup`, the two random walks,
-   the GNSS noises) has its own initial covariance P_i(0), process noise
-   Q_i,k and measurement noise R_i (one of them non-zero), and is
-   propagated with the nominal gains (Joseph form, valid for any gain):
+   each measurement's noise: ``gnss_position_noise``, ``gnss_velocity_noise``,
+   ``zupt_noise``, ``odometer_noise``, ``nhc_noise``) has its own initial
+   covariance P_i(0), process noise Q_i,k and measurement noise R_i (one of
+   them non-zero; a measurement's R_i is its block R_b, zero elsewhere), and
+   is propagated with the nominal gains (Joseph form, valid for any gain):
 
        P_i <- Phi_k P_i Phi_k^T + Q_i,k,
-       P_i <- (I - K H) P_i (I - K H)^T + K R_i K^T   (at a fix).
+       P_i <- (I - K H) P_i (I - K H)^T + K R_i K^T   (at an update).
 
    A constant source j of 1-sigma sigma_j has P_j(0) = x_j x_j^T with x_j its
    state: its own bias or scale-factor state sigma_j and the position and
@@ -45,7 +50,7 @@ velocity random walks white. The analysis has two passes.
 
 Outputs are those of :mod:`schuler.mission.covariance` on the filter's states:
 position north and east, velocity north and east (the filter's velocity
-error) and heading error -phi_D, at every covariance step before its fix. An
+error) and heading error -phi_D, at every covariance step before its update. An
 outage's end is ``schuler aided``'s (:func:`schuler.aided.analysis.outage_drift`):
 the last covariance step before the epoch that ends it.
 
@@ -67,7 +72,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from schuler.aided import measurements
 from schuler.aided.error_state import (
     ACCEL_BIAS,
     ACCEL_SCALE,
@@ -80,11 +84,11 @@ from schuler.aided.error_state import (
     noise_input,
     system_matrix,
 )
-from schuler.aided.gnss import in_outages
 from schuler.core.attitude import dcm_from_quaternion
 from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.core.propagation import discretise_noise
 from schuler.exceptions import InvalidParameter
+from schuler.mission.aiding_measurements import MeasurementBlock, measurement_blocks
 from schuler.mission.coefficients import step_coefficients
 from schuler.mission.covariance import OUTPUT_CHANNELS, CovarianceBudget
 from schuler.mission.setup import AXES, CONSTANT_SOURCES, SOURCES, WHITE_SOURCES, Aiding, MissionSetup
@@ -184,7 +188,8 @@ class AidedBudget:
     ----------
     budget : CovarianceBudget
         Every source's variance of every output channel at every covariance step, SI^2 (sources:
-        :data:`~schuler.mission.setup.SOURCES` then the aiding's GNSS sources).
+        :data:`~schuler.mission.setup.SOURCES` then the aiding's measurement-noise sources,
+        :attr:`~schuler.mission.setup.Aiding.sources`).
     outages : list of dict
         Per outage: ``start_s``, ``duration_s`` (s), ``end_index`` (the step of its end) and
         ``horizontal_error_sigma_m`` (m) and ``shares`` ({source: fraction of the north + east variance}).
@@ -201,8 +206,8 @@ class AidedBudget:
     start_sigma: np.ndarray
 
 
-def _grid(setup: MissionSetup, aiding: Aiding) -> tuple[int, np.ndarray]:
-    """Number of covariance steps and the step index of each fix (epochs outside the outages)."""
+def _steps(setup: MissionSetup, aiding: Aiding) -> int:
+    """Number of covariance steps of the mission, refused unless whole and at most :data:`MAX_STEPS`."""
     step = aiding.covariance_interval
     steps = setup.duration / step
     if abs(steps - round(steps)) > 1e-9 * steps:
@@ -210,14 +215,37 @@ def _grid(setup: MissionSetup, aiding: Aiding) -> tuple[int, np.ndarray]:
                                                       f"covariance steps of {step:g} s")
     if round(steps) > MAX_STEPS:
         raise InvalidParameter("covariance_interval", f"{round(steps)} steps exceed {MAX_STEPS}: use a longer one")
-    per_epoch = 1.0 / (aiding.gnss_rate * step)
-    if abs(per_epoch - round(per_epoch)) > 1e-9 or round(per_epoch) < 1:
-        raise InvalidParameter("gnss_rate", f"the GNSS interval {1.0 / aiding.gnss_rate:g} s must be a whole number "
-                                            f"of covariance steps of {step:g} s")
-    every = int(round(per_epoch))
-    fixes = np.arange(every, int(round(steps)) + 1, every)
-    fixes = fixes[~in_outages(fixes * step, aiding.outages)]
-    return int(round(steps)), fixes
+    return int(round(steps))
+
+
+@dataclass(frozen=True)
+class _Update:
+    """The measurements due at the end of one covariance step, stacked: H (m, 21), R (m, m), and each block's rows
+    and noise source (its index in the stack of sources, its R)."""
+
+    H: np.ndarray
+    R: np.ndarray
+    parts: list[tuple[int, slice, np.ndarray]]
+
+
+def _updates(blocks: list[MeasurementBlock], source_index: dict[str, int]) -> dict[int, _Update]:
+    """The stacked update of every step at whose end a measurement falls, the blocks in their order."""
+    due: dict[int, list[tuple[MeasurementBlock, int]]] = {}
+    for block in blocks:
+        for row, step in enumerate(block.steps):
+            due.setdefault(int(step), []).append((block, row))
+    out = {}
+    for step, rows in due.items():
+        H = np.concatenate([block.H[row] for block, row in rows])
+        R = np.zeros((H.shape[0], H.shape[0]))
+        parts, first = [], 0
+        for block, _ in rows:
+            m = block.R.shape[0]
+            R[first:first + m, first:first + m] = block.R
+            parts.append((source_index[block.source], slice(first, first + m), block.R))
+            first += m
+        out[step] = _Update(H, R, parts)
+    return out
 
 
 def aided_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> AidedBudget:
@@ -242,7 +270,7 @@ def aided_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> AidedBu
     unknown = set(disabled) - set(sources)
     if unknown:
         raise InvalidParameter("disabled", f"unknown sources {sorted(unknown)}; choose from {', '.join(sources)}")
-    steps, fixes = _grid(setup, aiding)
+    steps = _steps(setup, aiding)
     dt = aiding.covariance_interval
     trajectory = setup.trajectory()
     coefficients = step_coefficients(trajectory, setup.latitude, setup.height, steps * dt, dt)
@@ -268,14 +296,11 @@ def aided_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> AidedBu
     P[1:] *= on[:, None, None]
     true_initial = P[1:].sum(axis=0)
 
-    H, R_parts = _measurements(setup, aiding, coefficients, trajectory, fixes, dt)
-    noise_index = [1 + sources.index(name) for name in aiding.sources]
-    is_fix = np.zeros(steps + 1, dtype=bool)
-    is_fix[fixes] = True
+    updates = _updates(measurement_blocks(setup, model, coefficients, steps),
+                       {name: 1 + i for i, name in enumerate(sources)})
     stored = np.empty((steps + 1, P.shape[0], 9, 9))
     stored[0] = P[:, :9, :9]
     gyro, accel = white["gyro_random_walk"], white["accel_random_walk"]
-    fix = 0
     identity = np.eye(STATES)
     for k in range(steps):
         P = Phi[k] @ P @ Phi[k].T
@@ -283,45 +308,21 @@ def aided_budget(setup: MissionSetup, disabled: tuple[str, ...] = ()) -> AidedBu
         P[gyro] += on[gyro - 1] * Q_gyro[k]
         P[accel] += on[accel - 1] * Q_accel[k]
         stored[k + 1] = P[:, :9, :9]
-        if is_fix[k + 1]:
-            Hk = H[fix]
-            R = sum(R_parts)
-            PHt = P[0] @ Hk.T
-            gain = np.linalg.solve(Hk @ PHt + R, PHt.T).T
-            A = identity - gain @ Hk
+        update = updates.get(k + 1)
+        if update is not None:
+            PHt = P[0] @ update.H.T
+            gain = np.linalg.solve(update.H @ PHt + update.R, PHt.T).T
+            A = identity - gain @ update.H
             P = A @ P @ A.T
-            P[0] += gain @ R @ gain.T
-            for index, part in zip(noise_index, R_parts):
-                P[index] += on[index - 1] * (gain @ part @ gain.T)
-            fix += 1
+            P[0] += gain @ update.R @ gain.T
+            for index, rows, R in update.parts:
+                P[index] += on[index - 1] * (gain[:, rows] @ R @ gain[:, rows].T)
     P0 = stored[:, 0]
     variance = _channels(stored[:, 1:], coefficients)
     budget = CovarianceBudget(time=np.arange(steps + 1) * dt, sources=sources, variance=variance,
                               initial_state=np.zeros((len(sources), 9)), initial_covariance=true_initial[:9, :9],
                               states=9)
     return AidedBudget(budget, _outages(budget, aiding), np.sqrt(P0[:, 0, 0] + P0[:, 1, 1]), start_sigma)
-
-
-def _measurements(setup: MissionSetup, aiding: Aiding, coefficients, trajectory, fixes: np.ndarray,
-                  dt: float) -> tuple[np.ndarray, list[np.ndarray]]:
-    """H of every fix, (n_fixes, m, 21), and R of each GNSS source, padded to m x m."""
-    t = fixes * dt
-    velocity, quaternion = trajectory.kinematics(t)
-    before = np.maximum(fixes - 1, 0)  # the step that ends at the fix: its means stand for the solution's rates
-    solution = measurements.Solution(coefficients.latitude[before], np.zeros(t.size), coefficients.height[before],
-                                     velocity, dcm_from_quaternion(quaternion), coefficients.body_rate[before])
-    zeros = np.zeros(t.size)
-    arm = np.asarray(aiding.lever_arm, dtype=float)
-    _, H = measurements.gnss_position(solution, arm, zeros, zeros, zeros, STATES)
-    m = 6 if aiding.use_velocity else 3
-    position = np.zeros((m, m))
-    position[:3, :3] = np.diag(np.square(aiding.position_sigma))
-    if not aiding.use_velocity:
-        return H, [position]
-    _, H_velocity = measurements.gnss_velocity(solution, arm, velocity, STATES, EARTH_RATE)
-    speed = np.zeros((m, m))
-    speed[3:, 3:] = np.eye(3) * aiding.velocity_sigma**2
-    return np.concatenate([H, H_velocity], axis=1), [position, speed]
 
 
 def _channels(stored: np.ndarray, coefficients) -> dict[str, np.ndarray]:

@@ -18,13 +18,12 @@ import math
 
 import numpy as np
 
+from schuler.aided.evaluation import PARAMETERS as AIDED_PARAMETERS
 from schuler.aided.evaluation import (
-    AIDING,
     SIMULATED_OUTAGE_START,
     SIMULATED_SIGMA,
     SIMULATED_VELOCITY_SIGMA,
 )
-from schuler.aided.evaluation import PARAMETERS as AIDED_PARAMETERS
 from schuler.contract import Cases, Evaluation, Output
 from schuler.core.response import Histories
 from schuler.imu.error_model import ErrorModel
@@ -35,9 +34,10 @@ from schuler.mission.covariance import CovarianceBudget, covariance_budgets
 from schuler.mission.monte_carlo import final_horizontal_errors, run_members
 from schuler.mission.plots import BUDGET_HISTORIES
 from schuler.mission.setup import (
+    AIDING_NAMES,
+    AIDING_SOURCES,
     ALIGNMENTS,
     CALIBRATIONS,
-    GNSS_SOURCES,
     SOURCES,
     TRAJECTORIES,
     VERTICAL_CHANNELS,
@@ -56,8 +56,12 @@ _AIDED_HELP = {
        for axis, name in zip("xyz", ("forward", "right", "down"))},
     "outage_start": f"Start of the first GNSS outage, from the start of navigation (not set: "
                     f"{SIMULATED_OUTAGE_START:g} s).",
-    "covariance_interval": "Covariance step of the aided filter (the GNSS interval a whole number of them; the "
-                           "Monte Carlo's a whole number of IMU intervals).",
+    "covariance_interval": "Covariance step of the aided filter (the GNSS, zero-velocity and odometer intervals "
+                           "whole numbers of them; the Monte Carlo's a whole number of IMU intervals).",
+    "zupt_rate": "Rate of the zero-velocity updates during the drive's stops (its interval a whole number of "
+                 "covariance steps).",
+    "odometer_rate": "Rate of the odometer and of the non-holonomic constraint (its interval a whole number of "
+                     "covariance steps).",
 }
 """The help of schuler aided's options where the mission's differs (no files)."""
 
@@ -86,13 +90,14 @@ PARAMETERS = ParameterSet((
     Parameter("north_reference_error", "arcsec", 10.0,
               "1-sigma heading error of the ground gyrocompass (schuler north).",
               minimum=0, maximum=36000),
-    Parameter("trajectory", "", "cruise", "Mission: stationary, cruise (a geodesic at the speed), flight "
-              "(take-off run, two 90-deg turns) or drive (a car's: four stops, 10 m/s in town, 20 m/s on the road, "
-              "90-deg turns; its own speeds).", choices=TRAJECTORIES, kind="choice"),
+    Parameter("trajectory", "", "great-circle", "Mission: stationary, great-circle (a geodesic at the speed, as in "
+              "schuler navigate), flight (take-off run, two 90-deg turns) or drive (a car's: four stops, 10 m/s in "
+              "town, 20 m/s on the road, 90-deg turns; its own speeds).", choices=TRAJECTORIES, kind="choice",
+              renamed_choices=(("cruise", "great-circle"),)),
     Parameter("profile", "", None, "Waypoint profile FILE.toml (format: schuler.navigate.profile) flown instead of "
               "the trajectory; its [start] and first heading set the start point and heading.", kind="text"),
     Parameter("duration", "s", 7200.0, "Mission duration (after the alignment).", minimum=60, maximum=10 * 86400),
-    Parameter("speed", "m/s", 250.0, "Ground speed of cruise and flight.", minimum=0, maximum=1000),
+    Parameter("speed", "m/s", 250.0, "Ground speed of the great circle and the flight.", minimum=0, maximum=1000),
     Parameter("heading", "deg", 30.0, "Heading at the start.", minimum=-360, maximum=360),
     Parameter("vertical_channel", "", "off", "Vertical channel: off (height held, as by an altimeter) or free.",
               choices=VERTICAL_CHANNELS, kind="choice"),
@@ -102,13 +107,15 @@ PARAMETERS = ParameterSet((
               minimum=0, maximum=1e5),
     Parameter("imu_rate", "Hz", 2.0, "IMU rate of the Monte Carlo's nonlinear INS (reduced: exact for the "
               "noise, ample for the smooth trajectories).", minimum=0.1, maximum=1000),
-    Parameter("aiding", "", None, "Aiding after the alignment, comma-separated: " + ", ".join(AIDING) + " (not set: "
-              "free-inertial; the filter and GNSS of schuler aided, the vertical channel aided by the GNSS height).",
+    Parameter("aiding", "", None, "Aiding after the alignment, comma-separated: " + ", ".join(AIDING_NAMES)
+              + " (not set: free-inertial; the filter, GNSS, stops and wheels of schuler aided, the vertical channel "
+              "aided by the GNSS height; gnss-position needed; zupt, odometer and nhc on the drive only).",
               kind="text"),
     *(dataclasses.replace(AIDED_PARAMETERS[name], help=_AIDED_HELP.get(name, AIDED_PARAMETERS[name].help))
       for name in ("gnss_rate", "gnss_sigma_north", "gnss_sigma_east", "gnss_sigma_down", "gnss_velocity_sigma",
                    "lever_arm_x", "lever_arm_y", "lever_arm_z", "outage_start", "outage_duration", "outage_every",
-                   "outages", "covariance_interval")),
+                   "outages", "covariance_interval", "zupt_rate", "zupt_sigma", "odometer_rate", "odometer_sigma",
+                   "nhc_sigma", "wheel_lever_arm_x", "wheel_lever_arm_y", "wheel_lever_arm_z")),
 ), owner="mission", exclusive=(*(("profile", name) for name in ("trajectory", "latitude", "longitude", "height",
                                                                 "heading", "speed")),
                                *(("outages", name) for name in ("outage_start", "outage_duration", "outage_every"))),
@@ -216,7 +223,7 @@ def _in_full(budget: CovarianceBudget, model: ErrorModel, aided: AidedBudget | N
     return {BUDGET_HISTORIES: budget_histories(budget)}, extras
 
 
-EXTRA_UNITS = {"budget": "1", **{name: "1" for name in SOURCES + GNSS_SOURCES}, "outages": "1", "start_s": "s",
+EXTRA_UNITS = {"budget": "1", **{name: "1" for name in SOURCES + AIDING_SOURCES}, "outages": "1", "start_s": "s",
                "duration_s": "s", "horizontal_error_sigma_m": "m", "shares": "1"}
 """Units of the extras (the budget's keys are source names whose values are shares; the map is flat by key)."""
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from schuler.contract import FigureRef, ReportSection
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
-from schuler.gyrocompassing.analytic import gains_from_design
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT, loop_gains
 from schuler.io import save_figure_formats
 from schuler.mission import plots
 from schuler.mission.covariance import covariance_budget
@@ -66,7 +66,7 @@ def reproduce() -> Reproduction:
         note="heading error = -psi_D, drift = -bias; the tan(L) psi_N term is zero without accelerometer errors"))
     physical = _setup(latitude=latitude, heading=0.0, trajectory="stationary", alignment="gyrocompass")
     x0 = initial_state_map(physical, np.eye(3), 7)
-    c_gamma, c_a = gains_from_design(30.0, 0.8, latitude)
+    c_gamma, c_a = loop_gains(latitude, DESIGN_TIME_CONSTANT, DESIGN_DAMPING)
     rows.append(compare(
         "physical gyrocompass azimuth error from a 0.01 deg/h east drift, 50 deg, T = 30 s",
         to_unit(x0[index, -1] * -EXAMPLE_DRIFT, "arcmin"), "arcmin", printed="(1.21)",
@@ -78,7 +78,7 @@ def reproduce() -> Reproduction:
         "levelling tilt psi_E from a 100 ug north accelerometer bias", to_unit(tilt, "arcsec"), "arcsec",
         printed="-b_N / g", value=float(to_unit(-EXAMPLE_ACCEL / STANDARD_GRAVITY, "arcsec")),
         where="Groves (2013), Sec. 5.6.1", tolerance=Tolerance(relative=1e-9)))
-    mission = _setup(imu="tactical", trajectory="cruise", duration=7200.0)
+    mission = _setup(imu="tactical", trajectory="great-circle", duration=7200.0)
     budget = covariance_budget(mission)
     shares = budget.shares()
     rows.append(compare("sum of the shares of the final horizontal position variance", sum(shares.values()), "1",

@@ -44,14 +44,20 @@ acting during alignment and during navigation). Misalignments, g-sensitivity
 and quantization are left out of this study.
 
 4. **Aiding** (optional, ``aiding`` set): GNSS position, or position and
-   velocity, at ``gnss_rate`` through scheduled outages, with the keys and
-   names of ``schuler aided`` (:class:`Aiding`; the analysis in
-   :mod:`schuler.mission.aiding`). Its noise adds the sources
-   ``gnss_position_noise`` and ``gnss_velocity_noise``.
+   velocity, at ``gnss_rate`` through scheduled outages, and on the ``drive``
+   zero-velocity updates at its stops (``zupt``, at ``zupt_rate`` inside the
+   drive's stationary intervals) and the wheel's odometer speed and
+   non-holonomic constraint (``odometer``, ``nhc``, at ``odometer_rate``), with
+   the keys and names of ``schuler aided`` (:class:`Aiding`; the measurements
+   in :mod:`schuler.mission.aiding_measurements`, the analysis in
+   :mod:`schuler.mission.aiding`). Their noises add the sources
+   ``gnss_position_noise``, ``gnss_velocity_noise``, ``zupt_noise``,
+   ``odometer_noise`` and ``nhc_noise``.
 """
 
 from __future__ import annotations
 
+import difflib
 import math
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
@@ -59,6 +65,7 @@ from pathlib import Path
 
 import numpy as np
 
+from schuler.aided.aiding import named
 from schuler.aided.evaluation import SIMULATED_SIGMA, SIMULATED_VELOCITY_SIGMA, aiding_of, lever_arm, outages_of
 from schuler.core.earth import STANDARD_GRAVITY
 from schuler.exceptions import InvalidParameter
@@ -73,7 +80,7 @@ CALIBRATIONS = ("pulse", "multi-position")
 ALIGNMENTS = ("kalman", "strapdown-gyrocompass", "gyrocompass", "ground-gyrocompass")
 SELF_ALIGNMENTS = ("kalman", "strapdown-gyrocompass")
 """Strapdown self-alignments at rest: to first order, the same residuals (:mod:`schuler.mission.stages`)."""
-TRAJECTORIES = ("stationary", "cruise", "flight", "drive")
+TRAJECTORIES = ("stationary", "great-circle", "flight", "drive")
 VERTICAL_CHANNELS = ("off", "free")
 
 AXES = ("x", "y", "z")
@@ -89,7 +96,16 @@ SOURCES = CONSTANT_SOURCES + WHITE_SOURCES
 """Every source of the budget."""
 
 GNSS_SOURCES = ("gnss_position_noise", "gnss_velocity_noise")
-"""White measurement-noise sources of an aided mission (GNSS position, GNSS velocity)."""
+"""White measurement-noise sources of GNSS (position, velocity)."""
+VEHICLE_SOURCES = ("zupt_noise", "odometer_noise", "nhc_noise")
+"""White measurement-noise sources of a drive's zero-velocity updates, odometer and non-holonomic constraint."""
+AIDING_SOURCES = GNSS_SOURCES + VEHICLE_SOURCES
+"""Every measurement-noise source an aided mission may add to the budget."""
+
+AIDING_NAMES = ("gnss-position", "gnss-velocity", "zupt", "odometer", "nhc")
+"""The measurements a mission's ``aiding`` may name (``schuler aided``'s names)."""
+DRIVE_AIDING = ("zupt", "odometer", "nhc")
+"""The measurements only the ``drive`` has: its stops and its wheels."""
 
 FLIGHT_ACCELERATION_TIME = 300.0
 """Take-off run of the ``flight`` profile: 0 to cruise speed, s."""
@@ -99,7 +115,8 @@ FLIGHT_TURN_TIME = 120.0
 
 @dataclass(frozen=True)
 class Aiding:
-    """The aiding of a mission: GNSS fixes through outages, as ``schuler aided`` simulates them (SI).
+    """The aiding of a mission: GNSS fixes through outages and a drive's stops and wheels, as ``schuler aided``
+    simulates them (SI).
 
     Parameters
     ----------
@@ -117,6 +134,20 @@ class Aiding:
         (start, duration) of each outage, s from the start of navigation.
     covariance_interval : float
         Step of the filter's covariance propagation, s.
+    vehicle : tuple of str
+        The drive's measurements used, in the order of :data:`DRIVE_AIDING` (``zupt``, ``odometer``, ``nhc``).
+    zupt_rate : float
+        Rate of the zero-velocity updates inside a stop, Hz.
+    zupt_sigma : float
+        1-sigma of the velocity at a stop, each axis, m/s.
+    odometer_rate : float
+        Rate of the odometer and of the non-holonomic constraint, Hz.
+    odometer_sigma : float
+        1-sigma of the odometer's speed, m/s.
+    nhc_sigma : float
+        1-sigma of the wheel point's lateral and vertical velocities, m/s.
+    wheel_lever_arm : tuple of float
+        IMU to the wheel's contact point, body axes, m.
     """
 
     use_velocity: bool
@@ -126,11 +157,19 @@ class Aiding:
     lever_arm: tuple[float, float, float]
     outages: tuple[tuple[float, float], ...]
     covariance_interval: float
+    vehicle: tuple[str, ...]
+    zupt_rate: float
+    zupt_sigma: float
+    odometer_rate: float
+    odometer_sigma: float
+    nhc_sigma: float
+    wheel_lever_arm: tuple[float, float, float]
 
     @property
     def sources(self) -> tuple[str, ...]:
-        """The measurement-noise sources this aiding adds to the budget."""
-        return GNSS_SOURCES if self.use_velocity else GNSS_SOURCES[:1]
+        """The measurement-noise sources this aiding adds to the budget, in the order of :data:`AIDING_SOURCES`."""
+        gnss = GNSS_SOURCES if self.use_velocity else GNSS_SOURCES[:1]
+        return gnss + tuple(f"{name}_noise" for name in DRIVE_AIDING if name in self.vehicle)
 
 
 def aiding_setup(values) -> Aiding | None:
@@ -139,24 +178,39 @@ def aiding_setup(values) -> Aiding | None:
     The defaults are ``schuler aided``'s: GNSS 1-sigma
     :data:`~schuler.aided.evaluation.SIMULATED_SIGMA` and
     :data:`~schuler.aided.evaluation.SIMULATED_VELOCITY_SIGMA`, the first outage at
-    :data:`~schuler.aided.evaluation.SIMULATED_OUTAGE_START`, the lever arm zero.
+    :data:`~schuler.aided.evaluation.SIMULATED_OUTAGE_START`, the lever arms zero, and the stops' and wheel's
+    rates and 1-sigma of :data:`schuler.aided.aiding.PARAMETERS`.
 
     Parameters
     ----------
     values : Mapping of str to object
-        ``aiding`` (comma-separated names of :data:`~schuler.aided.evaluation.AIDING`, or None), ``gnss_rate``
+        ``aiding`` (comma-separated names of :data:`AIDING_NAMES`, or None), ``gnss_rate``
         (Hz), ``gnss_sigma_north|east|down`` (m or None), ``gnss_velocity_sigma`` (m/s or None),
         ``lever_arm_x|y|z`` (m or None), ``outage_start``, ``outage_duration``, ``outage_every``, ``duration`` and
-        ``covariance_interval`` (s).
+        ``covariance_interval`` (s), ``zupt_rate`` and ``odometer_rate`` (Hz), ``zupt_sigma``, ``odometer_sigma``
+        and ``nhc_sigma`` (m/s), ``wheel_lever_arm_x|y|z`` (m).
 
     Returns
     -------
     Aiding or None
         The aiding, SI.
+
+    Raises
+    ------
+    InvalidParameter
+        ``aiding`` names a measurement the mission does not have (``zaru`` and ``baro`` are ``schuler aided``'s
+        only), or lacks ``gnss-position``.
     """
     if values["aiding"] is None:
         return None
+    for name in (part.strip() for part in str(values["aiding"]).split(",")):
+        if name and name not in AIDING_NAMES:
+            hint = difflib.get_close_matches(name, AIDING_NAMES, n=1)
+            raise InvalidParameter("aiding", f"{name!r} is not a measurement of a mission"
+                                   + (f"; did you mean {hint[0]!r}?" if hint else "")
+                                   + f" choose from {', '.join(AIDING_NAMES)}")
     _, use_velocity = aiding_of(values["aiding"])
+    vehicle = tuple(name for name in DRIVE_AIDING if name in named(values["aiding"]))
     sigma = tuple(float(fallback if values[name] is None else values[name]) for name, fallback in
                   zip(("gnss_sigma_north", "gnss_sigma_east", "gnss_sigma_down"), SIMULATED_SIGMA))
     velocity_sigma = SIMULATED_VELOCITY_SIGMA if values["gnss_velocity_sigma"] is None \
@@ -164,7 +218,12 @@ def aiding_setup(values) -> Aiding | None:
     return Aiding(use_velocity=use_velocity, gnss_rate=float(values["gnss_rate"]),
                   position_sigma=sigma,  # type: ignore[arg-type]
                   velocity_sigma=velocity_sigma, lever_arm=lever_arm(values), outages=outages_of(values),
-                  covariance_interval=float(values["covariance_interval"]))
+                  covariance_interval=float(values["covariance_interval"]), vehicle=vehicle,
+                  zupt_rate=float(values["zupt_rate"]), zupt_sigma=float(values["zupt_sigma"]),
+                  odometer_rate=float(values["odometer_rate"]), odometer_sigma=float(values["odometer_sigma"]),
+                  nhc_sigma=float(values["nhc_sigma"]),
+                  wheel_lever_arm=tuple(float(values[f"wheel_lever_arm_{axis}"])  # type: ignore[arg-type]
+                                        for axis in AXES))
 
 
 @dataclass(frozen=True)
@@ -203,7 +262,7 @@ class MissionSetup:
     def trajectory(self):
         """The vehicle's trajectory (:mod:`schuler.navigate.trajectory`).
 
-        ``stationary``: at rest, level, at the heading. ``cruise``: a geodesic at
+        ``stationary``: at rest, level, at the heading. ``great-circle``: a geodesic at
         the speed and height from the start. ``flight``: at rest at t = 0, a
         take-off run to the speed over 300 s, a 90-deg right turn at 35 % and a
         90-deg left turn at 70 % of the mission (120 s each), level at the height.
@@ -217,7 +276,7 @@ class MissionSetup:
         if self.trajectory_kind == "stationary":
             return Stationary(latitude=self.latitude, longitude=self.longitude, height=self.height,
                               heading=self.heading)
-        if self.trajectory_kind == "cruise":
+        if self.trajectory_kind == "great-circle":
             return GreatCircle(latitude=self.latitude, longitude=self.longitude, height=self.height,
                                heading=self.heading, speed=self.speed, duration=self.duration)
         if self.trajectory_kind == "drive":
@@ -345,6 +404,12 @@ def mission_setup(values, model: ErrorModel | None = None) -> MissionSetup:
     -------
     MissionSetup
         The resolved mission: error model, stage choices, start point and trajectory.
+
+    Raises
+    ------
+    InvalidParameter
+        Bad aiding (:func:`aiding_setup`), or ``zupt``, ``odometer`` or ``nhc`` on a trajectory other than the
+        drive (named ``aiding``).
     """
     if values["profile"]:
         profile = _profile(values["profile"])
@@ -355,6 +420,10 @@ def mission_setup(values, model: ErrorModel | None = None) -> MissionSetup:
         profile = None
         start = {name: float(values[name]) for name in ("latitude", "longitude", "height", "heading")}
         kind = str(values["trajectory"])
+    aiding = aiding_setup(values)
+    if aiding is not None and aiding.vehicle and kind != "drive":
+        raise InvalidParameter("aiding", f"{', '.join(aiding.vehicle)}: on the drive trajectory only (its stops "
+                                         f"and wheels), not on a {kind} trajectory")
     return MissionSetup(
         error_model=model if model is not None else error_model(values["imu"]),
         calibration=str(values["calibration"]), calibration_duration=float(values["calibration_duration"]),
@@ -366,7 +435,7 @@ def mission_setup(values, model: ErrorModel | None = None) -> MissionSetup:
         duration=float(values["duration"]), speed=float(values["speed"]),
         vertical_channel=str(values["vertical_channel"]), output_step=float(values["output_step"]),
         initial_position_error=float(values["initial_position_error"]), trajectory_kind=kind, profile=profile,
-        aiding=aiding_setup(values), **start,
+        aiding=aiding, **start,
     )
 
 

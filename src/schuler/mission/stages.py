@@ -71,8 +71,9 @@ import numpy as np
 from scipy.linalg import solve_continuous_lyapunov
 
 from schuler.core.earth import EARTH_RATE, earth_rate_ned, radii_of_curvature
+from schuler.core.gyrocompass_design import loop_gains
 from schuler.exceptions import InvalidParameter
-from schuler.gyrocompassing.analytic import gains_from_design, settling_time, steady_state
+from schuler.gyrocompassing.analytic import settling_time, steady_state
 from schuler.gyrocompassing.models import simplified_model
 from schuler.mission.setup import AXES, CONSTANT_SOURCES, SELF_ALIGNMENTS, MissionSetup
 
@@ -132,7 +133,7 @@ def gyrocompass_gains(setup: MissionSetup) -> tuple[float, float]:
     c_gamma, c_a : float
         The loop's correction gains, 1/s.
     """
-    c_gamma, c_a = gains_from_design(setup.gyrocompass_time_constant, setup.gyrocompass_damping, setup.latitude)
+    c_gamma, c_a = loop_gains(setup.latitude, setup.gyrocompass_time_constant, setup.gyrocompass_damping)
     return float(c_gamma), float(c_a)
 
 

@@ -30,9 +30,9 @@ Sec. 2: control law (1.6), models (1.17)-(1.19), steady state (1.21), transient 
 
 Examples
 --------
->>> from schuler.gyrocompassing.analytic import gains_from_design
->>> c_gamma, c_a = gains_from_design(30.0, 0.8, np.radians(50.0))
->>> run = gyrocompass_alignment(np.radians(50.0), 0.0, float(c_gamma), float(c_a), duration=1200.0,
+>>> from schuler.core.gyrocompass_design import loop_gains
+>>> c_gamma, c_a = loop_gains(np.radians(50.0), 30.0, 0.8)
+>>> run = gyrocompass_alignment(np.radians(50.0), 0.0, c_gamma, c_a, duration=1200.0,
 ...                             initial_azimuth_error=np.radians(1.0))
 >>> bool(abs(run.azimuth_error_rad[-1]) < 1e-5)
 True
@@ -48,11 +48,11 @@ from scipy.spatial.transform import Rotation
 
 from schuler.core.attitude import dcm_from_quaternion, quaternion_from_rotation_vector, wrap_angle
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY
+from schuler.core.gyrocompass_design import DESIGN_DAMPING, DESIGN_TIME_CONSTANT, loop_gains
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
 from schuler.gyrocompassing.analytic import (
     band_settling_time,
-    gains_from_design,
     settling_time,
     steady_state,
 )
@@ -278,7 +278,8 @@ def _first(initial, departure) -> float | None:
 
 
 def kpi_gyrocompassing(initial_azimuth_errors=None, *, latitude: float = KYIV_LATITUDE, azimuth: float = 0.0,
-                       time_constant: float = 30.0, damping: float = 0.8, drift_east: float = np.radians(0.01) / 3600,
+                       time_constant: float = DESIGN_TIME_CONSTANT, damping: float = DESIGN_DAMPING,
+                       drift_east: float = np.radians(0.01) / 3600,
                        drift_up: float = 0.0, latitude_error: float = 0.0, accel_error_x: float = 0.0,
                        accel_error_y: float = 0.0, initial_beta: float = 0.0, initial_alpha: float = 0.0,
                        duration: float = 2400.0, time_step: float = 0.1) -> GyrocompassingComparison:
@@ -312,7 +313,7 @@ def kpi_gyrocompassing(initial_azimuth_errors=None, *, latitude: float = KYIV_LA
     """
     delta0 = (np.geomspace(np.radians(1.0 / 60.0), 0.4, 12) if initial_azimuth_errors is None
               else np.atleast_1d(np.asarray(initial_azimuth_errors, dtype=float)))
-    c_gamma, c_a = (float(x) for x in gains_from_design(time_constant, damping, latitude))
+    c_gamma, c_a = loop_gains(latitude, time_constant, damping)
     drift_x = drift_east * np.cos(azimuth)
     drift_y = drift_east * np.sin(azimuth)
     run = gyrocompass_alignment(latitude, azimuth, c_gamma, c_a, duration=duration, time_step=time_step,

@@ -73,10 +73,6 @@ class GroundVehicleProfile(WaypointProfile):
         velocity = np.stack([horizontal * np.cos(psi), horizontal * np.sin(psi), -speed * np.sin(gamma)], axis=-1)
         return velocity, quaternion_from_euler(np.zeros_like(psi), gamma, psi)
 
-    def stationary_intervals(self) -> list[tuple[float, float]]:
-        """The (start, end) times of the stops, s: consecutive waypoints both at speed zero."""
-        still = (self.speeds[:-1] == 0.0) & (self.speeds[1:] == 0.0)
-        return [(float(self.times[k]), float(self.times[k + 1])) for k in np.flatnonzero(still)]
 
 
 def _positive(name: str, value: float, largest: float) -> float:

@@ -63,7 +63,7 @@ from schuler.navigate.mechanization import (
 from schuler.navigate.profile import load_profile
 from schuler.navigate.recording import RECORD_SUFFIXES, is_recording, replay
 from schuler.navigate.results import HISTORIES, NavigationResult
-from schuler.navigate.trajectory import GreatCircle, Stationary
+from schuler.navigate.trajectory import GreatCircle, Stationary, WaypointProfile
 from schuler.navigate.truth import DEFAULT_CHUNK, TruthGenerator
 from schuler.params import Case, Parameter, ParameterSet
 
@@ -256,27 +256,55 @@ def setup(case: Case) -> Setup:
     """
     imu = None if case["imu"] is None else case["imu"].strip()
     if imu is not None and (is_recording(imu) or Path(imu).suffix.lower() in RECORD_SUFFIXES):
-        raise InvalidParameter("imu", f"{Path(imu).name} is a recording: replay it with record (--record FILE); "
+        raise InvalidParameter("imu", f"{Path(imu).name} is a recording: replay it with record (`record` FILE); "
                                       "imu is the sensor error model, a grade or SPEC.toml")
     name = case["trajectory"].strip()
-    given = [key for key in DRIVE_OPTIONS if case[key] is not None]
-    if given and name != "drive":
-        raise InvalidParameter(given[0], "applies to the drive trajectory only")
+    _refuse_drive_options(name, case)
     if case["record"] is not None:
         if imu is not None:
             raise InvalidParameter("record", "a recording carries its own sensor errors: leave imu out")
         recording = replay(case["record"].strip(), case)
         return Setup(recording.trajectory, recording.duration, recording.imu_rate, case["output_step"],
                      case["mode"], case["vertical_channel"], None, recording.increments)
-    trajectory, duration = _trajectory(name, case)
+    trajectory, duration = trajectory_of(name, case)
     model = imu_noise.load_error_model(imu) if imu is not None else None
     imu_rate = DEFAULT_IMU_RATE if case["imu_rate"] is None else case["imu_rate"]
     return Setup(trajectory, float(duration), imu_rate, case["output_step"], case["mode"],
                  case["vertical_channel"], model)
 
 
-def _trajectory(name: str, case: Case) -> tuple[object, float]:
-    """The case's trajectory and duration (s): a named one from the start options, or a profile file."""
+def _refuse_drive_options(name: str, case) -> None:
+    given = [key for key in DRIVE_OPTIONS if case[key] is not None]
+    if given and name != "drive":
+        raise InvalidParameter(given[0], "applies to the drive trajectory only")
+
+
+def trajectory_of(name: str, case: Case) -> tuple[Stationary | GreatCircle | WaypointProfile, float]:
+    """The case's trajectory and duration: a named one of :data:`TRAJECTORIES` from the start options, or a
+    waypoint profile file.
+
+    Parameters
+    ----------
+    name : str
+        ``stationary``, ``great-circle``, ``drive`` or the path of a profile FILE.toml.
+    case : Mapping
+        The start options ``latitude``, ``longitude``, ``height``, ``heading``, ``speed``, the drive's
+        :data:`DRIVE_OPTIONS` and ``duration`` (SI; None: not set).
+
+    Returns
+    -------
+    trajectory : Stationary, GreatCircle or WaypointProfile
+        The trajectory (a drive is a :class:`~schuler.navigate.drive.GroundVehicleProfile`).
+    duration : float
+        Its simulated time, s (not set: :data:`DEFAULT_DURATION`, the drive's or the profile's own).
+
+    Raises
+    ------
+    InvalidParameter
+        An option of another trajectory; a start option beside a profile, which sets its own; a name that is
+        neither a trajectory nor a profile file.
+    """
+    _refuse_drive_options(name, case)
     duration = case["duration"]
     if name not in TRAJECTORIES:
         given = [key for key in _START if case[key] is not None]
@@ -287,8 +315,8 @@ def _trajectory(name: str, case: Case) -> tuple[object, float]:
         return profile, profile.duration if duration is None else duration
     if name != "great-circle" and case["speed"]:
         raise InvalidParameter("speed", "applies to the great-circle trajectory only (" + (
-            "stationary is at rest)" if name == "stationary" else "the drive sets its own: --city-speed, "
-            "--road-speed, --turn-speed)"))
+            "stationary is at rest)" if name == "stationary" else "the drive sets its own: `city_speed`, "
+            "`road_speed`, `turn_speed`)"))
     defaults = DRIVE_START if name == "drive" else {"latitude": DEFAULT_LATITUDE, "longitude": 0.0, "height": 0.0}
     start: dict[str, Any] = {key: defaults.get(key, 0.0) if case[key] is None else case[key]
                              for key in ("latitude", "longitude", "height", "heading")}
@@ -372,8 +400,8 @@ def bytes_per_member(shared: Setup, noisy: ErrorModel | None) -> int:
 
 
 def _refuse_monte_carlo():
-    raise InvalidParameter("monte_carlo", "--record is one member (its own sensor errors, recorded once): run it "
-                                          "without --monte-carlo")
+    raise InvalidParameter("monte_carlo", "`record` is one member (its own sensor errors, recorded once): run it "
+                                          "without `monte_carlo`")
 
 
 def runs(cases: Cases, shared: Setup) -> Iterator[tuple[np.ndarray, NavigationResult]]:
@@ -402,7 +430,7 @@ def runs(cases: Cases, shared: Setup) -> Iterator[tuple[np.ndarray, NavigationRe
     noisy = _noise_model(shared, cases)
     per_member = bytes_per_member(shared, noisy)
     fixed = estimate_memory(0, shared.output_count, DEFAULT_CHUNK, False)
-    require(fixed + per_member, "this run", "--duration or --output-step")
+    require(fixed + per_member, "this run", "`duration` or `output_step`")
     size = max(1, min(len(cases), (budget() // 4 - fixed) // per_member))
     if noisy is not None:
         size = min(size, NOISE_MEMBERS)

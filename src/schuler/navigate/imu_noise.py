@@ -283,8 +283,8 @@ class ImuNoise:
         self.interval = float(interval)
         self.true_rate = np.asarray(true_rate, dtype=float)
         self.true_specific_force = np.asarray(true_specific_force, dtype=float)
-        self._simulator = ImuSimulator(noise_model(model), self.interval, true_gyro_rad_s=self.true_rate,
-                                       true_accel_m_s2=self.true_specific_force, seed=seed,
+        self._simulator = ImuSimulator(noise_model(model), self.interval, true_gyro=self.true_rate,
+                                       true_accel=self.true_specific_force, seed=seed,
                                        workers=workers or min(4, os.cpu_count() or 1))
 
     def increments(self, members, start: int, stop: int, dt: float) -> tuple[np.ndarray, np.ndarray]:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from schuler.exceptions import renamed_keywords
 from schuler.navigate.channels import DISPLAY_UNITS, suffix
 from schuler.units import to_unit
 
@@ -75,12 +76,13 @@ def plot_errors(histories, mode: str = "strapdown", channels=None, hours: bool =
     return fig
 
 
-def plot_final_errors(horizontal_m):
+@renamed_keywords(horizontal_m="horizontal")
+def plot_final_errors(horizontal):
     """Histogram of the Monte Carlo members' final horizontal position errors (m).
 
     Parameters
     ----------
-    horizontal_m : array_like
+    horizontal : array_like
         Final horizontal position error of each member, m, shape (N,).
 
     Returns
@@ -89,7 +91,7 @@ def plot_final_errors(horizontal_m):
         The histogram, with the rms marked.
     """
     fig, axis = _figure(figsize=(WIDTH, 4.0))
-    values = np.asarray(horizontal_m, dtype=float)
+    values = np.asarray(horizontal, dtype=float)
     axis.hist(values, bins=min(60, max(10, values.size // 20)), color="C0", alpha=0.8)
     axis.axvline(float(np.sqrt(np.mean(values**2))), color="C3", ls="--", label="rms")
     axis.set_xlabel("final horizontal position error [m]")

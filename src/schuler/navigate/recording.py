@@ -120,11 +120,11 @@ def _site(record: ImuRecord, case) -> Stationary:
     name = Path(record.source).name or "the record"
     latitude = case["latitude"] if case["latitude"] is not None else record.latitude_rad
     if latitude is None:
-        raise InvalidParameter("record", f"{name} states no latitude: give --latitude (the site of the recording)")
+        raise InvalidParameter("record", f"{name} states no latitude: give `latitude` (the site of the recording)")
     attitude = record.initial_attitude_rad
     if attitude is None:
         if case["heading"] is None:
-            raise InvalidParameter("record", f"{name} states no initial attitude: give --heading (the record is then "
+            raise InvalidParameter("record", f"{name} states no initial attitude: give `heading` (the record is then "
                                           "taken as level)")
         attitude = (0.0, 0.0, case["heading"])
     roll, pitch, heading = attitude
@@ -162,14 +162,14 @@ def replay(text: str, case) -> Replay:
     """
     if case["trajectory"].strip() != "stationary":
         raise InvalidParameter("trajectory", "a recording is replayed as a static vehicle: use the stationary "
-                                             "trajectory with --record FILE")
+                                             "trajectory with `record` FILE")
     if case["speed"]:
         raise InvalidParameter("speed", "a recording is replayed as a static vehicle (at rest)")
     record = read_recording(text)
     rate = 1.0 / record.sample_interval_s
     if case["imu_rate"] is not None and not math.isclose(case["imu_rate"], rate, rel_tol=_RELATIVE):
         raise InvalidParameter("imu_rate", f"{case['imu_rate']:g} Hz differs from the recording's {rate:g} Hz; "
-                                           "leave --imu-rate out")
+                                           "leave `imu_rate` out")
     every = output_interval(case["output_step"], rate)
     step = every / rate
     if case["duration"] is None:

@@ -306,6 +306,11 @@ class WaypointProfile:
         """Time of the last waypoint, s."""
         return float(self.times[-1])
 
+    def stationary_intervals(self) -> list[tuple[float, float]]:
+        """The (start, end) times of the stops, s: consecutive waypoints both at speed zero."""
+        still = (self.speeds[:-1] == 0.0) & (self.speeds[1:] == 0.0)
+        return [(float(self.times[k]), float(self.times[k + 1])) for k in np.flatnonzero(still)]
+
     def _blend(self, values, t):
         """Value, rate and second derivative of one blended quantity at times t."""
         index = np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, max(self.times.size - 2, 0))
@@ -342,3 +347,33 @@ class WaypointProfile:
         velocity = np.stack([horizontal * np.cos(psi), horizontal * np.sin(psi), -speed * np.sin(gamma)], axis=-1)
         roll = np.arctan(horizontal * psi_rate / STANDARD_GRAVITY)
         return velocity, quaternion_from_euler(roll, gamma, psi)
+
+
+def stationary_intervals(trajectory, duration: float) -> list[tuple[float, float]]:
+    """The (start, end) times a trajectory is at rest within its first ``duration`` seconds, s.
+
+    A :class:`Stationary` one is at rest throughout, a :class:`GreatCircle` never, a :class:`WaypointProfile`
+    between consecutive waypoints at speed zero (and after its last waypoint when that one is at rest: its values
+    hold).
+
+    Parameters
+    ----------
+    trajectory : Stationary, GreatCircle or WaypointProfile
+        The trajectory.
+    duration : float
+        The time considered, s.
+
+    Examples
+    --------
+    >>> stationary_intervals(Stationary(latitude=0.5), 60.0)
+    [(0.0, 60.0)]
+    """
+    if isinstance(trajectory, Stationary):
+        return [(0.0, float(duration))]
+    if not isinstance(trajectory, WaypointProfile):
+        return []
+    intervals = trajectory.stationary_intervals()
+    if trajectory.speeds[-1] == 0.0 and duration > trajectory.duration:
+        last = intervals.pop() if intervals and intervals[-1][1] == trajectory.duration else (trajectory.duration,) * 2
+        intervals.append((last[0], float(duration)))
+    return [(start, min(end, float(duration))) for start, end in intervals if start < duration]

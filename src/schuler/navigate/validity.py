@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 
+from schuler.exceptions import renamed_keywords
 from schuler.navigate import _kernels
 
 VALID_HEIGHTS = (-1.1e4, 1.2e5)
@@ -95,17 +96,18 @@ def domain_message(states: np.ndarray, ids: np.ndarray, batch: int | None, dt: f
     return f"the run cannot be continued: {what}{hint}"
 
 
-def validity_messages(t_s: np.ndarray, computed_height_m: np.ndarray, attitude_error_rad: np.ndarray,
+@renamed_keywords(t_s="t", computed_height_m="computed_height", attitude_error_rad="attitude_error")
+def validity_messages(t: np.ndarray, computed_height: np.ndarray, attitude_error: np.ndarray,
                       ids: np.ndarray, batch: int | None, vertical_channel: str) -> list[str]:
     """What a finite run says about leaving its models' validity (empty when it stayed inside).
 
     Parameters
     ----------
-    t_s : ndarray, shape (n_out,)
+    t : ndarray, shape (n_out,)
         Output times, s.
-    computed_height_m : ndarray, shape (N, n_out)
+    computed_height : ndarray, shape (N, n_out)
         The computed height at the output times, m.
-    attitude_error_rad : ndarray, shape (N, n_out, 3)
+    attitude_error : ndarray, shape (N, n_out, 3)
         Error rotation vectors, rad.
     ids : ndarray of int, shape (N,)
         Global member numbers.
@@ -128,26 +130,26 @@ def validity_messages(t_s: np.ndarray, computed_height_m: np.ndarray, attitude_e
     """
     messages = []
     low, high = VALID_HEIGHTS
-    outside = (computed_height_m < low) | (computed_height_m > high)
+    outside = (computed_height < low) | (computed_height > high)
     if outside.any():
         members = np.flatnonzero(outside.any(axis=1))
         first = outside.argmax(axis=1)
         member = members[np.argmin(first[members])]
         k = int(first[member])
-        worst = computed_height_m[members]
+        worst = computed_height[members]
         extreme = float(worst.min() if worst.min() < low else worst.max())
         hint = _FREE_HINT if vertical_channel == "free" else ""
-        messages.append(f"the computed height left {low / 1e3:,.0f} km .. {high / 1e3:,.0f} km at t = {t_s[k]:,.6g} s"
+        messages.append(f"the computed height left {low / 1e3:,.0f} km .. {high / 1e3:,.0f} km at t = {t[k]:,.6g} s"
                         f"{_who(members, ids, batch)} and reached {extreme / 1e3:,.4g} km: outside that range WGS-84 "
                         f"normal gravity no longer models the Earth's, so later errors are the model's{hint}")
-    angle = np.linalg.norm(attitude_error_rad, axis=-1)
+    angle = np.linalg.norm(attitude_error, axis=-1)
     large = angle > SMALL_ANGLE
     if large.any():
         members = np.flatnonzero(large.any(axis=1))
         first = large.argmax(axis=1)
         member = members[np.argmin(first[members])]
         k = int(first[member])
-        messages.append(f"the attitude error passed {math.degrees(SMALL_ANGLE):.2g} deg at t = {t_s[k]:,.6g} s"
+        messages.append(f"the attitude error passed {math.degrees(SMALL_ANGLE):.2g} deg at t = {t[k]:,.6g} s"
                         f"{_who(members, ids, batch)} and reached {math.degrees(float(angle[members].max())):.3g} "
                         "deg: beyond the small angles of the linear error models (0.5 % from their first-order "
                         "terms), which this run no longer referees")

@@ -19,10 +19,12 @@ to 'The Story of 84 Minutes'", Engineering Case Library, Stanford University, 19
 
 from __future__ import annotations
 
+import sys
 import warnings
 
 import numpy as np
 
+from schuler.core.geometry import grid_points, time_grid
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
 from schuler.memory import require
@@ -34,10 +36,9 @@ from schuler.navigation_errors.effective_period import (
 )
 from schuler.navigation_errors.inputs import (
     EARTH_PARAMETERS,
+    GRID_NAMES,
     check_vertical_growth,
     earth_constants,
-    grid_points,
-    time_grid,
 )
 from schuler.navigation_errors.results import PeriodResult, VerticalChannelResult
 from schuler.navigation_errors.vertical_channel import (
@@ -203,8 +204,9 @@ def vertical(*, accel_bias_up: float, duration: float, output_step: float | None
     check_vertical_growth(duration, R, g)
     gains = loop_gains(order, time_constant, k1, k2, k3, R, g)
     step = duration / 1000.0 if output_step is None else output_step
-    require(float(grid_points(duration, step)) * VERTICAL_BYTES_PER_POINT, "this run", "--duration or --output-step")
-    t = time_grid(duration, step)
+    require(grid_points(duration, step, names=GRID_NAMES) * VERTICAL_BYTES_PER_POINT, "this run",
+            "`duration` or `output_step`")
+    t = time_grid(duration, step, names=GRID_NAMES, max_points=sys.maxsize)  # sized by require above
     unaided, aided = altitude_errors(t, gains, accel_bias_up, baro_bias, R, g)
     closed = hover_altitude_error(t, accel_bias_up, R, g)
     poles = baro_aided_model(gains, R, g).eigenvalues()

@@ -27,24 +27,25 @@ what a scenario's distributions say.
 
 from __future__ import annotations
 
+import sys
 import warnings
 
 import numpy as np
 
 from schuler.contract import Cases, Evaluation, Output
+from schuler.core.geometry import grid_points, time_grid
 from schuler.core.response import Histories
 from schuler.exceptions import InvalidParameter
 from schuler.memory import require
 from schuler.navigation_errors.inputs import (
     EARTH_PARAMETERS,
     FLIGHT_TIME,
+    GRID_NAMES,
     SOURCE_SI_UNITS,
     MagnitudeParameter,
     SourceParameters,
     earth_constant_arrays,
-    grid_points,
     magnitude_si,
-    time_grid,
 )
 from schuler.navigation_errors.results import SimulationAccuracyWarning
 from schuler.navigation_errors.single_channel import (
@@ -177,7 +178,7 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
         return _run_histories(cases, dict(out), notes)
     n = len(cases)
     batch = _batch(cases)
-    points = grid_points(batch["duration"], batch["step"])
+    points = grid_points(batch["duration"], batch["step"], names=GRID_NAMES)
     out = {output.name: np.full(n, np.nan) for output in OUTPUTS}
     for source in set(batch["source"].tolist()):
         chosen = batch["source"] == source
@@ -197,7 +198,7 @@ def evaluate(cases: Cases, histories: bool = False) -> dict[str, np.ndarray] | E
 
 def _simulate_groups(batch: dict[str, np.ndarray], points: np.ndarray, out: dict[str, np.ndarray]) -> None:
     """The simulated outputs, one simulation per distinct grid and model (errors are linear in the magnitude)."""
-    require(float(points.max()) * SIMULATION_BYTES_PER_POINT, "this run", "--duration or --output-step")
+    require(float(points.max()) * SIMULATION_BYTES_PER_POINT, "this run", "`duration` or `output_step`")
     codes = np.array([SOURCES.index(s) for s in batch["source"]], dtype=float)
     # the speed shapes only the azimuth model
     speed = np.where(codes == SOURCES.index("azimuth"), batch["speed"], 0.0)
@@ -207,7 +208,7 @@ def _simulate_groups(batch: dict[str, np.ndarray], points: np.ndarray, out: dict
     for k, (code, R, g, V, duration, step) in enumerate(unique):
         members = np.flatnonzero(inverse.ravel() == k)
         source = SOURCES[int(code)]
-        t = time_grid(duration, step)
+        t = time_grid(duration, step, names=GRID_NAMES, max_points=sys.maxsize)  # sized by require above
         simulated = simulate_error(source, 1.0, t, R, g, V)
         closed = spherical_error(source, 1.0, t, R, g, V)
         magnitude = batch["magnitude"][members]
@@ -244,9 +245,9 @@ def _run_histories(cases: Cases, out: dict[str, np.ndarray], notes: list[str]) -
     """The batch's first case in full: its outputs, the error histories (CSV ``errors_run_<source>``), extras."""
     fidelity = cases.fidelity or FIDELITIES[0]
     batch = {name: values[0] for name, values in _batch(cases).items()}
-    count = float(grid_points(batch["duration"], batch["step"]))
-    require(count * HISTORY_BYTES_PER_POINT, "this run", "--duration or --output-step")
-    t = time_grid(batch["duration"], batch["step"])
+    count = grid_points(batch["duration"], batch["step"], names=GRID_NAMES)
+    require(count * HISTORY_BYTES_PER_POINT, "this run", "`duration` or `output_step`")
+    t = time_grid(batch["duration"], batch["step"], names=GRID_NAMES, max_points=sys.maxsize)  # sized above
     source, magnitude = str(batch["source"]), float(batch["magnitude"])
     R, g, V = float(batch["radius"]), float(batch["gravity"]), float(batch["speed"])
     channels = {"flat_m": flat_error(source, magnitude, t, g, V),

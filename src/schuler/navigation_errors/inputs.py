@@ -10,8 +10,10 @@ Three things are shared by ``schuler errors run`` and its actions:
   Not set, a source takes its Problem 3 value (Bollay 1966).
 * **The Earth**: a preset of :data:`schuler.core.earth.PRESETS`, with the radius
   and gravity optionally overridden (:func:`earth_constants`).
-* **The output time grid**: 0, step, 2 step, ..., duration (a last, shorter step
-  ends on the duration), sized before it is allocated (:func:`grid_points`).
+* **The output time grid**: the core's rule (:func:`schuler.core.geometry.time_grid`:
+  0, step, 2 step, ..., duration, a last, shorter step ending on the duration),
+  sized before it is allocated (:func:`schuler.core.geometry.grid_points`) and
+  named in its messages by :data:`GRID_NAMES`.
 
 Examples
 --------
@@ -21,8 +23,6 @@ Examples
 Traceback (most recent call last):
 ...
 schuler.exceptions.InvalidParameter: magnitude: '1 ft/s' is not an angle (expected a unit like deg)
->>> time_grid(100.0, 30.0)
-array([  0.,  30.,  60.,  90., 100.])
 """
 
 from __future__ import annotations
@@ -67,8 +67,8 @@ FLIGHT_TIME = 10_120.0
 MAX_GROWTH_EXPONENT = 200.0
 """Largest sqrt(2) omega_s t of a divergent vertical channel (its error grows as exp of it: e^200 = 7e86)."""
 
-GRID_TOLERANCE = 1e-9
-"""A duration within this many steps of a whole number of steps ends on that step."""
+GRID_NAMES = ("duration", "output_step")
+"""The output grid's parameters, as the core's time grid names them in its messages."""
 
 
 def magnitude_si(source: str, value, label: str = "magnitude") -> float:
@@ -284,62 +284,3 @@ def check_vertical_growth(duration: float, radius: float, gravity: float) -> Non
         raise InvalidParameter("duration",
                                f"{duration:g} s lets the vertical error grow as exp({rate * duration:.0f}); "
                                f"at most {MAX_GROWTH_EXPONENT / rate:,.0f} s here")
-
-
-def grid_points(duration, step, names: tuple[str, str] = ("duration", "output_step")) -> np.ndarray:
-    """Number of points of :func:`time_grid` for each (duration, step), without building the grids.
-
-    Counts are floats (exact below 2^53), so that an absurd grid is sized, and
-    refused by :func:`schuler.memory.require`, rather than overflowing an integer.
-
-    Raises :class:`InvalidParameter` (naming ``names``) for a non-finite or
-    non-positive duration or step, or a step longer than the duration.
-
-    Parameters
-    ----------
-    duration : float or ndarray
-        Simulated time of each case, s.
-    step : float or ndarray
-        Output step of each case, s.
-    names : tuple of str
-        Parameter names used in error messages.
-    """
-    duration = np.asarray(duration, dtype=float)
-    step = np.asarray(step, dtype=float)
-    if not np.all(np.isfinite(duration) & (duration > 0)):
-        raise InvalidParameter(names[0], f"must be finite and > 0, got {duration[~(duration > 0)].ravel()[:1]}")
-    if not np.all(np.isfinite(step) & (step > 0)):
-        raise InvalidParameter(names[1], "must be finite and > 0")
-    longer = step > duration * (1 + GRID_TOLERANCE)
-    if np.any(longer):
-        bad = np.flatnonzero(np.ravel(longer))[0]
-        raise InvalidParameter(names[1], f"{np.ravel(step)[bad]:g} s is longer than the duration "
-                                         f"{np.ravel(np.broadcast_to(duration, step.shape))[bad]:g} s")
-    steps = duration / step
-    whole = np.round(steps)
-    on_step = np.abs(steps - whole) <= GRID_TOLERANCE * np.maximum(1.0, steps)
-    return np.where(on_step, whole + 1, np.floor(steps) + 2)
-
-
-def time_grid(duration: float, step: float | None = None,
-              names: tuple[str, str] = ("duration", "output_step")) -> np.ndarray:
-    """Output times 0, step, 2 step, ..., ending exactly on ``duration``, s.
-
-    A duration within 1e-9 step of a whole number of steps ends on that step
-    (moved onto ``duration``); otherwise a last, shorter step ends on it. Call
-    :func:`grid_points` and :func:`schuler.memory.require` first for long grids.
-
-    Parameters
-    ----------
-    duration : float
-        s (> 0).
-    step : float, optional
-        s (> 0, at most ``duration``); default ``duration / 1000``.
-    names : tuple of str
-        Parameter names used in error messages.
-    """
-    step = duration / 1000.0 if step is None else step
-    count = int(grid_points(duration, step, names))
-    grid = float(step) * np.arange(count, dtype=float)
-    grid[-1] = duration
-    return grid

@@ -34,10 +34,11 @@ import numpy as np
 
 from schuler.contract import FigureRef, ReportSection
 from schuler.core.earth import BOLLAY, FOOT, PRESETS, STATUTE_MILE
+from schuler.core.geometry import time_grid
 from schuler.navigation_errors import plots
 from schuler.navigation_errors.actions import altitude_errors, loop_gains
 from schuler.navigation_errors.files import problem3_figures, problem3_tables
-from schuler.navigation_errors.inputs import FLIGHT_TIME, time_grid
+from schuler.navigation_errors.inputs import FLIGHT_TIME
 from schuler.navigation_errors.results import Problem3Curves, Problem3Figures
 from schuler.navigation_errors.single_channel import (
     SOURCES,

@@ -39,6 +39,7 @@ no. 4, pp. 447-455, 1975 (:data:`schuler.references.BENSON_1975`).
 from __future__ import annotations
 
 import math
+import sys
 import warnings
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -46,15 +47,15 @@ from typing import ClassVar
 import numpy as np
 
 from schuler.core.earth import PRESETS
+from schuler.core.geometry import grid_points, time_grid
 from schuler.core.lti import simulate
 from schuler.exceptions import InvalidParameter
 from schuler.memory import require
 from schuler.navigation_errors.inputs import (
     EARTH_PARAMETERS,
+    GRID_NAMES,
     check_vertical_growth,
     earth_constants,
-    grid_points,
-    time_grid,
 )
 from schuler.navigation_errors.results import NOISE_FRACTION, lengths, sample_indices
 from schuler.navigation_errors.three_d import psi_angle_model
@@ -276,14 +277,14 @@ def three_d(*, latitude: float, velocity_north: float, velocity_east: float, dur
     model = psi_angle_model(latitude=latitude, radius=R, gravity=g, rate=rate, velocity_north=velocity_north,
                             velocity_east=velocity_east, vertical_channel=vertical_channel)
     width = model.n_states + model.n_inputs
-    require(float(grid_points(duration, output_step)) * 8 * (width * width + 3 * model.n_states + 2),
-            "this run", "--duration or --output-step")
+    require(grid_points(duration, output_step, names=GRID_NAMES) * 8 * (width * width + 3 * model.n_states + 2),
+            "this run", "`duration` or `output_step`")
     latitude_change = abs(velocity_north) * duration / R
     if latitude_change > LATITUDE_CHANGE_WARNING:
         warnings.warn(f"the vehicle moves {math.degrees(latitude_change):.3g} deg in latitude over the run; the "
                       f"model's coefficients stay those of {math.degrees(latitude):.6g} deg", UserWarning,
                       stacklevel=2)
-    t = time_grid(duration, output_step)
+    t = time_grid(duration, output_step, names=GRID_NAMES, max_points=sys.maxsize)  # sized by require above
     response = simulate(model, t, initial_state=_initial_state(model, values), inputs=_model_inputs(model, values))
     histories = {name: response[name] for name in model.states}
     final = {name: float(history[-1]) for name, history in histories.items()}

@@ -176,7 +176,7 @@ class DaskCluster:
         try:
             from distributed import Client, LocalCluster
         except ImportError:
-            raise ScenarioError("--scheduler: Dask is not installed; install schuler[dask]") from None
+            raise ScenarioError("`scheduler`: Dask is not installed; install schuler[dask]") from None
         self.cluster = None
         if scheduler == "local":
             self.cluster = LocalCluster(
@@ -191,9 +191,9 @@ class DaskCluster:
             try:
                 self.client = Client(scheduler, timeout="20s")
             except OSError as error:
-                raise ScenarioError(f"--scheduler: cannot reach {scheduler}: {error}") from None
+                raise ScenarioError(f"`scheduler`: cannot reach {scheduler}: {error}") from None
         else:
-            raise ScenarioError(f"--scheduler: {scheduler!r} is neither 'local' nor an address like tcp://HOST:8786")
+            raise ScenarioError(f"`scheduler`: {scheduler!r} is neither 'local' nor an address like tcp://HOST:8786")
 
     def map(self, function, tasks: Iterable) -> Iterator:
         """Results of ``function`` on each task as they complete (any order), twice the cluster's threads in flight.
@@ -248,7 +248,7 @@ def _wait_futures(pending: set) -> list:
     try:
         return [future.result() for future in done]
     except BrokenProcessPool:
-        raise ScenarioError("--workers: a worker process ended abruptly (out of memory?); "
+        raise ScenarioError("`workers`: a worker process ended abruptly (out of memory?); "
                             "the same command resumes from the chunks stored") from None
 
 
@@ -285,7 +285,7 @@ def make_executor(scheduler: str | None = None, workers: int | None = None):
         ``workers`` below 1, Dask missing, or a scheduler that is neither ``local`` nor reachable.
     """
     if workers is not None and workers < 1:
-        raise ScenarioError(f"--workers: {workers} must be at least 1")
+        raise ScenarioError(f"`workers`: {workers} must be at least 1")
     if scheduler:
         return DaskCluster(scheduler, workers)
     if workers and workers > 1:

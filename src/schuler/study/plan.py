@@ -311,11 +311,11 @@ def parse_axis(text: str, parameters: Iterable[Parameter]) -> Axis:
     name, equals, spec_text = text.partition("=")
     name = name.strip().replace("-", "_")
     if not equals or not spec_text.strip():
-        raise ScenarioError(f"--param {text!r}: expected NAME=START:STOP:STEP or NAME=V1,V2,...")
+        raise ScenarioError(f"`param` {text!r}: expected NAME=START:STOP:STEP or NAME=V1,V2,...")
     if name not in by_name:
-        raise ScenarioError(f"--param {name}: unknown parameter; allowed: {', '.join(by_name)}")
+        raise ScenarioError(f"`param` {name}: unknown parameter; allowed: {', '.join(by_name)}")
     spec = by_name[name]
-    label = f"--param {name}"
+    label = f"`param` {name}"
     try:
         if ":" in spec_text:
             values = _range_values(spec, spec_text, label)
@@ -403,24 +403,24 @@ def plan_sweep(
     names = [axis.name for axis in axes]
     repeated = sorted({name for name in names if names.count(name) > 1})
     if repeated:
-        raise ScenarioError(f"--param {repeated[0]}: given more than once")
+        raise ScenarioError(f"`param` {repeated[0]}: given more than once")
     if chunk_size < 1:
-        raise ScenarioError(f"--chunk-size: {chunk_size} must be at least 1")
+        raise ScenarioError(f"`chunk_size`: {chunk_size} must be at least 1")
     table = scenario.monte_carlo
     draws = monte_carlo if monte_carlo is not None else (table.cases if table and table.cases else None)
     distributions: dict[str, Distribution] = {}
     if draws is not None:
         if draws < 1:
-            raise ScenarioError(f"--monte-carlo: {draws} must be at least 1")
+            raise ScenarioError(f"`monte_carlo`: {draws} must be at least 1")
         if table is None or not table.distributions:
             raise ScenarioError(
-                "--monte-carlo: the scenario has no random parameters; "
+                "`monte_carlo`: the scenario has no random parameters; "
                 "add a [monte_carlo.normal] or [monte_carlo.uniform] table"
             )
         distributions = dict(table.distributions)
         clash = sorted(set(distributions) & set(names))
         if clash:
-            raise ScenarioError(f"--param {clash[0]}: already random in the scenario's [monte_carlo] table")
+            raise ScenarioError(f"`param` {clash[0]}: already random in the scenario's [monte_carlo] table")
     plan = SweepPlan(
         system=system.name,
         parameters=tuple(system.parameters),
@@ -436,7 +436,7 @@ def plan_sweep(
         raise ScenarioError(f"the sweep has {plan.total} cases, more than {MAX_CASES}; check the steps")
     seconds = estimate_seconds(plan, system)
     if seconds is not None:
-        require_time(seconds, f"this sweep of {plan.total} cases", "the --param steps, --monte-carlo or the "
+        require_time(seconds, f"this sweep of {plan.total} cases", "the `param` steps, `monte_carlo` or the "
                      "scenario's [monte_carlo] cases")
     return replace(plan, estimated_seconds=seconds)
 
@@ -480,4 +480,4 @@ def _fidelity(system: System, fidelity: str | None) -> str | None:
     try:
         return system.check_fidelity(fidelity)
     except InvalidParameter as error:
-        raise ScenarioError(f"--fidelity: {error.reason}") from None
+        raise ScenarioError(f"`fidelity`: {error.reason}") from None

@@ -28,7 +28,7 @@ as the command-line options (underscores instead of dashes)::
     [monte_carlo.uniform]   # two values: lower and upper end
     latitude = ["40 deg", "60 deg"]
 
-    [instrument]        # optional, align, calibrate, north and errors: an IMU sets the
+    [instrument]        # optional, align, calibrate, north, errors, vertical: an IMU sets the
     imu = "tactical"    # instrument parameters the file does not set (like --imu): a grade,
     imu_window = "10 min"   # a TOML spec or a recording (paths relative to the scenario's
                         # folder); imu_window, imu_latitude as the options of that name
@@ -483,7 +483,7 @@ def _with_instrument(system: System, values: Case, written: dict[str, Any], sour
     try:
         parsed = options.parse(written)
         case, _ = apply_instrument(system.name, system.parameters, values, parsed["imu"],
-                                   window_s=parsed.get("imu_window"), latitude_rad=parsed.get("imu_latitude"),
+                                   window=parsed.get("imu_window"), latitude=parsed.get("imu_latitude"),
                                    base=folder)
     except (InvalidParameter, ScenarioError) as error:
         raise ScenarioError(f"{source}: [instrument] {error}") from None

@@ -175,7 +175,7 @@ def _prepare(out_dir: Path, plan: SweepPlan) -> None:
         stored.pop("schuler_version", None)
         if stored != manifest:
             raise ScenarioError(
-                f"--out {out_dir}: holds a different sweep (see its sweep.json); "
+                f"`out` {out_dir}: holds a different sweep (see its sweep.json); "
                 "choose another folder or delete this one"
             )
         return
