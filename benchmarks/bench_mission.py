@@ -6,9 +6,9 @@
   (:func:`schuler.navigation_errors.three_d.propagate_along`, one call per constant source and a
   sampled Monte Carlo of the white noises being out of the question, the constant sources only),
   measured in the same run.
-* Monte Carlo of the nonlinear INS (1-h cruise, 200 members, 2 Hz IMU, white noise on all six
-  axes): member-samples per second with the mission's addressed Philox noise blocks, against the
-  same run with the navigate layer's :class:`~schuler.navigate.errors.WhiteNoise` (measured here).
+* Monte Carlo of the nonlinear INS (1-h great circle, 200 members, 2 Hz IMU, white noise on all six
+  axes from the navigate layer's :class:`~schuler.navigate.errors.WhiteNoise`, the IMU layer's
+  compiled streams): member-samples per second, and the noise's own rate.
 * The four example missions' --monte-carlo 1000 time, estimated from the measured throughput
   (issue 18: each under 4 minutes on 2 cores).
 
@@ -29,11 +29,9 @@ from schuler.core.random import RandomStreams
 from schuler.mission.coefficients import step_coefficients
 from schuler.mission.covariance import covariance_budget
 from schuler.mission.evaluation import PARAMETERS
-from schuler.mission.monte_carlo import BlockWhiteNoise, run_members
+from schuler.mission.monte_carlo import run_members, white_noise
 from schuler.mission.setup import CONSTANT_SOURCES, mission_setup
 from schuler.mission.stages import initial_state_map, sensor_inputs
-from schuler.navigate.errors import WhiteNoise
-from schuler.navigate.mechanization import navigate
 from schuler.navigation_errors.three_d import propagate_along
 from schuler.study.scenario import load_scenario
 
@@ -90,17 +88,10 @@ def main() -> None:
     run_members(setup, np.arange(4), RandomStreams(0), rate)  # numba warm-up
     _, wall, cpu = timed(lambda: run_members(setup, np.arange(members), RandomStreams(0), rate), repeat=1)
     mission_rate = samples / cpu
-    print(f"Monte Carlo, 1-h cruise, {members} members at {rate:g} Hz: {samples / wall / 1e6:.2f} M member-samples/s "
-          f"wall, {mission_rate / 1e6:.2f} M/s CPU")
-    trajectory = setup.trajectory()
-    noise = WhiteNoise(float(np.mean(setup.gyro_random_walk)), float(np.mean(setup.accel_random_walk)), seed=0)
-    _, base_wall, base_cpu = timed(lambda: navigate(trajectory, setup.duration, imu_rate=rate,
-                                                    output_step=setup.duration, noise=noise,
-                                                    member_ids=np.arange(members)), repeat=1)
-    print(f"  same run with navigate's WhiteNoise: {samples / base_cpu / 1e6:.2f} M/s CPU; "
-          f"ratio {base_cpu / cpu:.1f}x")
-    block = BlockWhiteNoise(setup.gyro_random_walk, setup.accel_random_walk, 0)
-    _, noise_wall, noise_cpu = timed(lambda: block.increments(np.arange(members), 0, int(setup.duration * rate),
+    print(f"Monte Carlo, 1-h great circle, {members} members at {rate:g} Hz: "
+          f"{samples / wall / 1e6:.2f} M member-samples/s wall, {mission_rate / 1e6:.2f} M/s CPU")
+    noise = white_noise(setup, RandomStreams(0))
+    _, noise_wall, noise_cpu = timed(lambda: noise.increments(np.arange(members), 0, int(setup.duration * rate),
                                                               1 / rate), repeat=1)
     print(f"  the noise alone: {samples / noise_cpu / 1e6:.2f} M member-samples/s CPU")
     for path in sorted(EXAMPLES.glob("mission_*.toml")):

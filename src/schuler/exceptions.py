@@ -53,8 +53,8 @@ _QUOTED_NAME = re.compile(r"`([a-z][a-z0-9_]*)`")
 def as_options(text: str) -> str:
     """A library message as the command line shows it: each parameter quoted as `name` becomes its option.
 
-    The library speaks of parameters (``give `stop_intervals` ``), the command line of options; every option is
-    its parameter's name with dashes (:attr:`schuler.params.Parameter.option`).
+    The library speaks of parameters (its messages quote each in backticks, as in the example), the command line
+    of options; every option is its parameter's name with dashes (:attr:`schuler.params.Parameter.option`).
 
     Parameters
     ----------

@@ -20,9 +20,10 @@ The mechanisation subtracts C^T b from the samples.
 The body is at rest, so the computed velocity is the measurement of dv
 (z = v, H = [0 I 0 0], noise ``velocity_noise`` for sway). The mechanisation
 (:func:`~schuler.alignment._kernels.navigate_at_rest`) runs at the sample rate;
-the filter predicts and updates every ``update_interval`` with
-Phi = I + F dt + (F dt)^2 / 2 and Q_d = (Phi G Q G^T Phi^T + G Q G^T) dt / 2,
-and feeds every estimate back (closed loop): C <- exp([phi x]) C, v <- v - dv,
+the filter predicts and updates every ``update_interval`` with the exact
+Phi = expm(F dt) and Q_d = integral expm(F s) G Q G^T expm(F^T s) ds of the core's
+Van Loan discretisation (:func:`~schuler.core.propagation.discretise_noise`, as every
+Kalman filter of the project), and feeds every estimate back (closed loop): C <- exp([phi x]) C, v <- v - dv,
 biases into the compensation.
 
 Batched across records: the filter's matrices are ``(m, 12, 12)`` arrays and
@@ -55,6 +56,7 @@ from schuler.alignment.inertial import start_attitude
 from schuler.alignment.limits import accuracy_limit, effective_bias_sigma
 from schuler.core.attitude import dcm_from_euler, dcm_from_rotation_vector, euler_from_dcm, orthonormalise, skew
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY, earth_rate_ned
+from schuler.core.propagation import discretise_noise
 from schuler.exceptions import InvalidParameter, renamed_keywords
 
 STATES = 12
@@ -187,29 +189,26 @@ def _initial_covariance(model, tuning: KalmanTuning, batch: StaticBatch, heading
     return P
 
 
-def _transition(C: np.ndarray, gravity: float, omega: np.ndarray, dt: float):
-    """Phi (m, 12, 12) and the noise input G (m, 12, 12) of the error model over dt.
+def _error_model(C: np.ndarray, gravity: float, omega: np.ndarray):
+    """F (12, 12) and the noise input G (m, 12, 12) of the error model at rest.
 
     The specific force in F is the modelled one at rest, (0, 0, -g): the measured
     mean carries the accelerometer noise, and with it f x phi would make the heading
     look observable through noise.
     """
-    m = C.shape[0]
-    F = np.zeros((m, STATES, STATES))
+    F = np.zeros((STATES, STATES))
     W = skew(omega)
-    F[:, 0:3, 0:3] = -W
-    F[:, 0:3, 6:9] = -np.eye(3)
-    F[:, 3:6, 0:3] = skew(np.array([0.0, 0.0, -gravity]))
-    F[:, 3:6, 3:6] = -2.0 * W
-    F[:, 3:6, 9:12] = np.eye(3)
-    Fdt = F * dt
-    Phi = np.eye(STATES) + Fdt + 0.5 * (Fdt @ Fdt)
-    G = np.zeros((m, STATES, STATES))
+    F[0:3, 0:3] = -W
+    F[0:3, 6:9] = -np.eye(3)
+    F[3:6, 0:3] = skew(np.array([0.0, 0.0, -gravity]))
+    F[3:6, 3:6] = -2.0 * W
+    F[3:6, 9:12] = np.eye(3)
+    G = np.zeros((C.shape[0], STATES, STATES))
     G[:, 0:3, 0:3] = -C
     G[:, 3:6, 3:6] = C
     G[:, 6:9, 6:9] = C
     G[:, 9:12, 9:12] = C
-    return Phi, G
+    return F, G
 
 
 def attitude_sigma(P: np.ndarray, heading: np.ndarray) -> np.ndarray:
@@ -290,9 +289,9 @@ def align_kalman(batch: StaticBatch, model, *, velocity_noise: float = 0.01, upd
         _kernels.navigate_at_rest(batch.gyro_increment, batch.accel_increment, int(start), int(stop), dt, C, velocity,
                                   np.einsum("mij,mj->mi", to_body, gyro_bias),
                                   np.einsum("mij,mj->mi", to_body, accel_bias), omega, gravity, previous)
-        Phi, G = _transition(C, batch.gravity, omega, span)
-        GQG = G @ intensity @ np.swapaxes(G, 1, 2)
-        P = Phi @ P @ np.swapaxes(Phi, 1, 2) + 0.5 * span * (Phi @ GQG @ np.swapaxes(Phi, 1, 2) + GQG)
+        F, G = _error_model(C, batch.gravity, omega)
+        Phi, Q = discretise_noise(F, G @ intensity @ np.swapaxes(G, 1, 2), span)
+        P = Phi @ P @ np.swapaxes(Phi, -1, -2) + Q
         S = P[:, 3:6, 3:6] + R
         gain = np.swapaxes(np.linalg.solve(S, np.swapaxes(P[:, :, 3:6], 1, 2)), 1, 2)
         x = np.einsum("mij,mj->mi", gain, velocity)

@@ -73,6 +73,7 @@ from schuler.alignment.limits import (
 )
 from schuler.core.attitude import euler_from_dcm
 from schuler.core.earth import EARTH_RATE, STANDARD_GRAVITY, earth_rate_ned
+from schuler.core.propagation import discretise_noise
 from schuler.exceptions import InvalidParameter, renamed_keywords
 
 PROPAGATION_STEP_S = 1.0
@@ -306,18 +307,6 @@ def design_gyrocompass(errors, *, latitude: float, duration: float,
         LoopStage("fine azimuth", azimuth_end, duration, fine_period, 1.0 / fastest, growing=True)))
 
 
-def _propagate(A: np.ndarray, intensity: np.ndarray, span: float) -> tuple[np.ndarray, np.ndarray]:
-    """(Phi, Q_d) of x' = A x + w, E[w w^T] = intensity delta, over ``span`` s (Van Loan 1978)."""
-    from scipy.linalg import expm
-
-    size = A.shape[0]
-    M = np.zeros((2 * size, 2 * size))
-    M[:size, :size], M[:size, size:], M[size:, size:] = -A, intensity, A.T
-    E = expm(M * span)
-    transition = E[size:, size:].T
-    return transition, transition @ E[:size, size:]
-
-
 def staged_limit(errors, design: GyrocompassDesign, *, latitude: float, heading: float,
                  gravity: float = STANDARD_GRAVITY, initial_window: float = 30.0) -> AccuracyLimit:
     """The stated 1-sigma limit of the staged loop at the window's end (module notes), rad.
@@ -353,7 +342,7 @@ def staged_limit(errors, design: GyrocompassDesign, *, latitude: float, heading:
     k1, k2, k3 = design.gains((edges[:-1] + edges[1:]) / 2.0, latitude)
     for step in range(edges.size - 1):
         A, B = error_model(latitude, k1[step], k2[step], k3[step], gravity)
-        transition, driven = _propagate(A, B @ intensity @ B.T, edges[step + 1] - edges[step])
+        transition, driven = discretise_noise(A, B @ intensity @ B.T, float(edges[step + 1] - edges[step]))
         P = transition @ P @ transition.T + driven
     end_k1, end_k2, end_k3 = design.gains(np.array([design.stages[-1].end_s]), latitude)
     A, B = error_model(latitude, float(end_k1[0]), float(end_k2[0]), float(end_k3[0]), gravity)

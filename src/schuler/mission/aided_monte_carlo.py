@@ -9,7 +9,7 @@ member)). Its IMU measures the trajectory's ideal increments
     dtheta = (I + S_g) dtheta_true + b_g dt + n_g,   dv = (I + S_a) dv_true + b_a dt + n_a,
 
 n the angle and velocity random walks' increments
-(:class:`~schuler.mission.monte_carlo.BlockWhiteNoise`); its GNSS fixes are
+(:class:`~schuler.navigate.errors.WhiteNoise`); its GNSS fixes are
 ``schuler aided``'s (:func:`schuler.aided.gnss.gnss_measurements`: the antenna's
 truth at the lever arm, white noise at the address (seed, ``gnss/...``,
 member, epoch), the outages removed). It starts where its alignment left it

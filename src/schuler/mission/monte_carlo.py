@@ -9,7 +9,8 @@ roll, pitch and heading errors of the computed attitude
 C_computed = exp(-[phi x]) C_true. Its sensors carry the drawn biases and
 scale factors (:class:`schuler.navigate.errors.ConstantSensorErrors`) and white noise of
 the error model's angle and velocity random walks per axis
-(:class:`BlockWhiteNoise`). The strapdown INS then runs along the trajectory
+(:class:`schuler.navigate.errors.WhiteNoise`, the IMU layer's white-noise streams).
+The strapdown INS then runs along the trajectory
 (:func:`schuler.navigate.mechanization.navigate`), batched over members.
 
 A reduced IMU rate is allowed: the white noise enters as increments of
@@ -21,9 +22,6 @@ the members do not depend on how a Monte Carlo is cut into chunks.
 """
 
 from __future__ import annotations
-
-import zlib
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -38,97 +36,12 @@ from schuler.core.earth import EARTH_RATE, radii_of_curvature
 from schuler.core.random import RandomStreams
 from schuler.mission.setup import CONSTANT_SOURCES, MissionSetup
 from schuler.mission.stages import alignment_noise, initial_state_map
-from schuler.navigate.errors import ConstantSensorErrors, InitialErrors
+from schuler.navigate.errors import ConstantSensorErrors, InitialErrors, WhiteNoise
 from schuler.navigate.mechanization import navigate
 from schuler.navigate.results import NavigationResult
 
-NOISE_BLOCK = 256
-"""IMU intervals per addressed noise block: short, so that a chunk of the run redraws little."""
-
-
 SCALE_FACTOR_LIMIT = 0.1
 """Largest scale-factor error a member flies with (the navigate layer's limit); larger draws are clipped."""
-
-
-def _stream_key(seed: int, stream: str) -> int:
-    return int(np.random.SeedSequence([seed, zlib.crc32(stream.encode())]).generate_state(1, np.uint64)[0])
-
-
-@dataclass(frozen=True)
-class BlockWhiteNoise:
-    """White rate noise per body axis, addressed by (seed, sensor, member, block): the navigate SensorNoise interface.
-
-    The increments of IMU intervals [256 b, 256 (b + 1)) of member m are the
-    normals of a Philox generator (counter-based; Salmon et al., "Parallel
-    random numbers: as easy as 1, 2, 3", SC 2011) keyed by (sensor stream, m) and
-    started at counter (0, b, 0, 0), times N sqrt(dt) per axis: the same
-    numbers however the run is chunked, at the generator's speed (one state
-    reset per member and block instead of a new generator).
-
-    Parameters
-    ----------
-    gyro_density, accel_density : array (3,)
-        N per axis: rad/sqrt(s) and m/s/sqrt(s).
-    seed : int
-
-    Examples
-    --------
-    >>> noise = BlockWhiteNoise(np.full(3, 1e-5), np.zeros(3), seed=1)
-    >>> whole, _ = noise.increments(np.arange(2), 0, 600, 0.5)
-    >>> part, _ = noise.increments(np.arange(2), 250, 600, 0.5)
-    >>> bool(np.array_equal(whole[:, 250:], part))
-    True
-    """
-
-    gyro_density: np.ndarray
-    accel_density: np.ndarray
-    seed: int = 0
-
-    def increments(self, members, start: int, stop: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        """The noise added to the angle and velocity increments of IMU intervals ``start .. stop - 1``.
-
-        Parameters
-        ----------
-        members : array_like of int
-            Global member numbers, shape (M,).
-        start, stop : int
-            Global index of the first IMU interval and one past the last, number of intervals (interval k ends
-            at t = (k + 1) dt).
-        dt : float
-            IMU interval, s.
-
-        Returns
-        -------
-        gyro, accel : ndarray
-            Shape (M, stop - start, 3), body axes: angle increment errors, rad, and velocity increment errors,
-            m/s (standard deviation N sqrt(dt) per axis).
-        """
-        members = np.asarray(members, dtype=np.int64)
-        first, last = start // NOISE_BLOCK, max(start, stop - 1) // NOISE_BLOCK
-        width = (last - first + 1) * NOISE_BLOCK
-        offset = start - first * NOISE_BLOCK
-        bit_generator = np.random.Philox(0)
-        generator = np.random.Generator(bit_generator)
-        block = np.empty((width, 3))
-        out = []
-        for sensor, density in (("gyro", self.gyro_density), ("accel", self.accel_density)):
-            values = np.zeros((members.size, stop - start, 3))
-            scale = np.asarray(density, dtype=float) * np.sqrt(dt)
-            if stop > start and np.any(scale > 0):
-                key = _stream_key(self.seed, f"mission/{sensor}")
-                for row, member in enumerate(members):
-                    for b in range(first, last + 1):
-                        bit_generator.state = {
-                            "bit_generator": "Philox",
-                            "state": {"counter": np.array([0, b, 0, 0], dtype=np.uint64),
-                                      "key": np.array([key, member], dtype=np.uint64)},
-                            "buffer": np.zeros(4, dtype=np.uint64), "buffer_pos": 4, "has_uint32": 0,
-                            "uinteger": 0}
-                        at = (b - first) * NOISE_BLOCK
-                        generator.standard_normal(out=block[at:at + NOISE_BLOCK])
-                    values[row] = block[offset:offset + stop - start] * scale
-            out.append(values)
-        return out[0], out[1]
 
 
 def member_draws(setup: MissionSetup, members, streams: RandomStreams, n_states: int,
@@ -260,7 +173,7 @@ def sensor_errors(draws: np.ndarray) -> ConstantSensorErrors:
                                 accel_scale_factor=triad("accel_scale_factor"))
 
 
-def white_noise(setup: MissionSetup, streams: RandomStreams) -> BlockWhiteNoise | None:
+def white_noise(setup: MissionSetup, streams: RandomStreams) -> WhiteNoise | None:
     """The members' angle and velocity random walks (None when the instrument has none).
 
     Parameters
@@ -272,11 +185,11 @@ def white_noise(setup: MissionSetup, streams: RandomStreams) -> BlockWhiteNoise 
 
     Returns
     -------
-    BlockWhiteNoise or None
-        The noise, addressed by (seed, sensor, member, block).
+    WhiteNoise or None
+        The noise, addressed by (seed, sensor axis, member, IMU interval).
     """
     noisy = np.any(setup.gyro_random_walk) or np.any(setup.accel_random_walk)
-    return BlockWhiteNoise(setup.gyro_random_walk, setup.accel_random_walk, streams.seed) if noisy else None
+    return WhiteNoise(setup.gyro_random_walk, setup.accel_random_walk, streams.seed) if noisy else None
 
 
 def final_horizontal_errors(result: NavigationResult) -> np.ndarray:

@@ -282,30 +282,37 @@ class SensorNoise(Protocol):
 
 @dataclass(frozen=True)
 class WhiteNoise:
-    """White rate noise: angle random walk (gyros) and velocity random walk (accelerometers).
+    """White rate noise: angle random walk (gyros) and velocity random walk (accelerometers), per body axis.
 
     Each interval's increment error is normal with standard deviation N sqrt(dt)
-    per axis (the integral of white rate noise of PSD N^2 over dt).
+    per axis (the integral of white rate noise of PSD N^2 over dt). Interval k of
+    member m on axis x takes the normal of :class:`~schuler.core.random.RandomStreams`
+    at (``"gyro_x/white"``, m, k), the stream the IMU layer's white noise draws
+    (:class:`~schuler.imu.simulate.ImuSimulator`), in compiled code: the same numbers
+    however a run is cut.
 
     Parameters
     ----------
-    angle_random_walk : float
-        N_g, rad/sqrt(s) (1 deg/sqrt(h) = 2.9089e-4 rad/sqrt(s)).
-    velocity_random_walk : float
-        N_a, m/s/sqrt(s) (1 ug/sqrt(Hz) = 9.80665e-6 m/s/sqrt(s)).
+    angle_random_walk : float or array_like (3,)
+        N_g, rad/sqrt(s), one for all axes or one per body axis (1 deg/sqrt(h) = 2.9089e-4 rad/sqrt(s)).
+    velocity_random_walk : float or array_like (3,)
+        N_a, m/s/sqrt(s), likewise (1 ug/sqrt(Hz) = 9.80665e-6 m/s/sqrt(s)).
     seed : int
         Study seed of the :class:`~schuler.core.random.RandomStreams`.
     """
 
-    angle_random_walk: float = 0.0
-    velocity_random_walk: float = 0.0
+    angle_random_walk: float | np.ndarray = 0.0
+    velocity_random_walk: float | np.ndarray = 0.0
     seed: int = 0
 
     def __post_init__(self):
         for name in ("angle_random_walk", "velocity_random_walk"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0):
-                raise InvalidParameter(name, f"must be finite and >= 0, got {value!r}")
+            value = np.asarray(getattr(self, name), dtype=float)
+            if value.shape not in ((), (3,)):
+                raise InvalidParameter(name, f"one density or one per body axis (3,), got shape {value.shape}")
+            if not np.all(np.isfinite(value) & (value >= 0)):
+                raise InvalidParameter(name, f"must be finite and >= 0, got {getattr(self, name)!r}")
+            object.__setattr__(self, name, np.broadcast_to(value, (3,)).copy())
 
     def increments(self, members, start: int, stop: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Normal increment errors of standard deviation N sqrt(dt), the :class:`SensorNoise` method.
@@ -330,10 +337,11 @@ class WhiteNoise:
         streams = RandomStreams(self.seed)
         members = np.asarray(members, dtype=np.int64)
         out = []
-        for sensor, density in (("gyro", self.angle_random_walk), ("accel", self.velocity_random_walk)):
-            if density == 0.0:
-                out.append(np.zeros((members.size, stop - start, 3)))
-                continue
-            axes = [streams.normal_series(f"{sensor}_{axis}/white", members, start, stop) for axis in "xyz"]
-            out.append(np.stack(axes, axis=-1) * (density * np.sqrt(dt)))
+        for sensor, densities in (("gyro", self.angle_random_walk), ("accel", self.velocity_random_walk)):
+            values = np.zeros((members.size, stop - start, 3))
+            for index, density in enumerate(np.atleast_1d(densities)):
+                if density > 0.0:
+                    series = streams.normal_series(f"{sensor}_{'xyz'[index]}/white", members, start, stop)
+                    values[:, :, index] = series * (density * np.sqrt(dt))
+            out.append(values)
         return out[0], out[1]
