@@ -112,7 +112,9 @@ def test_round_trip_over_seeds_and_rates_through_the_system():
         summary = SYSTEM.monte_carlo(SYSTEM.case(imu="industrial", duration=1200.0, imu_rate=rate), 6,
                                      RandomStreams(3))
         stats = summary.statistics["fraction_within_tolerance"]
-        assert stats["min"] == 1.0, (rate, stats)
+        # each record checks 11 or 12 resolved terms against 3 sigma + method bias: of 66-72 checks about 0.2 fall
+        # outside by chance, 3 or more with probability 0.1 %; a mean fraction >= 1 - 2/66 allows at most 2
+        assert stats["mean"] >= 1 - 2 / 66, (rate, stats)
         n = summary.statistics["noise_gyro_x_N"]
         truth = math.radians(0.007)  # 0.007 deg/s/sqrt(Hz) in rad/sqrt(s)
         # the mean of 6 records is within 1 % of the data-sheet figure; their spread is a few tenths of a percent
